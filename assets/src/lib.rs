@@ -1,0 +1,1 @@
+//! Hair data model and loaders (in progress).

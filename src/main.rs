@@ -1,0 +1,47 @@
+//! `strandgraph`: the command-line front end.
+//!
+//! Each subcommand lives in its own module; `main` only parses arguments,
+//! sets up logging and turns errors into diagnostics with exit code 2.
+
+mod graph_cmd;
+mod info;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "strandgraph", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Compile a render graph (RON) and print its plan: queue lanes, lifetimes, aliasing, sync.
+    Graph(graph_cmd::Args),
+    /// Print strands, points, segments, bounds and memory of a scene, groom or mesh file.
+    Info(info::Args),
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Graph(args) => graph_cmd::run(args),
+        Command::Info(args) => info::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(report) => {
+            eprintln!("{report:?}");
+            ExitCode::from(2)
+        }
+    }
+}
