@@ -1,0 +1,1 @@
+//! Render graph compiler (in progress).

@@ -1,0 +1,1 @@
+//! Pass registry (in progress).
