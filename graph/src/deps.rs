@@ -1,0 +1,341 @@
+//! Dependencies between passes, derived from data flow.
+//!
+//! The graph is a data-flow graph, not a list: declaration order does not
+//! order passes. Per resource, each frame has one version:
+//! - a **transient** is produced by its writers (which must be ordered among
+//!   themselves), then updated by its atomic passes (which commute), then read;
+//! - an **imported** or **history** resource starts the frame with contents
+//!   (given by the caller, or left by the previous frame): its readers see
+//!   those, so every writer waits for every reader (write-after-read).
+//!
+//! Anything else (a read with no writer, a cycle, two unordered writers) is an
+//! error. Atomic updaters that nothing orders are serialised in topological
+//! order: their results commute, but Vulkan still wants a barrier between them.
+
+use crate::error::{ErrorKind, GraphError, GraphErrors};
+use crate::reach::Reach;
+use crate::resolve::{Access, Graph, PassId, ResourceId};
+use crate::schema::{AccessMode, LifetimeClass};
+use serde::Serialize;
+use std::cmp::Reverse;
+use std::collections::{BTreeSet, BinaryHeap};
+
+/// The kind of memory hazard a dependency protects against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+pub enum Hazard {
+    ReadAfterWrite,
+    WriteAfterRead,
+    WriteAfterWrite,
+}
+
+impl Hazard {
+    pub fn short(self) -> &'static str {
+        match self {
+            Hazard::ReadAfterWrite => "RAW",
+            Hazard::WriteAfterRead => "WAR",
+            Hazard::WriteAfterWrite => "WAW",
+        }
+    }
+}
+
+/// `to` must wait for `from` because of `resource`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Edge {
+    pub from: PassId,
+    pub to: PassId,
+    pub resource: ResourceId,
+    pub hazard: Hazard,
+}
+
+/// Every dependency edge and a deterministic topological order of all passes.
+#[derive(Debug, Clone)]
+pub struct Dependencies {
+    pub edges: Vec<Edge>,
+    /// All passes; ties broken by declaration order.
+    pub order: Vec<PassId>,
+}
+
+struct Users {
+    readers: Vec<(PassId, Access)>,
+    writers: Vec<(PassId, Access)>,
+    updaters: Vec<(PassId, Access)>,
+}
+
+fn users(g: &Graph, r: ResourceId) -> Users {
+    let mut u = Users {
+        readers: vec![],
+        writers: vec![],
+        updaters: vec![],
+    };
+    for (p, pass) in g.passes.iter().enumerate() {
+        for a in pass.accesses.iter().filter(|a| a.resource == r) {
+            match a.mode {
+                AccessMode::Read => u.readers.push((p, *a)),
+                AccessMode::Write => u.writers.push((p, *a)),
+                AccessMode::Atomic => u.updaters.push((p, *a)),
+            }
+        }
+    }
+    u
+}
+
+pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
+    let src = &g.source;
+    let mut errors = Vec::new();
+    let mut edges = Vec::new();
+    let all_users: Vec<Users> = (0..g.resources.len()).map(|r| users(g, r)).collect();
+
+    for (r, res) in g.resources.iter().enumerate() {
+        let u = &all_users[r];
+        let class = res.decl.lifetime();
+        let initial_contents = res.has_initial_contents();
+        // Atomic updates need initialised memory: they follow every writer.
+        for &(p, a) in &u.updaters {
+            let sources: Vec<_> = u.writers.iter().filter(|(w, _)| *w != p).collect();
+            if sources.is_empty() && !initial_contents {
+                errors.push(
+                    GraphError::new(
+                        ErrorKind::ReadBeforeWrite,
+                        src,
+                        a.span,
+                        format!(
+                            "pass `{}` updates transient `{}` atomically, but no pass writes it first",
+                            g.passes[p].name, res.name
+                        ),
+                    )
+                    .label(res.span, "declared here")
+                    .help("add a pass that clears it, e.g. kind `common.clear`"),
+                );
+            }
+            edges.extend(sources.iter().map(|(w, _)| Edge {
+                from: *w,
+                to: p,
+                resource: r,
+                hazard: Hazard::ReadAfterWrite,
+            }));
+        }
+        for &(p, a) in &u.readers {
+            let sources: Vec<PassId> =
+                u.writers.iter().chain(&u.updaters).map(|(w, _)| *w).filter(|w| *w != p).collect();
+            if initial_contents {
+                // Readers see the contents the frame started with.
+                let writers: BTreeSet<PassId> = sources.into_iter().collect();
+                edges.extend(writers.into_iter().map(|w| Edge {
+                    from: p,
+                    to: w,
+                    resource: r,
+                    hazard: Hazard::WriteAfterRead,
+                }));
+                continue;
+            }
+            if sources.is_empty() {
+                errors.push(
+                    GraphError::new(
+                        ErrorKind::ReadBeforeWrite,
+                        src,
+                        a.span,
+                        format!("pass `{}` reads transient `{}`, but no pass writes it", g.passes[p].name, res.name),
+                    )
+                    .label(res.span, "declared here"),
+                );
+            }
+            edges.extend(sources.into_iter().map(|w| Edge {
+                from: w,
+                to: p,
+                resource: r,
+                hazard: Hazard::ReadAfterWrite,
+            }));
+        }
+        // An in-place write (`a -> b`) is the last use of version `a`: every
+        // other reader of `a` runs first, and only one pass may consume it.
+        let consumers: Vec<(PassId, Access)> = u
+            .readers
+            .iter()
+            .filter(|(p, _)| {
+                g.passes[*p].accesses.iter().any(|w| {
+                    w.mode.writes() && w.resource != r && g.physical(w.resource) == g.physical(r)
+                })
+            })
+            .copied()
+            .collect();
+        if let [(a, _), (b, acc_b), ..] = consumers.as_slice() {
+            errors.push(GraphError::new(
+                ErrorKind::UnorderedWriters,
+                src,
+                acc_b.span,
+                format!(
+                    "passes `{}` and `{}` both write `{}` in place; only one pass may make a new version of it",
+                    g.passes[*a].name, g.passes[*b].name, res.name
+                ),
+            ));
+        }
+        for &(c, _) in &consumers {
+            edges.extend(u.readers.iter().filter(|(p, _)| *p != c).map(|(p, _)| Edge {
+                from: *p,
+                to: c,
+                resource: r,
+                hazard: Hazard::WriteAfterRead,
+            }));
+        }
+        if class == LifetimeClass::History && res.version_of.is_none() && u.writers.is_empty() && u.updaters.is_empty() {
+            if let Some(&(p, a)) = u.readers.first() {
+                errors.push(GraphError::new(
+                    ErrorKind::ReadBeforeWrite,
+                    src,
+                    a.span,
+                    format!(
+                        "pass `{}` reads history `{}`, which no pass ever writes",
+                        g.passes[p].name, res.name
+                    ),
+                ));
+            }
+        }
+    }
+    if !errors.is_empty() {
+        return Err(GraphErrors(errors));
+    }
+    edges.sort_by_key(|e| (e.from, e.to, e.resource));
+    edges.dedup();
+
+    let order = topological_order(g.passes.len(), &edges).map_err(|cycle| cycle_error(g, &edges, &cycle))?;
+    let reach = Reach::new(g.passes.len(), &order, edges.iter().map(|e| (e.from, e.to)));
+    let position = positions(&order);
+
+    // Writers must be ordered by the rest of the graph; ordered ones get a WAW edge.
+    for (r, u) in all_users.iter().enumerate() {
+        let mut writers = u.writers.clone();
+        writers.sort_by_key(|(p, _)| position[*p]);
+        for (i, &(a, acc_a)) in writers.iter().enumerate() {
+            for &(b, acc_b) in &writers[i + 1..] {
+                if reach.reaches(a, b) {
+                    edges.push(Edge {
+                        from: a,
+                        to: b,
+                        resource: r,
+                        hazard: Hazard::WriteAfterWrite,
+                    });
+                } else {
+                    errors.push(
+                        GraphError::new(
+                            ErrorKind::UnorderedWriters,
+                            src,
+                            acc_b.span,
+                            format!(
+                                "passes `{}` and `{}` both write `{}`, but nothing orders them",
+                                g.passes[a].name, g.passes[b].name, g.resources[r].name
+                            ),
+                        )
+                        .label(acc_a.span, "also written here")
+                        .help("make one read something the other writes, or write separate resources"),
+                    );
+                }
+            }
+        }
+    }
+    if !errors.is_empty() {
+        return Err(GraphErrors(errors));
+    }
+    // Atomic updaters commute; serialise them along the topological order
+    // (edges forward in that order cannot create a cycle).
+    for (r, u) in all_users.iter().enumerate() {
+        let mut ups: Vec<PassId> = u.updaters.iter().map(|(p, _)| *p).collect();
+        ups.sort_by_key(|p| position[*p]);
+        ups.dedup();
+        edges.extend(ups.windows(2).map(|w| Edge {
+            from: w[0],
+            to: w[1],
+            resource: r,
+            hazard: Hazard::WriteAfterWrite,
+        }));
+    }
+    edges.sort_by_key(|e| (e.from, e.to, e.resource));
+    edges.dedup();
+    Ok(Dependencies { edges, order })
+}
+
+pub(crate) fn positions(order: &[PassId]) -> Vec<usize> {
+    let mut pos = vec![usize::MAX; order.iter().max().map_or(0, |m| m + 1)];
+    for (i, &p) in order.iter().enumerate() {
+        pos[p] = i;
+    }
+    pos
+}
+
+/// Kahn's algorithm, smallest declaration index first, so the order is
+/// stable and reads like the file. On a cycle, returns the passes left over.
+pub(crate) fn topological_order(n: usize, edges: &[Edge]) -> Result<Vec<PassId>, Vec<PassId>> {
+    let mut indegree = vec![0usize; n];
+    let mut succ = vec![Vec::new(); n];
+    let mut seen = BTreeSet::new();
+    for e in edges {
+        if seen.insert((e.from, e.to)) {
+            indegree[e.to] += 1;
+            succ[e.from].push(e.to);
+        }
+    }
+    let mut ready: BinaryHeap<Reverse<PassId>> = (0..n).filter(|&p| indegree[p] == 0).map(Reverse).collect();
+    let mut order = Vec::with_capacity(n);
+    while let Some(Reverse(p)) = ready.pop() {
+        order.push(p);
+        for &s in &succ[p] {
+            indegree[s] -= 1;
+            if indegree[s] == 0 {
+                ready.push(Reverse(s));
+            }
+        }
+    }
+    if order.len() == n {
+        Ok(order)
+    } else {
+        Err((0..n).filter(|&p| indegree[p] > 0).collect())
+    }
+}
+
+/// Names one cycle among the passes Kahn's algorithm could not order.
+fn cycle_error(g: &Graph, edges: &[Edge], stuck: &[PassId]) -> GraphErrors {
+    use petgraph::graph::DiGraph;
+    let mut dg = DiGraph::<PassId, ResourceId>::new();
+    let nodes: Vec<_> = (0..g.passes.len()).map(|p| dg.add_node(p)).collect();
+    for e in edges {
+        if stuck.contains(&e.from) && stuck.contains(&e.to) {
+            dg.add_edge(nodes[e.from], nodes[e.to], e.resource);
+        }
+    }
+    // Within a strongly connected component, walk until a pass repeats.
+    let scc = petgraph::algo::tarjan_scc(&dg).into_iter().find(|c| c.len() > 1).unwrap_or_default();
+    let mut path: Vec<(PassId, ResourceId)> = Vec::new();
+    let mut at = scc.iter().map(|n| dg[*n]).min().unwrap_or(stuck[0]);
+    loop {
+        if let Some(i) = path.iter().position(|(p, _)| *p == at) {
+            path.drain(..i);
+            break;
+        }
+        let next = dg
+            .edges(nodes[at])
+            .filter(|e| scc.contains(&petgraph::visit::EdgeRef::target(e)))
+            .map(|e| (dg[petgraph::visit::EdgeRef::target(&e)], *e.weight()))
+            .min();
+        let Some((to, r)) = next else { break };
+        path.push((at, r));
+        at = to;
+    }
+    let Some(&(first, _)) = path.first() else {
+        return GraphError::new(ErrorKind::Cycle, &g.source, g.passes[stuck[0]].span, "passes form a cycle").into();
+    };
+    let chain: Vec<String> = path
+        .iter()
+        .map(|(p, r)| format!("`{}` -({})->", g.passes[*p].name, g.resources[*r].name))
+        .chain(std::iter::once(format!("`{}`", g.passes[first].name)))
+        .collect();
+    let mut e = GraphError::new(
+        ErrorKind::Cycle,
+        &g.source,
+        g.passes[first].span,
+        format!("passes form a cycle: {}", chain.join(" ")),
+    )
+    .primary("this pass depends on itself");
+    for (p, _) in path.iter().skip(1) {
+        e = e.label(g.passes[*p].span, "on the cycle");
+    }
+    e.into()
+}
