@@ -55,7 +55,14 @@ type Parse = fn(&[u8]) -> Result<Groom, FormatError>;
 fn binary_formats() -> Vec<(&'static str, Parse, Vec<u8>, usize, usize, usize)> {
     // (name, parser, file, strands field offset, points-per-strand or points field, first position byte)
     vec![
-        ("cyhair", cyhair::parse as Parse, cyhair_file(), 4, 8, 128 + 3 * 2),
+        (
+            "cyhair",
+            cyhair::parse as Parse,
+            cyhair_file(),
+            4,
+            8,
+            128 + 3 * 2,
+        ),
         ("tfx4", tfx4::parse as Parse, tfx4_file(), 4, 8, 160),
         ("tfx3", tfx3::parse as Parse, tfx3_file(), 4, 8, 296),
     ]
@@ -68,7 +75,10 @@ fn valid_files_parse() {
         assert_eq!(g.strand_count(), 3, "{name}");
         assert_eq!(g.point_count(), 12, "{name}");
     }
-    assert_eq!(tfx2::parse(tfx2_file().as_bytes()).unwrap().point_count(), 12);
+    assert_eq!(
+        tfx2::parse(tfx2_file().as_bytes()).unwrap().point_count(),
+        12
+    );
     assert_eq!(obj::parse(OBJ.as_bytes()).unwrap().triangle_count(), 2);
 }
 
@@ -120,11 +130,17 @@ fn counts_exceeding_the_file_are_rejected_before_allocation() {
     // tfx2: numStrands larger than the lines left.
     let t = tfx2_file().replace("numStrands 3", "numStrands 900000");
     let e = tfx2::parse(t.as_bytes()).unwrap_err();
-    assert!(matches!(e.kind, FormatErrorKind::CountExceedsFile { .. }), "{e}");
+    assert!(
+        matches!(e.kind, FormatErrorKind::CountExceedsFile { .. }),
+        "{e}"
+    );
     assert_eq!(e.location, Location::Line(9));
     let t = tfx2_file().replacen("numVerts 4", "numVerts 4000", 1);
     let e = tfx2::parse(t.as_bytes()).unwrap_err();
-    assert!(matches!(e.kind, FormatErrorKind::CountExceedsFile { .. }), "{e}");
+    assert!(
+        matches!(e.kind, FormatErrorKind::CountExceedsFile { .. }),
+        "{e}"
+    );
     assert_eq!(e.location, Location::LineCol(11, 19));
 }
 
@@ -135,7 +151,10 @@ fn zero_counts_are_rejected() {
             let mut b = file.clone();
             put_u32(&mut b, at, 0);
             let e = parse(&b).unwrap_err();
-            assert!(matches!(e.kind, FormatErrorKind::ZeroCount { .. }), "{name}: {e}");
+            assert!(
+                matches!(e.kind, FormatErrorKind::ZeroCount { .. }),
+                "{name}: {e}"
+            );
             assert_eq!(e.location, Location::Byte(at), "{name}");
         }
     }
@@ -180,7 +199,10 @@ fn nan_and_inf_positions_are_rejected() {
             let at = pos_at + 4 * 7; // a coordinate of the third point or so
             put_f32(&mut b, at, bad);
             let e = parse(&b).unwrap_err();
-            assert!(matches!(e.kind, FormatErrorKind::NonFinite { .. }), "{name}: {e}");
+            assert!(
+                matches!(e.kind, FormatErrorKind::NonFinite { .. }),
+                "{name}: {e}"
+            );
             assert_eq!(e.location, Location::Byte(at), "{name}");
         }
     }
@@ -272,7 +294,12 @@ fn header_defaults_fill_absent_cyhair_arrays() {
     assert_eq!(g.strand_offsets, vec![0, 3, 6]);
     assert!(g.thickness.iter().all(|&t| t == 0.25));
     assert!(g.transparency.unwrap().iter().all(|&t| t == 0.5));
-    assert!(g.colors.unwrap().iter().all(|&c| c == Vec3::new(0.1, 0.2, 0.3)));
+    assert!(
+        g.colors
+            .unwrap()
+            .iter()
+            .all(|&c| c == Vec3::new(0.1, 0.2, 0.3))
+    );
     // d_segments that do not match point_count.
     put_u32(&mut b, 16, 3);
     let e = cyhair::parse(&b).unwrap_err();

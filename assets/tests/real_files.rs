@@ -97,8 +97,11 @@ fn sintel_meshes_obj() {
     // 5,952 faces: all triangles in this file.
     assert_eq!(head.triangle_count(), 5_952);
     head.validate().unwrap();
-    let lashes =
-        load_mesh(&grooms_dir().join("sintel/sintel_eyelashes.obj"), Units::Metres).unwrap();
+    let lashes = load_mesh(
+        &grooms_dir().join("sintel/sintel_eyelashes.obj"),
+        Units::Metres,
+    )
+    .unwrap();
     assert!(lashes.triangle_count() >= 192);
 }
 
@@ -119,5 +122,9 @@ fn sintel_hair_roots_sit_on_sintel_head() {
         .zip(&skin)
         .filter(|(r, s)| s.root_position(&head).unwrap().distance(**r) < 0.02)
         .count();
-    assert!(near * 10 >= roots.len() * 9, "{near} of {} roots near the head", roots.len());
+    assert!(
+        near * 10 >= roots.len() * 9,
+        "{near} of {} roots near the head",
+        roots.len()
+    );
 }

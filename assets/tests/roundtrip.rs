@@ -17,9 +17,11 @@ fn variable_groom() -> impl Strategy<Value = Groom> {
     )
     .prop_map(|strands| {
         let mut g = Groom::from_strands(
-            strands
-                .iter()
-                .map(|s| s.iter().map(|&(x, y, z, _)| Vec3::new(x, y, z)).collect::<Vec<_>>()),
+            strands.iter().map(|s| {
+                s.iter()
+                    .map(|&(x, y, z, _)| Vec3::new(x, y, z))
+                    .collect::<Vec<_>>()
+            }),
             0.0,
         );
         g.thickness = strands.iter().flatten().map(|p| p.3).collect();
@@ -36,8 +38,11 @@ fn fixed_groom() -> impl Strategy<Value = Groom> {
         )
             .prop_map(move |(pts, per_strand)| {
                 let mut g = Groom::from_strands(
-                    pts.chunks(n)
-                        .map(|c| c.iter().map(|&(x, y, z)| Vec3::new(x, y, z)).collect::<Vec<_>>()),
+                    pts.chunks(n).map(|c| {
+                        c.iter()
+                            .map(|&(x, y, z)| Vec3::new(x, y, z))
+                            .collect::<Vec<_>>()
+                    }),
                     0.0,
                 );
                 g.thickness = per_strand
