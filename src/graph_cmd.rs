@@ -1,11 +1,75 @@
 //! `strandgraph graph`: compile a graph and print its plan.
 
+use miette::{IntoDiagnostic, Result, WrapErr};
+use std::path::PathBuf;
+use strandgraph_graph::{Quantities, compile_file, export, report};
+use strandgraph_passes::Registry;
+
 #[derive(clap::Args)]
 pub struct Args {
-    /// The graph file (RON).
-    pub file: std::path::PathBuf,
+    /// The graph file (RON), e.g. scenes/graphs/kulikov.ron.
+    pub file: PathBuf,
+    /// Write the plan as Graphviz DOT to this file (`-` for stdout).
+    #[arg(long)]
+    pub dot: Option<PathBuf>,
+    /// Write the plan and its memory plan as JSON to this file (`-` for stdout).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Size resources for these quantities instead of the built-in example,
+    /// as `name=value` pairs: strands, vertices, segments, bundles, models,
+    /// triangles, lights, width, height.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Do not print the readable plan (useful with --dot/--json -).
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
-pub fn run(args: Args) -> miette::Result<()> {
-    Err(miette::miette!("{}: graph compiler not built yet", args.file.display()))
+pub fn run(args: Args) -> Result<()> {
+    let plan = compile_file(&args.file, &Registry)?;
+    let quantities = quantities(&args.set)?;
+    let instance = plan.instantiate(&quantities)?;
+    tracing::info!(passes = plan.order.len(), sync_points = plan.sync_points.len(), "compiled");
+    if !args.quiet {
+        print!("{}", report::render(&plan, Some(&instance)));
+    }
+    if let Some(path) = &args.dot {
+        write_out(path, &export::to_dot(&plan))?;
+    }
+    if let Some(path) = &args.json {
+        write_out(path, &export::to_json(&plan, Some(&instance)))?;
+    }
+    Ok(())
+}
+
+fn write_out(path: &PathBuf, text: &str) -> Result<()> {
+    if path.as_os_str() == "-" {
+        print!("{text}");
+        return Ok(());
+    }
+    std::fs::write(path, text).into_diagnostic().wrap_err_with(|| format!("writing {}", path.display()))
+}
+
+fn quantities(pairs: &[String]) -> Result<Quantities> {
+    let mut q = Quantities::example();
+    for pair in pairs {
+        let (name, value) = pair
+            .split_once('=')
+            .ok_or_else(|| miette::miette!("--set {pair}: expected NAME=VALUE"))?;
+        let v: u64 = value.trim().parse().map_err(|e| miette::miette!("--set {pair}: {e}"))?;
+        let small = || u32::try_from(v).map_err(|_| miette::miette!("--set {pair}: too large"));
+        match name.trim() {
+            "strands" => q.strands = v,
+            "vertices" => q.vertices = v,
+            "segments" => q.segments = v,
+            "bundles" => q.bundles = v,
+            "models" => q.models = v,
+            "triangles" => q.triangles = v,
+            "lights" => q.lights = v,
+            "width" => q.width = small()?,
+            "height" => q.height = small()?,
+            other => return Err(miette::miette!("--set {pair}: unknown quantity `{other}`")),
+        }
+    }
+    Ok(q)
 }

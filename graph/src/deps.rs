@@ -4,9 +4,14 @@
 //! order passes. Per resource, each frame has one version:
 //! - a **transient** is produced by its writers (which must be ordered among
 //!   themselves), then updated by its atomic passes (which commute), then read;
-//! - an **imported** or **history** resource starts the frame with contents
-//!   (given by the caller, or left by the previous frame): its readers see
-//!   those, so every writer waits for every reader (write-after-read).
+//! - an **imported** resource that no pass writes is a pure input; one that
+//!   passes write behaves like a transient whose memory the caller owns;
+//! - a **history** resource's readers see the previous frame's contents, so
+//!   every writer waits for every reader (write-after-read);
+//! - a **version** (`"depth:scene.depth -> scene.depth.hair"` in `writes`)
+//!   names the contents after an in-place write: readers of the old name run
+//!   before the writer, readers of the new name after it. This is how a pass
+//!   updates memory other passes read both before and after.
 //!
 //! Anything else (a read with no writer, a cycle, two unordered writers) is an
 //! error. Atomic updaters that nothing orders are serialised in topological
@@ -88,11 +93,16 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
     for (r, res) in g.resources.iter().enumerate() {
         let u = &all_users[r];
         let class = res.decl.lifetime();
-        let initial_contents = res.has_initial_contents();
+        let root = res.version_of.is_none();
+        // History: readers see the previous frame, so writers wait for them.
+        let history = root && class == LifetimeClass::History;
+        // An imported resource no pass writes is a pure input.
+        let external = root && class != LifetimeClass::Transient;
+        let pure_input = external && u.writers.is_empty() && u.updaters.is_empty();
         // Atomic updates need initialised memory: they follow every writer.
         for &(p, a) in &u.updaters {
             let sources: Vec<_> = u.writers.iter().filter(|(w, _)| *w != p).collect();
-            if sources.is_empty() && !initial_contents {
+            if sources.is_empty() && !external {
                 errors.push(
                     GraphError::new(
                         ErrorKind::ReadBeforeWrite,
@@ -117,8 +127,10 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
         for &(p, a) in &u.readers {
             let sources: Vec<PassId> =
                 u.writers.iter().chain(&u.updaters).map(|(w, _)| *w).filter(|w| *w != p).collect();
-            if initial_contents {
-                // Readers see the contents the frame started with.
+            if pure_input {
+                continue;
+            }
+            if history {
                 let writers: BTreeSet<PassId> = sources.into_iter().collect();
                 edges.extend(writers.into_iter().map(|w| Edge {
                     from: p,
@@ -134,7 +146,7 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
                         ErrorKind::ReadBeforeWrite,
                         src,
                         a.span,
-                        format!("pass `{}` reads transient `{}`, but no pass writes it", g.passes[p].name, res.name),
+                        format!("pass `{}` reads `{}`, but no pass writes it", g.passes[p].name, res.name),
                     )
                     .label(res.span, "declared here"),
                 );
@@ -177,7 +189,7 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
                 hazard: Hazard::WriteAfterRead,
             }));
         }
-        if class == LifetimeClass::History && res.version_of.is_none() && u.writers.is_empty() && u.updaters.is_empty() {
+        if history && u.writers.is_empty() && u.updaters.is_empty() {
             if let Some(&(p, a)) = u.readers.first() {
                 errors.push(GraphError::new(
                     ErrorKind::ReadBeforeWrite,

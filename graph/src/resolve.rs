@@ -3,7 +3,7 @@
 
 use crate::error::{ErrorKind, GraphError, GraphErrors};
 use crate::registry::{PassRegistry, suggest};
-use crate::schema::{AccessMode, GraphDesc, ImageFormat, LifetimeClass, PassDecl, Queue, ResourceDecl, Usage};
+use crate::schema::{AccessMode, GraphDesc, ImageFormat, PassDecl, Queue, ResourceDecl, Usage};
 use crate::source::{Locator, Source, Span};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -21,14 +21,6 @@ pub struct Resource {
     /// For a version made by an in-place write (`"a -> b"`), the declared
     /// resource whose memory it is; `None` for declared resources.
     pub version_of: Option<ResourceId>,
-}
-
-impl Resource {
-    /// Whether the frame starts with contents in this resource (given by the
-    /// caller, or left by the previous frame), so its readers need no writer.
-    pub fn has_initial_contents(&self) -> bool {
-        self.version_of.is_none() && self.decl.lifetime() != LifetimeClass::Transient
-    }
 }
 
 /// One entry of a pass's `reads`, `writes` or `atomics`.

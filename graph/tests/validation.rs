@@ -1,0 +1,360 @@
+//! One small bad graph per validation error. The line the error must point at
+//! carries a `// <-` marker; each test checks the kind, that line, and the
+//! names the message must mention.
+
+use strandgraph_graph::{ErrorKind, GraphError, KindList, Quantities, compile_str};
+
+fn registry() -> KindList {
+    KindList::new(["test.produce", "test.consume", "common.clear", "test.draw"])
+}
+
+fn marker_line(src: &str) -> usize {
+    src.lines().position(|l| l.contains("// <-")).expect("test source has a `// <-` marker") + 1
+}
+
+fn expect_error(src: &str, kind: ErrorKind, names: &[&str]) -> GraphError {
+    let errors = match compile_str("bad.ron", src, &registry()) {
+        Ok(_) => panic!("expected {kind:?}, but the graph compiled"),
+        Err(e) => e,
+    };
+    let err = errors
+        .0
+        .iter()
+        .find(|e| e.kind == kind)
+        .unwrap_or_else(|| panic!("expected {kind:?}, got {:?}: {errors}", errors.kinds()))
+        .clone();
+    assert_eq!(err.line, marker_line(src), "wrong line for: {err}");
+    assert_eq!(err.file, "bad.ron");
+    for name in names {
+        assert!(err.message.contains(name), "message `{}` does not name `{name}`", err.message);
+    }
+    let shown = err.to_string();
+    assert!(shown.starts_with(&format!("bad.ron:{}:", err.line)), "display lacks location: {shown}");
+    err
+}
+
+#[test]
+fn syntax_error_points_at_the_offending_token() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "a", size: Bytes(16), lifetime: Forever), // <-
+    ],
+    passes: [],
+    outputs: [],
+)"#;
+    expect_error(src, ErrorKind::Syntax, &["Forever"]);
+}
+
+#[test]
+fn unknown_resource() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "positions", size: PerElement(Vertices, 16), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "skin", kind: "test.produce",
+             reads: ["positons"], // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_error(src, ErrorKind::UnknownResource, &["positons", "skin"]);
+    let help = miette::Diagnostic::help(&e).map(|h| h.to_string()).unwrap_or_default();
+    assert!(help.contains("positions"), "no suggestion: {help}");
+}
+
+#[test]
+fn unknown_pass_kind_with_suggestion() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p",
+             kind: "test.prodcue", // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_error(src, ErrorKind::UnknownPassKind, &["test.prodcue", "`p`"]);
+    let help = miette::Diagnostic::help(&e).map(|h| h.to_string()).unwrap_or_default();
+    assert!(help.contains("test.produce"), "no suggestion: {help}");
+}
+
+#[test]
+fn duplicate_resource_name() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "a", size: Bytes(16)),
+        Buffer(name: "a", size: Bytes(32)), // <-
+    ],
+    passes: [],
+    outputs: [],
+)"#;
+    expect_error(src, ErrorKind::DuplicateName, &["`a`"]);
+}
+
+#[test]
+fn duplicate_pass_name() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "test.produce", writes: ["out"]),
+        Pass(name: "p", kind: "test.consume", reads: ["out"]), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::DuplicateName, &["`p`"]);
+}
+
+#[test]
+fn transient_read_before_any_write() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "scratch", size: Bytes(64)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "use", kind: "test.consume",
+             reads: ["scratch"], // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::ReadBeforeWrite, &["use", "scratch"]);
+}
+
+#[test]
+fn atomic_update_before_any_write() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "counter", size: Bytes(4)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "count", kind: "test.produce",
+             atomics: ["counter"]), // <-
+        Pass(name: "use", kind: "test.consume", reads: ["counter"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::ReadBeforeWrite, &["count", "counter"]);
+}
+
+#[test]
+fn history_never_written() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "prev", size: Bytes(64), lifetime: History),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "motion", kind: "test.consume",
+             reads: ["prev"], // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::ReadBeforeWrite, &["motion", "prev"]);
+}
+
+#[test]
+fn cycle_names_the_passes_on_it() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "a", size: Bytes(16)),
+        Buffer(name: "b", size: Bytes(16)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "first", kind: "test.produce", reads: ["b"], writes: ["a"]), // <-
+        Pass(name: "second", kind: "test.produce", reads: ["a"], writes: ["b"]),
+        Pass(name: "last", kind: "test.consume", reads: ["a"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_error(src, ErrorKind::Cycle, &["`first`", "`second`", "(a)", "(b)"]);
+    assert!(!e.message.contains("last"), "`last` is not on the cycle: {}", e.message);
+}
+
+#[test]
+fn two_unordered_writers() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "lights", size: Bytes(64)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "sun", kind: "test.produce", writes: ["lights"]),
+        Pass(name: "lamps", kind: "test.produce",
+             writes: ["lights"]), // <-
+        Pass(name: "shade", kind: "test.consume", reads: ["lights"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::UnorderedWriters, &["sun", "lamps", "lights"]);
+}
+
+#[test]
+fn ordered_writers_are_accepted() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "x", size: Bytes(64)),
+        Buffer(name: "y", size: Bytes(64)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "a", kind: "test.produce", writes: ["x", "y"]),
+        Pass(name: "b", kind: "test.produce", reads: ["y"], writes: ["x"]),
+        Pass(name: "c", kind: "test.consume", reads: ["x"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let plan = compile_str("ok.ron", src, &registry()).unwrap();
+    assert!(plan.dependencies.iter().any(|d| d.from == 0 && d.to == 1 && d.hazard.short() == "WAW"));
+}
+
+#[test]
+fn two_passes_making_a_version_of_the_same_resource() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Image(name: "color", format: Rgba16Float, size: Screen, lifetime: Imported)],
+    passes: [
+        Pass(name: "bloom", kind: "test.produce", writes: ["color -> color.bloom"]),
+        Pass(name: "fog", kind: "test.produce",
+             writes: ["color -> color.fog"]), // <-
+    ],
+    outputs: ["color.bloom", "color.fog"],
+)"#;
+    expect_error(src, ErrorKind::UnorderedWriters, &["bloom", "fog", "color"]);
+}
+
+#[test]
+fn queue_cannot_rasterize_on_async_compute() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Image(name: "out", format: Rgba8Unorm, size: Screen, lifetime: Imported)],
+    passes: [
+        Pass(name: "compose", kind: "test.draw", queue: AsyncCompute,
+             writes: ["color:out"]), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::QueueCannotAccess, &["compose", "async-compute", "color", "out"]);
+}
+
+#[test]
+fn transfer_queue_only_copies() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "src", size: Bytes(64), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(64), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "upload", kind: "test.produce", queue: Transfer,
+             reads: ["copy:src"],
+             writes: ["out"]), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::QueueCannotAccess, &["upload", "transfer", "storage", "out"]);
+}
+
+#[test]
+fn output_nobody_writes() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "in", size: Bytes(16), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [Pass(name: "p", kind: "test.consume", reads: ["in"])],
+    outputs: [
+        "out", // <-
+    ],
+)"#;
+    expect_error(src, ErrorKind::OutputNotWritten, &["out"]);
+}
+
+#[test]
+fn sampling_a_buffer_is_a_bad_access() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "depth", size: Bytes(16), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "p", kind: "test.produce",
+             reads: ["sampled:depth"], // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::BadAccess, &["sampled:depth", "buffer"]);
+}
+
+#[test]
+fn unknown_usage_prefix() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "test.produce",
+             writes: ["texture:out"]), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::BadAccess, &["texture"]);
+}
+
+#[test]
+fn zero_sized_resource_is_reported_at_instantiation() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "per_strand", size: PerElement(Strands, 16)), // <-
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "a", kind: "test.produce", writes: ["per_strand"]),
+        Pass(name: "b", kind: "test.consume", reads: ["per_strand"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let plan = compile_str("bad.ron", src, &registry()).unwrap();
+    let q = Quantities {
+        strands: 0,
+        ..Quantities::example()
+    };
+    let err = plan.instantiate(&q).unwrap_err();
+    let e = err.first();
+    assert_eq!(e.kind, ErrorKind::Size);
+    assert_eq!(e.line, marker_line(src));
+    assert!(e.message.contains("per_strand") && e.message.contains("zero"), "{}", e.message);
+}
+
+#[test]
+fn several_errors_are_reported_together() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "nope", reads: ["missing"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let errors = compile_str("bad.ron", src, &registry()).unwrap_err();
+    assert_eq!(errors.kinds(), vec![ErrorKind::UnknownPassKind, ErrorKind::UnknownResource]);
+}
