@@ -14,6 +14,9 @@ pub mod scene;
 pub mod skinning;
 pub mod transform;
 
+pub use hairmesh::HairMesh;
+pub use scene::{Scene, SceneCounts};
+
 pub use bounds::Aabb;
 pub use error::{AssetError, FormatError, FormatErrorKind, Location};
 pub use groom::Groom;

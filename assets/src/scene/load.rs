@@ -1,0 +1,428 @@
+//! Loading a scene: parse the RON, then build or load every mesh and groom.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use super::{GroomDesc, GroomSource, LodSettings, Material, MeshSource, SceneDesc};
+use crate::error::AssetError;
+use crate::groom::Groom;
+use crate::hairmesh::HairMesh;
+use crate::loaders::{self, LoadOptions};
+use crate::mesh::TriMesh;
+use crate::procedural::surface::{Shape, Surface};
+use crate::skinning::{self, RootSkinningInfo};
+
+/// A loaded mesh, in its local space with its world transform.
+pub struct SceneMesh {
+    pub name: String,
+    pub mesh: TriMesh,
+    pub shape: Option<Shape>,
+}
+
+/// A loaded groom with everything the pipelines need.
+pub struct SceneGroom {
+    pub name: String,
+    /// Strands in the groom's local space; `groom.transform` is the world transform
+    /// (parent's transform composed with the groom's).
+    pub groom: Groom,
+    pub world: glam::Mat4,
+    pub parent: Option<usize>,
+    /// Kulikov: one hairRootSkinningInfo_t per strand root, against the parent mesh.
+    pub skinning: Option<Vec<RootSkinningInfo>>,
+    pub hair_mesh: Option<HairMesh>,
+    pub material: Material,
+    pub lod: LodSettings,
+    pub facial_hair: bool,
+}
+
+impl SceneGroom {
+    pub fn memory_bytes(&self) -> usize {
+        self.groom.memory_bytes()
+            + self.skinning.as_ref().map_or(0, |s| s.len() * 16)
+            + self.hair_mesh.as_ref().map_or(0, HairMesh::memory_bytes)
+    }
+    pub fn world_bounds(&self) -> crate::Aabb {
+        self.groom.bounds().transformed(&self.world)
+    }
+}
+
+/// A scene, fully loaded.
+pub struct Scene {
+    pub path: PathBuf,
+    pub desc: SceneDesc,
+    pub meshes: Vec<SceneMesh>,
+    pub grooms: Vec<SceneGroom>,
+    /// The render graph file, resolved against the scene's folder.
+    pub graph: PathBuf,
+}
+
+/// Totals the render-graph CLI maps into graph quantities.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneCounts {
+    pub strands: u64,
+    pub vertices: u64,
+    pub segments: u64,
+    pub bundles: u64,
+    /// Hair models (grooms).
+    pub models: u64,
+    pub meshes: u64,
+    pub triangles: u64,
+    pub lights: u64,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// 1-based (line, column) of the first occurrence of `needle` in `text`, else (1, 1).
+fn locate(text: &str, needle: &str) -> (usize, usize) {
+    let Some(at) = text.find(needle) else {
+        return (1, 1);
+    };
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, col)
+}
+
+impl Scene {
+    /// Parses a scene file without loading what it names.
+    pub fn parse(path: &Path, text: &str) -> Result<SceneDesc, AssetError> {
+        let opts = ron::Options::default().with_default_extension(
+            ron::extensions::Extensions::UNWRAP_VARIANT_NEWTYPES
+                | ron::extensions::Extensions::IMPLICIT_SOME,
+        );
+        opts.from_str(text).map_err(|e| AssetError::Scene {
+            path: path.to_path_buf(),
+            line: e.span.start.line,
+            col: e.span.start.col,
+            message: e.code.to_string(),
+        })
+    }
+
+    /// Parses the scene and builds or loads all of its meshes and grooms.
+    pub fn load(path: &Path) -> Result<Scene, AssetError> {
+        let text = std::fs::read_to_string(path).map_err(|source| AssetError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let desc = Self::parse(path, &text)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let err = |needle: &str, message: String| {
+            let (line, col) = locate(&text, needle);
+            AssetError::Scene {
+                path: path.to_path_buf(),
+                line,
+                col,
+                message,
+            }
+        };
+        let (w, h) = desc.resolution;
+        if w == 0 || h == 0 || w > 16384 || h > 16384 {
+            return Err(err(
+                "resolution",
+                format!("resolution {w}x{h} is out of range"),
+            ));
+        }
+        for (i, m) in desc.meshes.iter().enumerate() {
+            if desc.meshes[..i].iter().any(|o| o.name == m.name) {
+                return Err(err(
+                    &format!("\"{}\"", m.name),
+                    format!("mesh name {:?} is used twice", m.name),
+                ));
+            }
+        }
+
+        // Meshes (in parallel).
+        let meshes: Vec<SceneMesh> = desc
+            .meshes
+            .par_iter()
+            .map(|m| {
+                let (mut mesh, shape) = match &m.source {
+                    MeshSource::Head(p) => (p.build(), Some(Shape::Head(*p))),
+                    MeshSource::Body(p) => (p.build(), Some(Shape::Body(*p))),
+                    MeshSource::File { path: p, units } => {
+                        let mesh = loaders::load_mesh(&dir.join(p), *units)
+                            .map_err(|e| err(p, format!("mesh {:?}: {e}", m.name)))?;
+                        (mesh, None)
+                    }
+                };
+                if !m.transform.is_finite() {
+                    return Err(err(
+                        &format!("\"{}\"", m.name),
+                        format!("mesh {:?}: bad transform", m.name),
+                    ));
+                }
+                mesh.transform = m.transform;
+                Ok(SceneMesh {
+                    name: m.name.clone(),
+                    mesh,
+                    shape,
+                })
+            })
+            .collect::<Result<_, _>>()?;
+
+        // Grooms, one after another (each is parallel inside).
+        let mut grooms = Vec::with_capacity(desc.grooms.len());
+        for g in &desc.grooms {
+            let span = tracing::info_span!("groom", name = %g.name);
+            let _e = span.enter();
+            grooms.push(load_groom(g, &meshes, dir, &err)?);
+        }
+        Ok(Scene {
+            path: path.to_path_buf(),
+            graph: dir.join(&desc.graph),
+            desc,
+            meshes,
+            grooms,
+        })
+    }
+
+    pub fn counts(&self) -> SceneCounts {
+        let mut c = SceneCounts {
+            models: self.grooms.len() as u64,
+            meshes: self.meshes.len() as u64,
+            lights: self.desc.lights.len() as u64,
+            width: self.desc.resolution.0,
+            height: self.desc.resolution.1,
+            ..Default::default()
+        };
+        for g in &self.grooms {
+            c.strands += g.groom.strand_count() as u64;
+            c.vertices += g.groom.point_count() as u64;
+            c.segments += g.groom.segment_count() as u64;
+            c.bundles += g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64);
+        }
+        c.triangles = self
+            .meshes
+            .iter()
+            .map(|m| m.mesh.triangle_count() as u64)
+            .sum();
+        c
+    }
+}
+
+fn load_groom(
+    g: &GroomDesc,
+    meshes: &[SceneMesh],
+    dir: &Path,
+    err: &dyn Fn(&str, String) -> AssetError,
+) -> Result<SceneGroom, AssetError> {
+    let name = format!("\"{}\"", g.name);
+    let parent = match &g.parent {
+        Some(p) => Some(meshes.iter().position(|m| &m.name == p).ok_or_else(|| {
+            err(
+                &format!("parent: \"{p}\""),
+                format!("groom {:?}: no mesh named {p:?}", g.name),
+            )
+        })?),
+        None => None,
+    };
+    let surface = || -> Result<Surface, AssetError> {
+        let p = parent.ok_or_else(|| {
+            err(
+                &name,
+                format!("groom {:?}: a procedural groom needs a parent mesh", g.name),
+            )
+        })?;
+        let m = &meshes[p];
+        Ok(match m.shape {
+            Some(s) => Surface::procedural(s),
+            None => Surface::from_mesh(m.mesh.clone()),
+        })
+    };
+    let mut skinning = None;
+    let mut hair_mesh = None;
+    let mut groom = match &g.source {
+        GroomSource::Procedural(params) => {
+            params
+                .validate()
+                .map_err(|m| err(&name, format!("groom {:?}: {m}", g.name)))?;
+            let generated = params.generate(&surface()?);
+            skinning = Some(generated.skinning);
+            generated.groom
+        }
+        GroomSource::HairMesh(params) => {
+            params
+                .validate()
+                .map_err(|m| err(&name, format!("groom {:?}: {m}", g.name)))?;
+            let hm = g.hair_mesh.ok_or_else(|| {
+                err(&name, format!("groom {:?}: a HairMesh source needs `hair_mesh: (bundles: .., layers: ..)`", g.name))
+            })?;
+            let mesh = HairMesh::procedural(&surface()?, params, &hm, params.strands);
+            let thickness = params.root_thickness.unwrap_or(70e-6);
+            let groom = mesh.to_groom(params.points as usize, thickness);
+            hair_mesh = Some(mesh);
+            groom
+        }
+        GroomSource::File {
+            path,
+            units,
+            thickness,
+        } => loaders::load_groom(
+            &dir.join(path),
+            &LoadOptions {
+                units: *units,
+                thickness: *thickness,
+            },
+        )
+        .map_err(|e| err(path, format!("groom {:?}: {e}", g.name)))?,
+    };
+    if groom.strand_count() == 0 {
+        return Err(err(
+            &name,
+            format!(
+                "groom {:?} has no strands (is the parent region empty?)",
+                g.name
+            ),
+        ));
+    }
+    if !g.transform.is_finite() {
+        return Err(err(&name, format!("groom {:?}: bad transform", g.name)));
+    }
+    if let (Some(p), None) = (parent, &skinning) {
+        skinning = Some(skinning::bake(&meshes[p].mesh, &groom.roots()));
+    }
+    if hair_mesh.is_none() {
+        if let Some(hm) = &g.hair_mesh {
+            hair_mesh = Some(HairMesh::fit(&groom, hm));
+        }
+    }
+    // Kulikov: a stable randomized strand order, so LOD draws a prefix.
+    if g.lod.enabled && hair_mesh.is_none() {
+        let order = groom.shuffled_order(g.lod.shuffle_seed);
+        groom = groom.reordered(&order);
+        if let Some(s) = skinning.as_mut() {
+            *s = order.iter().map(|&i| s[i as usize]).collect();
+        }
+    }
+    let world = match parent {
+        Some(p) => meshes[p].mesh.transform.compose(&g.transform),
+        None => g.transform.matrix(),
+    };
+    groom.transform = g.transform;
+    if let Some(h) = hair_mesh.as_mut() {
+        h.transform = g.transform;
+    }
+    Ok(SceneGroom {
+        name: g.name.clone(),
+        groom,
+        world,
+        parent,
+        skinning,
+        hair_mesh,
+        material: g.material,
+        lod: g.lod,
+        facial_hair: g.facial_hair,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    fn load_err(p: &Path) -> AssetError {
+        match Scene::load(p) {
+            Err(e) => e,
+            Ok(_) => panic!("{} loaded", p.display()),
+        }
+    }
+
+    fn tmp(name: &str) -> PathBuf {
+        let d =
+            std::env::temp_dir().join(format!("strandgraph-scene-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    const MINI: &str = r#"Scene(
+    resolution: (640, 360),
+    camera: Orbit(target: (0.0, 0.0, 0.0), distance: 0.8, yaw_deg: 30.0, pitch_deg: 10.0, fov_deg: 35.0),
+    lights: [
+        Directional(direction: (0.0, -1.0, -1.0), color: (1.0, 1.0, 1.0), intensity: 3.0),
+        Point(position: (0.5, 0.5, 0.5), color: (1.0, 0.9, 0.8), intensity: 10.0),
+    ],
+    environment: (color: (0.5, 0.6, 0.7), intensity: 0.3),
+    meshes: [
+        (name: "head", source: Head(resolution: 48)),
+    ],
+    grooms: [
+        (name: "hair", source: Procedural(style: Wavy, strands: 500, points: 8), parent: "head",
+         material: (melanin: 1.0, roughness: 0.25, highlight_shift_deg: -4.0)),
+        (name: "beard", source: Procedural(style: Beard, strands: 200, points: 4), parent: "head",
+         facial_hair: true, hair_mesh: (bundles: 20, layers: 4)),
+    ],
+    graph: "graphs/kulikov.ron",
+)"#;
+
+    #[test]
+    fn loads_a_scene_and_counts() {
+        let d = tmp("mini");
+        let p = write(&d, "mini.ron", MINI);
+        let s = Scene::load(&p).unwrap();
+        let c = s.counts();
+        assert_eq!(c.strands, 700);
+        assert_eq!(c.vertices, 500 * 8 + 200 * 4);
+        assert_eq!(c.segments, 500 * 7 + 200 * 3);
+        assert_eq!((c.models, c.lights, c.width, c.height), (2, 2, 640, 360));
+        assert!(c.bundles > 0 && c.bundles <= 20);
+        assert_eq!(s.graph, d.join("graphs/kulikov.ron"));
+        assert!(s.grooms[1].facial_hair);
+        assert_eq!(s.grooms[0].skinning.as_ref().map(Vec::len), Some(500));
+        // The shuffled skinning still matches the shuffled roots.
+        let g = &s.grooms[0];
+        let head = &s.meshes[0].mesh;
+        for (r, sk) in g.groom.roots().iter().zip(g.skinning.as_ref().unwrap()) {
+            assert!(sk.root_position(head).unwrap().distance(*r) < 1e-4);
+        }
+    }
+
+    #[test]
+    fn parse_errors_have_line_and_column() {
+        let d = tmp("bad");
+        let p = write(
+            &d,
+            "bad.ron",
+            &MINI.replace("intensity: 3.0", "intensity: \"x\""),
+        );
+        let e = load_err(&p);
+        let AssetError::Scene { line, .. } = e else {
+            panic!("{e}")
+        };
+        assert_eq!(line, 5);
+        assert!(
+            e.to_string().starts_with(&format!("{}:5:", p.display())),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn semantic_errors_point_at_the_culprit() {
+        let d = tmp("sem");
+        let p = write(
+            &d,
+            "sem.ron",
+            &MINI.replace(
+                "parent: \"head\",\n         facial",
+                "parent: \"nose\",\n         facial",
+            ),
+        );
+        let e = load_err(&p).to_string();
+        assert!(
+            e.contains(":15:") && e.contains("no mesh named \"nose\""),
+            "{e}"
+        );
+        let p = write(
+            &d,
+            "missing.ron",
+            &MINI.replace("Head(resolution: 48)", "File(path: \"nope.obj\")"),
+        );
+        let e = load_err(&p).to_string();
+        assert!(e.contains("nope.obj") && e.contains(":10:"), "{e}");
+    }
+}
