@@ -51,9 +51,10 @@ fn put_f32(b: &mut [u8], at: usize, v: f32) {
 }
 
 type Parse = fn(&[u8]) -> Result<Groom, FormatError>;
+/// (name, parser, file, strands field offset, points field offset, first position byte)
+type BinaryCase = (&'static str, Parse, Vec<u8>, usize, usize, usize);
 
-fn binary_formats() -> Vec<(&'static str, Parse, Vec<u8>, usize, usize, usize)> {
-    // (name, parser, file, strands field offset, points-per-strand or points field, first position byte)
+fn binary_formats() -> Vec<BinaryCase> {
     vec![
         (
             "cyhair",

@@ -84,10 +84,12 @@ pub fn parse(data: &[u8]) -> Result<Groom, FormatError> {
     let color_at = plan(BIT_COLORS, 8, "point_count", point_count, 12)?;
     let (h, p) = (hair_count as usize, point_count as usize);
 
-    let mut offsets = Vec::with_capacity(h + 1);
-    offsets.push(0u32);
-    if let Some(at) = seg_at {
+    // Strand offsets: from the segments array (checked to fit above) or from d_segments
+    // (checked against point_count, which was checked to fit, before allocating).
+    let offsets = if let Some(at) = seg_at {
         r.seek(at, "segments")?;
+        let mut offsets = Vec::with_capacity(h + 1);
+        offsets.push(0u32);
         let mut total = 0u64;
         for i in 0..h {
             let seg = r.u16("segments")? as u64;
@@ -110,6 +112,7 @@ pub fn parse(data: &[u8]) -> Result<Groom, FormatError> {
                 )),
             ));
         }
+        offsets
     } else {
         let per = d_segments as u64 + 1;
         if hair_count.checked_mul(per) != Some(point_count) {
@@ -120,8 +123,8 @@ pub fn parse(data: &[u8]) -> Result<Groom, FormatError> {
                 )),
             ));
         }
-        offsets.extend((1..=h).map(|s| (s as u64 * per) as u32));
-    }
+        (0..=h).map(|s| (s as u64 * per) as u32).collect()
+    };
 
     let mut g = Groom {
         strand_offsets: offsets,

@@ -282,10 +282,8 @@ fn load_groom(
     if let (Some(p), None) = (parent, &skinning) {
         skinning = Some(skinning::bake(&meshes[p].mesh, &groom.roots()));
     }
-    if hair_mesh.is_none() {
-        if let Some(hm) = &g.hair_mesh {
-            hair_mesh = Some(HairMesh::fit(&groom, hm));
-        }
+    if let (None, Some(hm)) = (&hair_mesh, &g.hair_mesh) {
+        hair_mesh = Some(HairMesh::fit(&groom, hm));
     }
     // Kulikov: a stable randomized strand order, so LOD draws a prefix.
     if g.lod.enabled && hair_mesh.is_none() {
