@@ -8,7 +8,9 @@
 use strandgraph_graph::{AnyKind, Quantities, compile_file, report};
 
 fn main() {
-    let path = std::env::args().nth(1).unwrap_or_else(|| "scenes/graphs/kulikov.ron".into());
+    let path = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "scenes/graphs/kulikov.ron".into());
     let plan = match compile_file(path.as_ref(), &AnyKind) {
         Ok(plan) => plan,
         Err(e) => {

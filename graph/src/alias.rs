@@ -79,7 +79,12 @@ fn align_up(x: u64, a: u64) -> u64 {
 
 pub fn plan_memory(requests: &[AliasRequest]) -> MemoryPlan {
     let mut order: Vec<&AliasRequest> = requests.iter().collect();
-    order.sort_by(|a, b| b.size.cmp(&a.size).then(a.first.cmp(&b.first)).then(a.resource.cmp(&b.resource)));
+    order.sort_by(|a, b| {
+        b.size
+            .cmp(&a.size)
+            .then(a.first.cmp(&b.first))
+            .then(a.resource.cmp(&b.resource))
+    });
     let mut placed: Vec<(AliasRequest, u64)> = Vec::new();
     for req in order {
         let mut busy: Vec<(u64, u64)> = placed
@@ -104,13 +109,22 @@ pub fn plan_memory(requests: &[AliasRequest]) -> MemoryPlan {
         let end = off + r.size;
         match heaps.iter_mut().find(|h| h.heap == r.heap) {
             Some(h) => h.bytes = h.bytes.max(end),
-            None => heaps.push(HeapSize { heap: r.heap, bytes: end }),
+            None => heaps.push(HeapSize {
+                heap: r.heap,
+                bytes: end,
+            }),
         }
     }
     heaps.sort_by_key(|h| h.heap);
     let max_pos = requests.iter().map(|r| r.end).max().unwrap_or(0);
     let lower_bound = (0..=max_pos)
-        .map(|t| requests.iter().filter(|r| r.first <= t && t <= r.end).map(|r| r.size).sum::<u64>())
+        .map(|t| {
+            requests
+                .iter()
+                .filter(|r| r.first <= t && t <= r.end)
+                .map(|r| r.size)
+                .sum::<u64>()
+        })
         .max()
         .unwrap_or(0);
     MemoryPlan {
@@ -165,8 +179,19 @@ mod tests {
     #[test]
     fn fills_gaps_between_live_resources() {
         // 0 and 2 are alive with a hole between them that 3 fits into.
-        let m = plan_memory(&[req(0, 512, 0, 3), req(1, 512, 0, 0), req(2, 512, 0, 3), req(3, 256, 2, 3)]);
-        let off = |r: usize| m.placements.iter().find(|p| p.resource == r).unwrap().offset;
+        let m = plan_memory(&[
+            req(0, 512, 0, 3),
+            req(1, 512, 0, 0),
+            req(2, 512, 0, 3),
+            req(3, 256, 2, 3),
+        ]);
+        let off = |r: usize| {
+            m.placements
+                .iter()
+                .find(|p| p.resource == r)
+                .unwrap()
+                .offset
+        };
         assert_eq!(off(3), off(1));
         assert_eq!(m.bytes_with_aliasing, 1536);
     }

@@ -23,12 +23,21 @@ pub fn cull(g: &Graph, deps: &Dependencies) -> (Vec<bool>, Vec<Culled>) {
     let n = g.passes.len();
     let mut needed = vec![false; n];
     let mut stack: Vec<PassId> = Vec::new();
-    let writes = |p: PassId, r: usize| g.passes[p].accesses.iter().any(|a| a.resource == r && a.mode.writes());
+    let writes = |p: PassId, r: usize| {
+        g.passes[p]
+            .accesses
+            .iter()
+            .any(|a| a.resource == r && a.mode.writes())
+    };
     for &(r, _) in &g.outputs {
         stack.extend((0..n).filter(|&p| writes(p, r)));
     }
     let mut preds = vec![Vec::new(); n];
-    for e in deps.edges.iter().filter(|e| e.hazard != Hazard::WriteAfterRead) {
+    for e in deps
+        .edges
+        .iter()
+        .filter(|e| e.hazard != Hazard::WriteAfterRead)
+    {
         preds[e.to].push(e.from);
     }
     while let Some(p) = stack.pop() {
@@ -55,7 +64,10 @@ pub fn cull(g: &Graph, deps: &Dependencies) -> (Vec<bool>, Vec<Culled>) {
             let reason = if written.is_empty() {
                 "writes nothing".to_string()
             } else {
-                format!("nothing that reaches an output reads what it writes ({})", written.join(", "))
+                format!(
+                    "nothing that reaches an output reads what it writes ({})",
+                    written.join(", ")
+                )
             };
             Culled { pass: p, reason }
         })

@@ -66,14 +66,18 @@ struct Users {
     updaters: Vec<(PassId, Access)>,
 }
 
-fn users(g: &Graph, r: ResourceId) -> Users {
-    let mut u = Users {
-        readers: vec![],
-        writers: vec![],
-        updaters: vec![],
-    };
+/// Who touches each resource, in one sweep over all accesses.
+fn users(g: &Graph) -> Vec<Users> {
+    let mut all: Vec<Users> = (0..g.resources.len())
+        .map(|_| Users {
+            readers: vec![],
+            writers: vec![],
+            updaters: vec![],
+        })
+        .collect();
     for (p, pass) in g.passes.iter().enumerate() {
-        for a in pass.accesses.iter().filter(|a| a.resource == r) {
+        for a in &pass.accesses {
+            let u = &mut all[a.resource];
             match a.mode {
                 AccessMode::Read => u.readers.push((p, *a)),
                 AccessMode::Write => u.writers.push((p, *a)),
@@ -81,14 +85,14 @@ fn users(g: &Graph, r: ResourceId) -> Users {
             }
         }
     }
-    u
+    all
 }
 
 pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
     let src = &g.source;
     let mut errors = Vec::new();
     let mut edges = Vec::new();
-    let all_users: Vec<Users> = (0..g.resources.len()).map(|r| users(g, r)).collect();
+    let all_users = users(g);
 
     for (r, res) in g.resources.iter().enumerate() {
         let u = &all_users[r];
@@ -125,8 +129,13 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
             }));
         }
         for &(p, a) in &u.readers {
-            let sources: Vec<PassId> =
-                u.writers.iter().chain(&u.updaters).map(|(w, _)| *w).filter(|w| *w != p).collect();
+            let sources: Vec<PassId> = u
+                .writers
+                .iter()
+                .chain(&u.updaters)
+                .map(|(w, _)| *w)
+                .filter(|w| *w != p)
+                .collect();
             if pure_input {
                 continue;
             }
@@ -146,7 +155,10 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
                         ErrorKind::ReadBeforeWrite,
                         src,
                         a.span,
-                        format!("pass `{}` reads `{}`, but no pass writes it", g.passes[p].name, res.name),
+                        format!(
+                            "pass `{}` reads `{}`, but no pass writes it",
+                            g.passes[p].name, res.name
+                        ),
                     )
                     .label(res.span, "declared here"),
                 );
@@ -182,25 +194,32 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
             ));
         }
         for &(c, _) in &consumers {
-            edges.extend(u.readers.iter().filter(|(p, _)| *p != c).map(|(p, _)| Edge {
-                from: *p,
-                to: c,
-                resource: r,
-                hazard: Hazard::WriteAfterRead,
-            }));
+            edges.extend(
+                u.readers
+                    .iter()
+                    .filter(|(p, _)| *p != c)
+                    .map(|(p, _)| Edge {
+                        from: *p,
+                        to: c,
+                        resource: r,
+                        hazard: Hazard::WriteAfterRead,
+                    }),
+            );
         }
-        if history && u.writers.is_empty() && u.updaters.is_empty() {
-            if let Some(&(p, a)) = u.readers.first() {
-                errors.push(GraphError::new(
-                    ErrorKind::ReadBeforeWrite,
-                    src,
-                    a.span,
-                    format!(
-                        "pass `{}` reads history `{}`, which no pass ever writes",
-                        g.passes[p].name, res.name
-                    ),
-                ));
-            }
+        if history
+            && u.writers.is_empty()
+            && u.updaters.is_empty()
+            && let Some(&(p, a)) = u.readers.first()
+        {
+            errors.push(GraphError::new(
+                ErrorKind::ReadBeforeWrite,
+                src,
+                a.span,
+                format!(
+                    "pass `{}` reads history `{}`, which no pass ever writes",
+                    g.passes[p].name, res.name
+                ),
+            ));
         }
     }
     if !errors.is_empty() {
@@ -209,7 +228,8 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
     edges.sort_by_key(|e| (e.from, e.to, e.resource));
     edges.dedup();
 
-    let order = topological_order(g.passes.len(), &edges).map_err(|cycle| cycle_error(g, &edges, &cycle))?;
+    let order = topological_order(g.passes.len(), &edges)
+        .map_err(|cycle| cycle_error(g, &edges, &cycle))?;
     let reach = Reach::new(g.passes.len(), &order, edges.iter().map(|e| (e.from, e.to)));
     let position = positions(&order);
 
@@ -238,7 +258,9 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
                             ),
                         )
                         .label(acc_a.span, "also written here")
-                        .help("make one read something the other writes, or write separate resources"),
+                        .help(
+                            "make one read something the other writes, or write separate resources",
+                        ),
                     );
                 }
             }
@@ -285,7 +307,8 @@ pub(crate) fn topological_order(n: usize, edges: &[Edge]) -> Result<Vec<PassId>,
             succ[e.from].push(e.to);
         }
     }
-    let mut ready: BinaryHeap<Reverse<PassId>> = (0..n).filter(|&p| indegree[p] == 0).map(Reverse).collect();
+    let mut ready: BinaryHeap<Reverse<PassId>> =
+        (0..n).filter(|&p| indegree[p] == 0).map(Reverse).collect();
     let mut order = Vec::with_capacity(n);
     while let Some(Reverse(p)) = ready.pop() {
         order.push(p);
@@ -314,7 +337,10 @@ fn cycle_error(g: &Graph, edges: &[Edge], stuck: &[PassId]) -> GraphErrors {
         }
     }
     // Within a strongly connected component, walk until a pass repeats.
-    let scc = petgraph::algo::tarjan_scc(&dg).into_iter().find(|c| c.len() > 1).unwrap_or_default();
+    let scc = petgraph::algo::tarjan_scc(&dg)
+        .into_iter()
+        .find(|c| c.len() > 1)
+        .unwrap_or_default();
     let mut path: Vec<(PassId, ResourceId)> = Vec::new();
     let mut at = scc.iter().map(|n| dg[*n]).min().unwrap_or(stuck[0]);
     loop {
@@ -332,7 +358,13 @@ fn cycle_error(g: &Graph, edges: &[Edge], stuck: &[PassId]) -> GraphErrors {
         at = to;
     }
     let Some(&(first, _)) = path.first() else {
-        return GraphError::new(ErrorKind::Cycle, &g.source, g.passes[stuck[0]].span, "passes form a cycle").into();
+        return GraphError::new(
+            ErrorKind::Cycle,
+            &g.source,
+            g.passes[stuck[0]].span,
+            "passes form a cycle",
+        )
+        .into();
     };
     let chain: Vec<String> = path
         .iter()

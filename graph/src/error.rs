@@ -73,7 +73,10 @@ impl GraphError {
             line,
             col,
             source: src.named_source(),
-            labels: vec![LabeledSpan::new_primary_with_span(Some("here".into()), span)],
+            labels: vec![LabeledSpan::new_primary_with_span(
+                Some("here".into()),
+                span,
+            )],
             help: None,
         }
     }
@@ -88,7 +91,8 @@ impl GraphError {
 
     /// Adds a secondary label pointing at related text.
     pub fn label(mut self, span: Span, text: impl Into<String>) -> Self {
-        self.labels.push(LabeledSpan::new_with_span(Some(text.into()), span));
+        self.labels
+            .push(LabeledSpan::new_with_span(Some(text.into()), span));
         self
     }
 
@@ -100,7 +104,11 @@ impl GraphError {
 
 impl fmt::Display for GraphError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}:{}: {}", self.file, self.line, self.col, self.message)
+        write!(
+            f,
+            "{}:{}:{}: {}",
+            self.file, self.line, self.col, self.message
+        )
     }
 }
 
@@ -111,7 +119,9 @@ impl Diagnostic for GraphError {
         Some(Box::new(self.kind.code()))
     }
     fn help<'a>(&'a self) -> Option<Box<dyn fmt::Display + 'a>> {
-        self.help.as_ref().map(|h| Box::new(h) as Box<dyn fmt::Display>)
+        self.help
+            .as_ref()
+            .map(|h| Box::new(h) as Box<dyn fmt::Display>)
     }
     fn source_code(&self) -> Option<&dyn SourceCode> {
         Some(&self.source)

@@ -27,15 +27,24 @@ pub fn to_dot(plan: &Plan) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "digraph {} {{", quoted(&g.name));
     let _ = writeln!(out, "  rankdir=LR;");
-    let _ = writeln!(out, "  node [shape=box, style=\"rounded,filled\", fontname=\"Helvetica\"];");
+    let _ = writeln!(
+        out,
+        "  node [shape=box, style=\"rounded,filled\", fontname=\"Helvetica\"];"
+    );
     let _ = writeln!(out, "  edge [fontname=\"Helvetica\", fontsize=10];");
     for q in Queue::ALL {
-        let passes: Vec<usize> = (0..g.passes.len()).filter(|&p| g.passes[p].queue == q).collect();
+        let passes: Vec<usize> = (0..g.passes.len())
+            .filter(|&p| g.passes[p].queue == q)
+            .collect();
         if passes.is_empty() {
             continue;
         }
         let _ = writeln!(out, "  subgraph \"cluster_{q}\" {{");
-        let _ = writeln!(out, "    label={}; style=dashed; color=\"#888888\";", quoted(&q.to_string()));
+        let _ = writeln!(
+            out,
+            "    label={}; style=dashed; color=\"#888888\";",
+            quoted(&q.to_string())
+        );
         for p in passes {
             let pass = &g.passes[p];
             let label = format!("{}\n{}", pass.name, pass.kind);
@@ -47,7 +56,11 @@ pub fn to_dot(plan: &Plan) -> String {
                     queue_colour(q)
                 );
             } else {
-                let reason = plan.culled.iter().find(|c| c.pass == p).map_or("", |c| c.reason.as_str());
+                let reason = plan
+                    .culled
+                    .iter()
+                    .find(|c| c.pass == p)
+                    .map_or("", |c| c.reason.as_str());
                 let _ = writeln!(
                     out,
                     "    p{p} [label={}, fillcolor=\"#eeeeee\", fontcolor=\"#777777\", style=\"rounded,filled,dashed\", tooltip={}];",
@@ -60,14 +73,18 @@ pub fn to_dot(plan: &Plan) -> String {
     }
     let mut grouped: BTreeMap<(usize, usize), Vec<String>> = BTreeMap::new();
     for d in &plan.dependencies {
-        grouped
-            .entry((d.from, d.to))
-            .or_default()
-            .push(format!("{} ({})", g.resources[d.version].name, d.hazard.short()));
+        grouped.entry((d.from, d.to)).or_default().push(format!(
+            "{} ({})",
+            g.resources[d.version].name,
+            d.hazard.short()
+        ));
     }
     for ((from, to), labels) in grouped {
         let cross = g.passes[from].queue != g.passes[to].queue;
-        let synced = plan.sync_points.iter().any(|s| s.after == from && s.before == to);
+        let synced = plan
+            .sync_points
+            .iter()
+            .any(|s| s.after == from && s.before == to);
         let style = match (cross, synced) {
             (false, _) => "color=\"#444444\"",
             (true, true) => "color=\"#cc0000\", penwidth=2.5",
@@ -77,7 +94,11 @@ pub fn to_dot(plan: &Plan) -> String {
         if synced {
             label.push_str("\n[sync]");
         }
-        let _ = writeln!(out, "  p{from} -> p{to} [label={}, {style}];", quoted(&label));
+        let _ = writeln!(
+            out,
+            "  p{from} -> p{to} [label={}, {style}];",
+            quoted(&label)
+        );
     }
     out.push_str("}\n");
     out
@@ -90,5 +111,6 @@ pub fn to_json(plan: &Plan, instance: Option<&Instance>) -> String {
         plan: &'a Plan,
         instance: Option<&'a Instance>,
     }
-    serde_json::to_string_pretty(&Export { plan, instance }).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    serde_json::to_string_pretty(&Export { plan, instance })
+        .unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
 }

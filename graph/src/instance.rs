@@ -92,7 +92,10 @@ impl Plan {
                         res.span,
                         format!("resource `{}`: {why}", res.name),
                     ));
-                    sizes.push(ResourceSize { bytes: 0, extent: None });
+                    sizes.push(ResourceSize {
+                        bytes: 0,
+                        extent: None,
+                    });
                 }
             }
         }
@@ -132,7 +135,9 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
         ResourceDecl::Buffer { size, .. } => {
             let bytes = match *size {
                 BufferSize::Bytes(b) => b,
-                BufferSize::PerElement(quantity, per) => q.count(quantity).checked_mul(per).ok_or_else(overflow)?,
+                BufferSize::PerElement(quantity, per) => {
+                    q.count(quantity).checked_mul(per).ok_or_else(overflow)?
+                }
                 BufferSize::Bits(quantity) => q.count(quantity).div_ceil(32) * 4,
                 BufferSize::PerElementPlus(quantity, per, extra) => q
                     .count(quantity)
@@ -144,15 +149,27 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
                     tiles,
                     layers,
                     texel_bytes,
-                } => [u64::from(tile), u64::from(tile), u64::from(tiles), u64::from(layers), u64::from(texel_bytes)]
-                    .into_iter()
-                    .try_fold(1u64, u64::checked_mul)
-                    .ok_or_else(overflow)?,
+                } => [
+                    u64::from(tile),
+                    u64::from(tile),
+                    u64::from(tiles),
+                    u64::from(layers),
+                    u64::from(texel_bytes),
+                ]
+                .into_iter()
+                .try_fold(1u64, u64::checked_mul)
+                .ok_or_else(overflow)?,
             };
-            ResourceSize { bytes, extent: None }
+            ResourceSize {
+                bytes,
+                extent: None,
+            }
         }
         ResourceDecl::Image {
-            format, size, layers, ..
+            format,
+            size,
+            layers,
+            ..
         } => {
             let (w, h) = match *size {
                 ImageSize::Screen => (q.width, q.height),
@@ -160,10 +177,15 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
                 ImageSize::ScreenDiv(d) => (q.width.div_ceil(d), q.height.div_ceil(d)),
                 ImageSize::Fixed(w, h) => (w, h),
             };
-            let bytes = [u64::from(w), u64::from(h), u64::from(*layers), format.texel_bytes()]
-                .into_iter()
-                .try_fold(1u64, u64::checked_mul)
-                .ok_or_else(overflow)?;
+            let bytes = [
+                u64::from(w),
+                u64::from(h),
+                u64::from(*layers),
+                format.texel_bytes(),
+            ]
+            .into_iter()
+            .try_fold(1u64, u64::checked_mul)
+            .ok_or_else(overflow)?;
             ResourceSize {
                 bytes,
                 extent: Some([w, h, *layers]),
@@ -171,7 +193,10 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
         }
     };
     if size.bytes == 0 {
-        return Err(format!("size is zero bytes for this scene ({})", describe(decl)));
+        return Err(format!(
+            "size is zero bytes for this scene ({})",
+            describe(decl)
+        ));
     }
     Ok(size)
 }

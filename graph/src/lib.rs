@@ -30,8 +30,8 @@ pub mod resolve;
 pub mod schedule;
 pub mod schema;
 pub mod source;
-pub mod synthetic;
 pub mod sync;
+pub mod synthetic;
 
 pub use error::{ErrorKind, GraphError, GraphErrors};
 pub use instance::{Instance, Quantities};

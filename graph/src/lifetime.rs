@@ -32,40 +32,37 @@ impl Lifetime {
 
 pub fn lifetimes(g: &Graph, schedule: &Schedule) -> Vec<Lifetime> {
     let hb = &schedule.happens_before;
+    // Uses of each declared resource's memory (versions share it), in order.
+    let mut uses: Vec<Vec<(usize, PassId, AccessMode)>> = vec![Vec::new(); g.resources.len()];
+    for (pos, &p) in schedule.order.iter().enumerate() {
+        for a in &g.passes[p].accesses {
+            uses[g.physical(a.resource)].push((pos, p, a.mode));
+        }
+    }
     let mut out = Vec::new();
     for (r, res) in g.resources.iter().enumerate() {
-        if res.decl.lifetime() != LifetimeClass::Transient || res.version_of.is_some() {
-            continue;
-        }
-        let mut uses = Vec::new();
-        let mut positions = Vec::new();
-        for (pos, &p) in schedule.order.iter().enumerate() {
-            // Versions (`a -> b`) share their resource's memory.
-            let touches = |a: &&crate::resolve::Access| g.physical(a.resource) == r;
-            for a in g.passes[p].accesses.iter().filter(touches) {
-                uses.push((p, a.mode));
-            }
-            if g.passes[p].accesses.iter().any(|a| g.physical(a.resource) == r) {
-                positions.push((pos, p));
-            }
-        }
-        let (Some(&(first, _)), Some(&(last, _))) = (positions.first(), positions.last()) else {
+        let transient = res.decl.lifetime() == LifetimeClass::Transient && res.version_of.is_none();
+        let (Some(&(first, _, _)), Some(&(last, _, _))) = (uses[r].first(), uses[r].last()) else {
             continue;
         };
+        if !transient {
+            continue;
+        }
         // The latest pass not ordered after every use.
         let end = schedule
             .order
             .iter()
             .enumerate()
             .rev()
-            .find(|&(_, &q)| positions.iter().any(|&(_, u)| !hb.reaches(u, q)))
-            .map_or(last, |(pos, _)| pos.max(last));
+            .take_while(|&(pos, _)| pos > last)
+            .find(|&(_, &q)| uses[r].iter().any(|&(_, u, _)| !hb.reaches(u, q)))
+            .map_or(last, |(pos, _)| pos);
         out.push(Lifetime {
             resource: r,
             first,
             last,
             end,
-            uses,
+            uses: uses[r].iter().map(|&(_, p, m)| (p, m)).collect(),
         });
     }
     out

@@ -49,7 +49,11 @@ impl Plan {
 }
 
 /// Compiles graph text; `name` is used in diagnostics.
-pub fn compile_str(name: &str, text: &str, registry: &dyn PassRegistry) -> Result<Plan, GraphErrors> {
+pub fn compile_str(
+    name: &str,
+    text: &str,
+    registry: &dyn PassRegistry,
+) -> Result<Plan, GraphErrors> {
     let src = Source::new(name, text);
     let desc: GraphDesc = ron::from_str(text).map_err(|e| syntax_error(&src, &e))?;
     let loc = Locator::new(text);
@@ -60,19 +64,33 @@ pub fn compile_str(name: &str, text: &str, registry: &dyn PassRegistry) -> Resul
 pub fn compile_file(path: &Path, registry: &dyn PassRegistry) -> Result<Plan, GraphErrors> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| {
-        GraphError::new(ErrorKind::Io, &Source::new(&name, ""), Span::default(), format!("cannot read: {e}"))
+        GraphError::new(
+            ErrorKind::Io,
+            &Source::new(&name, ""),
+            Span::default(),
+            format!("cannot read: {e}"),
+        )
     })?;
     compile_str(&name, &text, registry)
 }
 
-fn compile(desc: &GraphDesc, src: &Source, loc: &Locator, registry: &dyn PassRegistry) -> Result<Plan, GraphErrors> {
+fn compile(
+    desc: &GraphDesc,
+    src: &Source,
+    loc: &Locator,
+    registry: &dyn PassRegistry,
+) -> Result<Plan, GraphErrors> {
     let graph = resolve(desc, src, loc, registry)?;
     let deps = analyse(&graph)?;
     let (live, culled) = cull(&graph, &deps);
     let sched = schedule(&graph, &deps, &live);
     let lifetimes = lifetimes(&graph, &sched);
     let dependencies = dependencies(&graph, &deps.edges, &live);
-    debug_assert!(dependencies.iter().all(|d| sched.happens_before.reaches(d.from, d.to)));
+    debug_assert!(
+        dependencies
+            .iter()
+            .all(|d| sched.happens_before.reaches(d.from, d.to))
+    );
     Ok(Plan {
         live,
         order: sched.order,
@@ -88,5 +106,11 @@ fn compile(desc: &GraphDesc, src: &Source, loc: &Locator, registry: &dyn PassReg
 fn syntax_error(src: &Source, e: &ron::error::SpannedError) -> GraphErrors {
     let start = src.offset_of(e.span.start.line, e.span.start.col);
     let end = src.offset_of(e.span.end.line, e.span.end.col).max(start);
-    GraphError::new(ErrorKind::Syntax, src, Span::new(start, end), e.code.to_string()).into()
+    GraphError::new(
+        ErrorKind::Syntax,
+        src,
+        Span::new(start, end),
+        e.code.to_string(),
+    )
+    .into()
 }

@@ -20,11 +20,18 @@ impl Reach {
         }
         let mut bits = vec![0u64; n * words];
         for &a in order.iter().rev() {
-            for i in 0..succ[a].len() {
-                let b = succ[a][i];
-                bits[a * words + b / 64] |= 1 << (b % 64);
-                for w in 0..words {
-                    bits[a * words + w] |= bits[b * words + w];
+            for &b in &succ[a] {
+                // Rows of `a` and `b` are disjoint slices of one vector.
+                let (row_a, row_b) = if a < b {
+                    let (lo, hi) = bits.split_at_mut(b * words);
+                    (&mut lo[a * words..(a + 1) * words], &hi[..words])
+                } else {
+                    let (lo, hi) = bits.split_at_mut(a * words);
+                    (&mut hi[..words], &lo[b * words..(b + 1) * words])
+                };
+                row_a[b / 64] |= 1 << (b % 64);
+                for (x, y) in row_a.iter_mut().zip(row_b) {
+                    *x |= *y;
                 }
             }
         }

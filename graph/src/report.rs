@@ -15,7 +15,11 @@ pub fn human_bytes(b: u64) -> String {
         v /= 1024.0;
         u += 1;
     }
-    if u == 0 { format!("{b} B") } else { format!("{v:.1} {}", UNITS[u]) }
+    if u == 0 {
+        format!("{b} B")
+    } else {
+        format!("{v:.1} {}", UNITS[u])
+    }
 }
 
 pub fn render(plan: &Plan, instance: Option<&Instance>) -> String {
@@ -52,7 +56,11 @@ fn lanes(s: &mut String, plan: &Plan) {
 
 fn order(s: &mut String, plan: &Plan) {
     let _ = writeln!(s, "Order");
-    let _ = writeln!(s, "  {:>3}  {:<14} {:<22} {:<26} waits for", "#", "queue", "pass", "kind");
+    let _ = writeln!(
+        s,
+        "  {:>3}  {:<14} {:<22} {:<26} waits for",
+        "#", "queue", "pass", "kind"
+    );
     for (i, &p) in plan.order.iter().enumerate() {
         let pass = &plan.graph.passes[p];
         let waits: Vec<String> = plan
@@ -81,7 +89,11 @@ fn sync_points(s: &mut String, plan: &Plan) {
         plan.sync_points.len()
     );
     for sp in &plan.sync_points {
-        let res: Vec<&str> = sp.resources.iter().map(|&r| plan.resource_name(r)).collect();
+        let res: Vec<&str> = sp
+            .resources
+            .iter()
+            .map(|&r| plan.resource_name(r))
+            .collect();
         let _ = writeln!(
             s,
             "  {} signals {} after `{}`  →  {} waits before `{}`   [{}]",
@@ -94,7 +106,10 @@ fn sync_points(s: &mut String, plan: &Plan) {
         );
     }
     let barriers = plan.dependencies.len() - cross;
-    let _ = writeln!(s, "  plus {barriers} same-queue dependencies, each a pipeline barrier\n");
+    let _ = writeln!(
+        s,
+        "  plus {barriers} same-queue dependencies, each a pipeline barrier\n"
+    );
 }
 
 fn culled(s: &mut String, plan: &Plan) {
@@ -114,13 +129,26 @@ fn lifetime_matrix(s: &mut String, plan: &Plan) {
         s,
         "Transient lifetimes (columns: passes in order; W write, R read, A atomic, = alive, ~ alive until another queue has waited)"
     );
-    let width = plan.lifetimes.iter().map(|l| plan.resource_name(l.resource).len()).max().unwrap_or(8).max(8);
-    let header: String = (0..plan.order.len()).map(|i| format!("{:>3}", i % 1000)).collect();
+    let width = plan
+        .lifetimes
+        .iter()
+        .map(|l| plan.resource_name(l.resource).len())
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    let header: String = (0..plan.order.len())
+        .map(|i| format!("{:>3}", i % 1000))
+        .collect();
     let _ = writeln!(s, "  {:<width$} {header}", "");
     for l in &plan.lifetimes {
         let mut row = String::new();
         for (pos, &p) in plan.order.iter().enumerate() {
-            let modes: Vec<AccessMode> = l.uses.iter().filter(|(u, _)| *u == p).map(|(_, m)| *m).collect();
+            let modes: Vec<AccessMode> = l
+                .uses
+                .iter()
+                .filter(|(u, _)| *u == p)
+                .map(|(_, m)| *m)
+                .collect();
             let mode = match modes.as_slice() {
                 [] => None,
                 [AccessMode::Read] => Some("R"),
@@ -148,8 +176,18 @@ fn memory(s: &mut String, plan: &Plan, inst: &Instance) {
         "Memory for {} strands, {} vertices, {} segments, {} bundles, {} models, {}x{}",
         q.strands, q.vertices, q.segments, q.bundles, q.models, q.width, q.height
     );
-    let width = plan.lifetimes.iter().map(|l| plan.resource_name(l.resource).len()).max().unwrap_or(8).max(8);
-    let _ = writeln!(s, "  {:<width$} {:<8} {:>12} {:>12}  lifetime", "transient", "heap", "offset", "size");
+    let width = plan
+        .lifetimes
+        .iter()
+        .map(|l| plan.resource_name(l.resource).len())
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    let _ = writeln!(
+        s,
+        "  {:<width$} {:<8} {:>12} {:>12}  lifetime",
+        "transient", "heap", "offset", "size"
+    );
     for p in &inst.memory.placements {
         let l = plan.lifetimes.iter().find(|l| l.resource == p.resource);
         let span = l.map_or(String::new(), |l| format!("{}..={}", l.first, l.end));
@@ -179,8 +217,14 @@ fn memory(s: &mut String, plan: &Plan, inst: &Instance) {
         .resources
         .iter()
         .enumerate()
-        .filter(|(_, r)| r.version_of.is_none() && r.decl.lifetime() != crate::schema::LifetimeClass::Transient)
+        .filter(|(_, r)| {
+            r.version_of.is_none() && r.decl.lifetime() != crate::schema::LifetimeClass::Transient
+        })
         .map(|(i, _)| inst.sizes[i].bytes)
         .sum();
-    let _ = writeln!(s, "Imported and history resources: {}", human_bytes(persistent));
+    let _ = writeln!(
+        s,
+        "Imported and history resources: {}",
+        human_bytes(persistent)
+    );
 }

@@ -47,7 +47,9 @@ pub struct Pass {
 impl Pass {
     /// Whether this pass uses the rasterizer (has colour or depth attachments).
     pub fn is_raster(&self) -> bool {
-        self.accesses.iter().any(|a| matches!(a.usage, Usage::Color | Usage::Depth))
+        self.accesses
+            .iter()
+            .any(|a| matches!(a.usage, Usage::Color | Usage::Depth))
     }
 }
 
@@ -166,9 +168,19 @@ pub fn resolve(
     for (i, name) in desc.outputs.iter().enumerate() {
         let span = loc.span(&format!("outputs[{i}]"));
         match by_name.get(name) {
-            None => errors.push(unknown_resource(src, span, name, "listed as an output", &resources)),
+            None => errors.push(unknown_resource(
+                src,
+                span,
+                name,
+                "listed as an output",
+                &resources,
+            )),
             Some(&r) => {
-                let written = passes.iter().any(|p| p.accesses.iter().any(|a| a.resource == r && a.mode.writes()));
+                let written = passes.iter().any(|p| {
+                    p.accesses
+                        .iter()
+                        .any(|a| a.resource == r && a.mode.writes())
+                });
                 if !written {
                     errors.push(
                         GraphError::new(
@@ -225,7 +237,10 @@ fn resolve_accesses(
                     ErrorKind::BadAccess,
                     src,
                     span,
-                    format!("pass `{}`: `a -> b` versions are made by `writes` only", decl.name),
+                    format!(
+                        "pass `{}`: `a -> b` versions are made by `writes` only",
+                        decl.name
+                    ),
                 ));
                 continue;
             }
@@ -240,7 +255,10 @@ fn resolve_accesses(
                                 ErrorKind::BadAccess,
                                 src,
                                 span,
-                                format!("pass `{}`: unknown usage `{prefix}` in `{entry}`", decl.name),
+                                format!(
+                                    "pass `{}`: unknown usage `{prefix}` in `{entry}`",
+                                    decl.name
+                                ),
                             )
                             .help(format!("usages are {}", known.join(", "))),
                         );
@@ -336,7 +354,10 @@ fn queue_error(
             usage.prefix()
         ),
     )
-    .label(loc.span(&format!("passes[{pass_index}].queue")), "queue chosen here")
+    .label(
+        loc.span(&format!("passes[{pass_index}].queue")),
+        "queue chosen here",
+    )
     .help(queue_help(usage))
 }
 
@@ -366,11 +387,18 @@ fn declare_versions(
     while !pending.is_empty() {
         let before = pending.len();
         pending.retain(|(old, new, span)| {
-            let Some(&old_id) = by_name.get(old) else { return true };
+            let Some(&old_id) = by_name.get(old) else {
+                return true;
+            };
             if let Some(&existing) = by_name.get(new) {
                 errors.push(
-                    GraphError::new(ErrorKind::DuplicateName, src, *span, format!("version `{new}` is already a name"))
-                        .label(resources[existing].span, "first declared here"),
+                    GraphError::new(
+                        ErrorKind::DuplicateName,
+                        src,
+                        *span,
+                        format!("version `{new}` is already a name"),
+                    )
+                    .label(resources[existing].span, "first declared here"),
                 );
                 return false;
             }
@@ -399,7 +427,13 @@ fn verb(mode: AccessMode) -> &'static str {
     }
 }
 
-fn unknown_resource(src: &Source, span: Span, name: &str, what: &str, resources: &[Resource]) -> GraphError {
+fn unknown_resource(
+    src: &Source,
+    span: Span,
+    name: &str,
+    what: &str,
+    resources: &[Resource],
+) -> GraphError {
     let mut e = GraphError::new(
         ErrorKind::UnknownResource,
         src,
@@ -437,8 +471,12 @@ fn usage_problem(a: &Access, decl: &ResourceDecl) -> Option<&'static str> {
         return Some("is a colour attachment, but the image has a depth format");
     }
     match a.mode {
-        AccessMode::Atomic if a.usage != Usage::Storage => Some("is atomic, which needs storage usage"),
-        AccessMode::Write if matches!(a.usage, Usage::Uniform | Usage::Sampled | Usage::Indirect) => {
+        AccessMode::Atomic if a.usage != Usage::Storage => {
+            Some("is atomic, which needs storage usage")
+        }
+        AccessMode::Write
+            if matches!(a.usage, Usage::Uniform | Usage::Sampled | Usage::Indirect) =>
+        {
             Some("is written, but that usage is read-only")
         }
         _ => None,
@@ -447,7 +485,9 @@ fn usage_problem(a: &Access, decl: &ResourceDecl) -> Option<&'static str> {
 
 fn queue_help(usage: Usage) -> &'static str {
     match usage {
-        Usage::Color | Usage::Depth => "attachments need the rasterizer: move the pass to `Graphics`",
+        Usage::Color | Usage::Depth => {
+            "attachments need the rasterizer: move the pass to `Graphics`"
+        }
         _ => "transfer queues only copy: move the pass to `Graphics` or `AsyncCompute`",
     }
 }

@@ -46,30 +46,47 @@ pub fn schedule(g: &Graph, deps: &Dependencies, live: &[bool]) -> Schedule {
         .iter()
         .map(|&q| Lane {
             queue: q,
-            passes: order.iter().copied().filter(|&p| g.passes[p].queue == q).collect(),
+            passes: order
+                .iter()
+                .copied()
+                .filter(|&p| g.passes[p].queue == q)
+                .collect(),
         })
         .filter(|l| !l.passes.is_empty())
         .collect();
-    let lane_edges: Vec<(PassId, PassId)> =
-        lanes.iter().flat_map(|l| l.passes.windows(2).map(|w| (w[0], w[1]))).collect();
+    let lane_edges: Vec<(PassId, PassId)> = lanes
+        .iter()
+        .flat_map(|l| l.passes.windows(2).map(|w| (w[0], w[1])))
+        .collect();
 
     let queue = |p: PassId| g.passes[p].queue;
     let mut cross: BTreeMap<(PassId, PassId), Vec<ResourceId>> = BTreeMap::new();
-    for e in deps.edges.iter().filter(|e| live[e.from] && live[e.to] && queue(e.from) != queue(e.to)) {
+    for e in deps
+        .edges
+        .iter()
+        .filter(|e| live[e.from] && live[e.to] && queue(e.from) != queue(e.to))
+    {
         cross.entry((e.from, e.to)).or_default().push(e.resource);
     }
 
     // Transitive reduction restricted to cross-queue edges: (u, v) is redundant
     // when another successor w of u (in lane order or across queues) reaches v.
     let n = g.passes.len();
-    let all_edges: Vec<(PassId, PassId)> = lane_edges.iter().copied().chain(cross.keys().copied()).collect();
+    let all_edges: Vec<(PassId, PassId)> = lane_edges
+        .iter()
+        .copied()
+        .chain(cross.keys().copied())
+        .collect();
     let reach = Reach::new(n, &order, all_edges.iter().copied());
     let mut succ = vec![Vec::new(); n];
     for &(a, b) in &all_edges {
         succ[a].push(b);
     }
     let position_in_lane = |p: PassId| {
-        lanes.iter().find_map(|l| l.passes.iter().position(|&x| x == p)).map_or(0, |i| i as u64 + 1)
+        lanes
+            .iter()
+            .find_map(|l| l.passes.iter().position(|&x| x == p))
+            .map_or(0, |i| i as u64 + 1)
     };
     let sync_points: Vec<SyncPoint> = cross
         .iter()
@@ -84,7 +101,10 @@ pub fn schedule(g: &Graph, deps: &Dependencies, live: &[bool]) -> Schedule {
         })
         .collect();
 
-    let enforced = lane_edges.iter().copied().chain(sync_points.iter().map(|s| (s.after, s.before)));
+    let enforced = lane_edges
+        .iter()
+        .copied()
+        .chain(sync_points.iter().map(|s| (s.after, s.before)));
     let happens_before = Reach::new(n, &order, enforced);
     Schedule {
         order,
@@ -96,5 +116,7 @@ pub fn schedule(g: &Graph, deps: &Dependencies, live: &[bool]) -> Schedule {
 
 /// Whether every edge is enforced by the schedule (lane order or sync points).
 pub fn covers(schedule: &Schedule, edges: &[Edge]) -> bool {
-    edges.iter().all(|e| schedule.happens_before.reaches(e.from, e.to))
+    edges
+        .iter()
+        .all(|e| schedule.happens_before.reaches(e.from, e.to))
 }

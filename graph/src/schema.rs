@@ -69,7 +69,9 @@ impl ResourceDecl {
     }
     pub fn lifetime(&self) -> LifetimeClass {
         match self {
-            ResourceDecl::Buffer { lifetime, .. } | ResourceDecl::Image { lifetime, .. } => *lifetime,
+            ResourceDecl::Buffer { lifetime, .. } | ResourceDecl::Image { lifetime, .. } => {
+                *lifetime
+            }
         }
     }
     pub fn is_image(&self) -> bool {
@@ -172,7 +174,9 @@ impl ImageFormat {
 }
 
 /// The queue a pass prefers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Deserialize, Serialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Deserialize, Serialize,
+)]
 pub enum Queue {
     #[default]
     Graphics,
@@ -273,7 +277,10 @@ impl Usage {
     ];
 
     pub fn prefix(self) -> &'static str {
-        Usage::PREFIXES.iter().find(|(_, u)| *u == self).map_or("storage", |(p, _)| p)
+        Usage::PREFIXES
+            .iter()
+            .find(|(_, u)| *u == self)
+            .map_or("storage", |(p, _)| p)
     }
 
     /// Usages that only images support.

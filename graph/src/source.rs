@@ -66,7 +66,11 @@ impl Source {
         let mut offset = 0;
         for (i, l) in self.text.split_inclusive('\n').enumerate() {
             if i + 1 == line {
-                let within: usize = l.chars().take(col.saturating_sub(1)).map(char::len_utf8).sum();
+                let within: usize = l
+                    .chars()
+                    .take(col.saturating_sub(1))
+                    .map(char::len_utf8)
+                    .sum();
                 return offset + within;
             }
             offset += l.len();
@@ -165,7 +169,9 @@ fn tokenize(text: &str) -> Vec<(Tok, Span)> {
                 }
                 i += 1; // opening quote
                 let body = i;
-                let closing: String = std::iter::once('"').chain("#".repeat(hashes).chars()).collect();
+                let closing: String = std::iter::once('"')
+                    .chain("#".repeat(hashes).chars())
+                    .collect();
                 let end = text[i..].find(&closing).map_or(b.len(), |p| i + p);
                 i = (end + closing.len()).min(b.len());
                 out.push((Tok::Str(text[body..end].to_string()), Span::new(start, i)));
@@ -334,7 +340,10 @@ Graph(
 
     #[test]
     fn falls_back_to_enclosing_value() {
-        assert_eq!(text_at("passes[0].writes[3]"), &DOC[DOC.find("Pass(").unwrap()..DOC.rfind("]),").unwrap() + 2]);
+        assert_eq!(
+            text_at("passes[0].writes[3]"),
+            &DOC[DOC.find("Pass(").unwrap()..DOC.rfind("]),").unwrap() + 2]
+        );
     }
 
     #[test]

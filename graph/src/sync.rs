@@ -86,15 +86,27 @@ fn shader_stages(pass: &Pass) -> Stages {
 
 fn point(pass: &Pass, a: &Access, is_image: bool) -> AccessPoint {
     let (stages, access, layout) = match (a.usage, a.mode) {
-        (Usage::Storage, AccessMode::Read) => (shader_stages(pass), Accesses::SHADER_STORAGE_READ, Layout::General),
+        (Usage::Storage, AccessMode::Read) => (
+            shader_stages(pass),
+            Accesses::SHADER_STORAGE_READ,
+            Layout::General,
+        ),
         (Usage::Storage, _) => (
             shader_stages(pass),
             Accesses::SHADER_STORAGE_READ | Accesses::SHADER_STORAGE_WRITE,
             Layout::General,
         ),
         (Usage::Uniform, _) => (shader_stages(pass), Accesses::UNIFORM_READ, Layout::General),
-        (Usage::Sampled, _) => (shader_stages(pass), Accesses::SHADER_SAMPLED_READ, Layout::ShaderReadOnly),
-        (Usage::Indirect, _) => (Stages::DRAW_INDIRECT, Accesses::INDIRECT_COMMAND_READ, Layout::General),
+        (Usage::Sampled, _) => (
+            shader_stages(pass),
+            Accesses::SHADER_SAMPLED_READ,
+            Layout::ShaderReadOnly,
+        ),
+        (Usage::Indirect, _) => (
+            Stages::DRAW_INDIRECT,
+            Accesses::INDIRECT_COMMAND_READ,
+            Layout::General,
+        ),
         // Colour writes blend, so they read what is there too.
         (Usage::Color, _) => (
             Stages::COLOR_ATTACHMENT_OUTPUT,
@@ -111,7 +123,9 @@ fn point(pass: &Pass, a: &Access, is_image: bool) -> AccessPoint {
             Accesses::DEPTH_STENCIL_ATTACHMENT_READ | Accesses::DEPTH_STENCIL_ATTACHMENT_WRITE,
             Layout::DepthAttachment,
         ),
-        (Usage::Copy, AccessMode::Read) => (Stages::COPY, Accesses::TRANSFER_READ, Layout::TransferSrc),
+        (Usage::Copy, AccessMode::Read) => {
+            (Stages::COPY, Accesses::TRANSFER_READ, Layout::TransferSrc)
+        }
         (Usage::Copy, _) => (Stages::COPY, Accesses::TRANSFER_WRITE, Layout::TransferDst),
     };
     AccessPoint {
@@ -127,8 +141,11 @@ pub fn access_point(g: &Graph, p: PassId, r: ResourceId) -> AccessPoint {
     let pass = &g.passes[p];
     let r = g.physical(r);
     let is_image = g.resources[r].decl.is_image();
-    let mut points =
-        pass.accesses.iter().filter(|a| g.physical(a.resource) == r).map(|a| point(pass, a, is_image));
+    let mut points = pass
+        .accesses
+        .iter()
+        .filter(|a| g.physical(a.resource) == r)
+        .map(|a| point(pass, a, is_image));
     let first = points.next().unwrap_or(AccessPoint {
         stages: Stages::empty(),
         access: Accesses::empty(),
@@ -138,7 +155,11 @@ pub fn access_point(g: &Graph, p: PassId, r: ResourceId) -> AccessPoint {
         stages: acc.stages | p.stages,
         access: acc.access | p.access,
         // Two different layouts in one pass: only GENERAL serves both.
-        layout: if acc.layout == p.layout { acc.layout } else { Some(Layout::General) },
+        layout: if acc.layout == p.layout {
+            acc.layout
+        } else {
+            Some(Layout::General)
+        },
     })
 }
 

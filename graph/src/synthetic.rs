@@ -28,9 +28,13 @@ pub struct Spec {
 impl Spec {
     /// A deterministic pseudo-random spec (an LCG, so the crate needs no RNG).
     pub fn random(n: usize, seed: u64) -> Spec {
-        let mut s = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let mut s = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         let mut next = move |m: u64| {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 33) % m.max(1)
         };
         let passes = (0..n)
@@ -40,13 +44,19 @@ impl Spec {
                 } else {
                     let k = 1 + next(3) as usize;
                     // Mostly recent producers, like a real frame.
-                    let mut r: Vec<usize> = (0..k).map(|_| i - 1 - next(i.min(8) as u64) as usize).collect();
+                    let mut r: Vec<usize> = (0..k)
+                        .map(|_| i - 1 - next(i.min(8) as u64) as usize)
+                        .collect();
                     r.sort_unstable();
                     r.dedup();
                     r
                 };
                 SynthPass {
-                    queue: if next(3) == 0 { Queue::AsyncCompute } else { Queue::Graphics },
+                    queue: if next(3) == 0 {
+                        Queue::AsyncCompute
+                    } else {
+                        Queue::Graphics
+                    },
                     reads,
                     atomic: next(10) == 0,
                     size: 1 + next(64),
@@ -62,7 +72,11 @@ impl Spec {
         let mut s = String::from("Graph(\n  name: \"synthetic\",\n  resources: [\n");
         let _ = writeln!(s, "    Buffer(name: \"counter\", size: Bytes(4)),");
         for (i, p) in self.passes.iter().enumerate() {
-            let lifetime = if self.outputs.contains(&i) { "Imported" } else { "Transient" };
+            let lifetime = if self.outputs.contains(&i) {
+                "Imported"
+            } else {
+                "Transient"
+            };
             let _ = writeln!(
                 s,
                 "    Buffer(name: \"r{i}\", size: PerElement(Segments, {}), lifetime: {lifetime}),",
@@ -70,7 +84,10 @@ impl Spec {
             );
         }
         s.push_str("  ],\n  passes: [\n");
-        let _ = writeln!(s, "    Pass(name: \"clear\", kind: \"common.clear\", writes: [\"counter\"]),");
+        let _ = writeln!(
+            s,
+            "    Pass(name: \"clear\", kind: \"common.clear\", writes: [\"counter\"]),"
+        );
         for (i, p) in self.passes.iter().enumerate() {
             let reads: Vec<String> = p.reads.iter().map(|r| format!("\"r{r}\"")).collect();
             let atomics = if p.atomic { "\"counter\"" } else { "" };

@@ -11,33 +11,51 @@ use strandgraph_graph::synthetic::{Spec, SynthPass};
 use strandgraph_graph::{Plan, Quantities, Queue, compile_str};
 
 fn spec() -> impl Strategy<Value = Spec> {
-    let pass = (0u8..2, prop::collection::vec(any::<Index>(), 0..4), prop::bool::weighted(0.15), 1u64..64);
-    (prop::collection::vec(pass, 1..40), prop::collection::vec(any::<Index>(), 0..3)).prop_map(|(passes, extra)| {
-        let n = passes.len();
-        let passes = passes
-            .into_iter()
-            .enumerate()
-            .map(|(i, (q, reads, atomic, size))| {
-                let mut reads: Vec<usize> = if i == 0 { vec![] } else { reads.iter().map(|x| x.index(i)).collect() };
-                reads.sort_unstable();
-                reads.dedup();
-                SynthPass {
-                    queue: if q == 0 { Queue::Graphics } else { Queue::AsyncCompute },
-                    reads,
-                    atomic,
-                    size,
-                }
-            })
-            .collect();
-        let mut outputs: Vec<usize> = extra.iter().map(|x| x.index(n)).chain([n - 1]).collect();
-        outputs.sort_unstable();
-        outputs.dedup();
-        Spec { passes, outputs }
-    })
+    let pass = (
+        0u8..2,
+        prop::collection::vec(any::<Index>(), 0..4),
+        prop::bool::weighted(0.15),
+        1u64..64,
+    );
+    (
+        prop::collection::vec(pass, 1..40),
+        prop::collection::vec(any::<Index>(), 0..3),
+    )
+        .prop_map(|(passes, extra)| {
+            let n = passes.len();
+            let passes = passes
+                .into_iter()
+                .enumerate()
+                .map(|(i, (q, reads, atomic, size))| {
+                    let mut reads: Vec<usize> = if i == 0 {
+                        vec![]
+                    } else {
+                        reads.iter().map(|x| x.index(i)).collect()
+                    };
+                    reads.sort_unstable();
+                    reads.dedup();
+                    SynthPass {
+                        queue: if q == 0 {
+                            Queue::Graphics
+                        } else {
+                            Queue::AsyncCompute
+                        },
+                        reads,
+                        atomic,
+                        size,
+                    }
+                })
+                .collect();
+            let mut outputs: Vec<usize> = extra.iter().map(|x| x.index(n)).chain([n - 1]).collect();
+            outputs.sort_unstable();
+            outputs.dedup();
+            Spec { passes, outputs }
+        })
 }
 
 fn compile(spec: &Spec) -> Plan {
-    compile_str("synthetic.ron", &spec.to_ron(), &Spec::kinds()).unwrap_or_else(|e| panic!("{e}\n{}", spec.to_ron()))
+    compile_str("synthetic.ron", &spec.to_ron(), &Spec::kinds())
+        .unwrap_or_else(|e| panic!("{e}\n{}", spec.to_ron()))
 }
 
 /// Successors as the backends enforce order: next pass in the same lane, and sync points.

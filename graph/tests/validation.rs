@@ -9,7 +9,10 @@ fn registry() -> KindList {
 }
 
 fn marker_line(src: &str) -> usize {
-    src.lines().position(|l| l.contains("// <-")).expect("test source has a `// <-` marker") + 1
+    src.lines()
+        .position(|l| l.contains("// <-"))
+        .expect("test source has a `// <-` marker")
+        + 1
 }
 
 fn expect_error(src: &str, kind: ErrorKind, names: &[&str]) -> GraphError {
@@ -26,10 +29,17 @@ fn expect_error(src: &str, kind: ErrorKind, names: &[&str]) -> GraphError {
     assert_eq!(err.line, marker_line(src), "wrong line for: {err}");
     assert_eq!(err.file, "bad.ron");
     for name in names {
-        assert!(err.message.contains(name), "message `{}` does not name `{name}`", err.message);
+        assert!(
+            err.message.contains(name),
+            "message `{}` does not name `{name}`",
+            err.message
+        );
     }
     let shown = err.to_string();
-    assert!(shown.starts_with(&format!("bad.ron:{}:", err.line)), "display lacks location: {shown}");
+    assert!(
+        shown.starts_with(&format!("bad.ron:{}:", err.line)),
+        "display lacks location: {shown}"
+    );
     err
 }
 
@@ -62,7 +72,9 @@ fn unknown_resource() {
     outputs: ["out"],
 )"#;
     let e = expect_error(src, ErrorKind::UnknownResource, &["positons", "skin"]);
-    let help = miette::Diagnostic::help(&e).map(|h| h.to_string()).unwrap_or_default();
+    let help = miette::Diagnostic::help(&e)
+        .map(|h| h.to_string())
+        .unwrap_or_default();
     assert!(help.contains("positions"), "no suggestion: {help}");
 }
 
@@ -79,7 +91,9 @@ fn unknown_pass_kind_with_suggestion() {
     outputs: ["out"],
 )"#;
     let e = expect_error(src, ErrorKind::UnknownPassKind, &["test.prodcue", "`p`"]);
-    let help = miette::Diagnostic::help(&e).map(|h| h.to_string()).unwrap_or_default();
+    let help = miette::Diagnostic::help(&e)
+        .map(|h| h.to_string())
+        .unwrap_or_default();
     assert!(help.contains("test.produce"), "no suggestion: {help}");
 }
 
@@ -181,8 +195,16 @@ fn cycle_names_the_passes_on_it() {
     ],
     outputs: ["out"],
 )"#;
-    let e = expect_error(src, ErrorKind::Cycle, &["`first`", "`second`", "(a)", "(b)"]);
-    assert!(!e.message.contains("last"), "`last` is not on the cycle: {}", e.message);
+    let e = expect_error(
+        src,
+        ErrorKind::Cycle,
+        &["`first`", "`second`", "(a)", "(b)"],
+    );
+    assert!(
+        !e.message.contains("last"),
+        "`last` is not on the cycle: {}",
+        e.message
+    );
 }
 
 #[test]
@@ -201,7 +223,11 @@ fn two_unordered_writers() {
     ],
     outputs: ["out"],
 )"#;
-    expect_error(src, ErrorKind::UnorderedWriters, &["sun", "lamps", "lights"]);
+    expect_error(
+        src,
+        ErrorKind::UnorderedWriters,
+        &["sun", "lamps", "lights"],
+    );
 }
 
 #[test]
@@ -221,7 +247,11 @@ fn ordered_writers_are_accepted() {
     outputs: ["out"],
 )"#;
     let plan = compile_str("ok.ron", src, &registry()).unwrap();
-    assert!(plan.dependencies.iter().any(|d| d.from == 0 && d.to == 1 && d.hazard.short() == "WAW"));
+    assert!(
+        plan.dependencies
+            .iter()
+            .any(|d| d.from == 0 && d.to == 1 && d.hazard.short() == "WAW")
+    );
 }
 
 #[test]
@@ -250,7 +280,11 @@ fn queue_cannot_rasterize_on_async_compute() {
     ],
     outputs: ["out"],
 )"#;
-    expect_error(src, ErrorKind::QueueCannotAccess, &["compose", "async-compute", "color", "out"]);
+    expect_error(
+        src,
+        ErrorKind::QueueCannotAccess,
+        &["compose", "async-compute", "color", "out"],
+    );
 }
 
 #[test]
@@ -268,7 +302,11 @@ fn transfer_queue_only_copies() {
     ],
     outputs: ["out"],
 )"#;
-    expect_error(src, ErrorKind::QueueCannotAccess, &["upload", "transfer", "storage", "out"]);
+    expect_error(
+        src,
+        ErrorKind::QueueCannotAccess,
+        &["upload", "transfer", "storage", "out"],
+    );
 }
 
 #[test]
@@ -342,7 +380,11 @@ fn zero_sized_resource_is_reported_at_instantiation() {
     let e = err.first();
     assert_eq!(e.kind, ErrorKind::Size);
     assert_eq!(e.line, marker_line(src));
-    assert!(e.message.contains("per_strand") && e.message.contains("zero"), "{}", e.message);
+    assert!(
+        e.message.contains("per_strand") && e.message.contains("zero"),
+        "{}",
+        e.message
+    );
 }
 
 #[test]
@@ -356,5 +398,44 @@ fn several_errors_are_reported_together() {
     outputs: ["out"],
 )"#;
     let errors = compile_str("bad.ron", src, &registry()).unwrap_err();
-    assert_eq!(errors.kinds(), vec![ErrorKind::UnknownPassKind, ErrorKind::UnknownResource]);
+    assert_eq!(
+        errors.kinds(),
+        vec![ErrorKind::UnknownPassKind, ErrorKind::UnknownResource]
+    );
+}
+
+#[test]
+fn versions_order_old_readers_before_the_in_place_writer() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Image(name: "depth", format: D32Float, size: Screen),
+        Buffer(name: "hiz", size: Bytes(64)),
+        Image(name: "out", format: Rgba8Unorm, size: Screen, lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "hair", kind: "test.draw", reads: ["hiz"], writes: ["depth:depth -> depth.hair", "color:out"]),
+        Pass(name: "prepass", kind: "test.draw", writes: ["depth:depth"]),
+        Pass(name: "downsample", kind: "test.produce", reads: ["sampled:depth"], writes: ["hiz"]),
+        Pass(name: "fog", kind: "test.produce", reads: ["sampled:depth.hair"], writes: ["out -> out.fogged"]),
+    ],
+    outputs: ["out.fogged"],
+)"#;
+    let plan = compile_str("ok.ron", src, &registry()).unwrap();
+    let order: Vec<&str> = plan.order.iter().map(|&p| plan.pass_name(p)).collect();
+    assert_eq!(order, ["prepass", "downsample", "hair", "fog"]);
+    // Versions share their resource's memory: one lifetime, one placement.
+    let depth = plan.graph.resource_id("depth").unwrap();
+    assert_eq!(
+        plan.graph
+            .physical(plan.graph.resource_id("depth.hair").unwrap()),
+        depth
+    );
+    let l = plan.lifetimes.iter().find(|l| l.resource == depth).unwrap();
+    assert_eq!((l.first, l.last), (0, 3));
+    assert!(
+        plan.lifetimes
+            .iter()
+            .all(|l| plan.graph.resources[l.resource].version_of.is_none())
+    );
 }

@@ -11,14 +11,30 @@ pub struct PassKind {
 }
 
 const fn kind(name: &'static str, summary: &'static str, source: &'static str) -> PassKind {
-    PassKind { name, summary, source }
+    PassKind {
+        name,
+        summary,
+        source,
+    }
 }
 
 pub static KINDS: &[PassKind] = &[
     // Shared by every pipeline.
-    kind("common.clear", "fill buffers or images with a constant (all-ones for atomicMin targets)", "strandgraph"),
-    kind("scene.depth_prepass", "rasterize opaque meshes (heads, bodies) into scene depth", "strandgraph"),
-    kind("scene.opaque", "shade opaque meshes, including hair shadows on skin", "Kulikov 2025, 'Hair shadows on skin'"),
+    kind(
+        "common.clear",
+        "fill buffers or images with a constant (all-ones for atomicMin targets)",
+        "strandgraph",
+    ),
+    kind(
+        "scene.depth_prepass",
+        "rasterize opaque meshes (heads, bodies) into scene depth",
+        "strandgraph",
+    ),
+    kind(
+        "scene.opaque",
+        "shade opaque meshes, including hair shadows on skin",
+        "Kulikov 2025, 'Hair shadows on skin'",
+    ),
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
     kind(
         "kulikov.lod",
@@ -30,8 +46,16 @@ pub static KINDS: &[PassKind] = &[
         "skin roots to triangles (hairRootSkinningInfo_t) and cache post-transform positions",
         "Kulikov 2025, 'Skinning'",
     ),
-    kind("kulikov.density", "splat strands into a density voxel grid per model", "Kulikov 2025, 'Simulation' (density output)"),
-    kind("kulikov.depth_downsample", "1/16 downscaled max depth for segment occlusion culling", "Kulikov 2025, 'Culling'"),
+    kind(
+        "kulikov.density",
+        "splat strands into a density voxel grid per model",
+        "Kulikov 2025, 'Simulation' (density output)",
+    ),
+    kind(
+        "kulikov.depth_downsample",
+        "1/16 downscaled max depth for segment occlusion culling",
+        "Kulikov 2025, 'Culling'",
+    ),
     kind(
         "kulikov.cull",
         "frustum, occlusion and fedora culling; visibility bits, screen bounds and sort bins",
@@ -42,7 +66,11 @@ pub static KINDS: &[PassKind] = &[
         "allocate 64x64 atlas tiles per model from screen bounds, downscaling until they fit",
         "Kulikov 2025, 'Visibility buffer: tile allocation, downscale'",
     ),
-    kind("kulikov.sort", "global counting sort of visible segments by screen bucket", "Kulikov 2025, 'Sort everything!'"),
+    kind(
+        "kulikov.sort",
+        "global counting sort of visible segments by screen bucket",
+        "Kulikov 2025, 'Sort everything!'",
+    ),
     kind(
         "kulikov.raster",
         "conservative software rasterizer into a 3-layer 32-bit visibility atlas plus additive coverage",
@@ -95,7 +123,11 @@ pub static KINDS: &[PassKind] = &[
         "Lipp §3.3, Appendix B Code 2",
     ),
     // Scheuermann 2004, ATI: polygonal hair, the baseline.
-    kind("scheuermann.sort", "approximate back-to-front sort of hair patches", "Scheuermann 2004, 'Approximate depth sorting'"),
+    kind(
+        "scheuermann.sort",
+        "approximate back-to-front sort of hair patches",
+        "Scheuermann 2004, 'Approximate depth sorting'",
+    ),
     kind(
         "scheuermann.draw",
         "Kajiya-Kay/Marschner-mix shading of hair polygons; opaque, back-facing and front-facing passes",

@@ -44,7 +44,11 @@ mod tests {
         assert_eq!(before, names.len(), "duplicate pass kind");
         for k in KINDS {
             assert!(k.name.contains('.'), "{} has no pipeline prefix", k.name);
-            assert!(!k.source.is_empty() && !k.summary.is_empty(), "{} is undocumented", k.name);
+            assert!(
+                !k.source.is_empty() && !k.summary.is_empty(),
+                "{} is undocumented",
+                k.name
+            );
         }
     }
 
@@ -59,6 +63,9 @@ mod tests {
                 seen += 1;
             }
         }
-        assert!(seen >= 2, "expected the kulikov and lipp graphs, found {seen}");
+        assert!(
+            seen >= 2,
+            "expected the kulikov and lipp graphs, found {seen}"
+        );
     }
 }
