@@ -11,7 +11,10 @@ fn compile_benches(c: &mut Criterion) {
     let text = Spec::random(1000, 42).to_ron();
     let kinds = Spec::kinds();
     c.bench_function("compile/synthetic_1000_passes", |b| {
-        b.iter(|| compile_str("synthetic.ron", black_box(&text), &kinds).expect("synthetic graph compiles"))
+        b.iter(|| {
+            compile_str("synthetic.ron", black_box(&text), &kinds)
+                .expect("synthetic graph compiles")
+        })
     });
     let plan = compile_str("synthetic.ron", &text, &kinds).expect("synthetic graph compiles");
     let q = Quantities::example();
@@ -22,7 +25,10 @@ fn compile_benches(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/graphs/kulikov.ron");
     let kulikov = std::fs::read_to_string(path).expect("kulikov.ron is shipped");
     c.bench_function("compile/kulikov", |b| {
-        b.iter(|| compile_str(path, black_box(&kulikov), &strandgraph_passes::Registry).expect("kulikov compiles"))
+        b.iter(|| {
+            compile_str(path, black_box(&kulikov), &strandgraph_passes::Registry)
+                .expect("kulikov compiles")
+        })
     });
 }
 

@@ -29,7 +29,11 @@ pub fn run(args: Args) -> Result<()> {
     let plan = compile_file(&args.file, &Registry)?;
     let quantities = quantities(&args.set)?;
     let instance = plan.instantiate(&quantities)?;
-    tracing::info!(passes = plan.order.len(), sync_points = plan.sync_points.len(), "compiled");
+    tracing::info!(
+        passes = plan.order.len(),
+        sync_points = plan.sync_points.len(),
+        "compiled"
+    );
     if !args.quiet {
         print!("{}", report::render(&plan, Some(&instance)));
     }
@@ -47,7 +51,9 @@ fn write_out(path: &PathBuf, text: &str) -> Result<()> {
         print!("{text}");
         return Ok(());
     }
-    std::fs::write(path, text).into_diagnostic().wrap_err_with(|| format!("writing {}", path.display()))
+    std::fs::write(path, text)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("writing {}", path.display()))
 }
 
 fn quantities(pairs: &[String]) -> Result<Quantities> {
@@ -56,7 +62,10 @@ fn quantities(pairs: &[String]) -> Result<Quantities> {
         let (name, value) = pair
             .split_once('=')
             .ok_or_else(|| miette::miette!("--set {pair}: expected NAME=VALUE"))?;
-        let v: u64 = value.trim().parse().map_err(|e| miette::miette!("--set {pair}: {e}"))?;
+        let v: u64 = value
+            .trim()
+            .parse()
+            .map_err(|e| miette::miette!("--set {pair}: {e}"))?;
         let small = || u32::try_from(v).map_err(|_| miette::miette!("--set {pair}: too large"));
         match name.trim() {
             "strands" => q.strands = v,

@@ -19,7 +19,11 @@ fn stdout(o: &Output) -> String {
 #[test]
 fn kulikov_plan_shows_async_compute_sync_points_and_memory() {
     let out = strandgraph(&["graph", "scenes/graphs/kulikov.ron"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = stdout(&out);
     for expected in [
         "async-compute  clear_cull",
@@ -36,16 +40,29 @@ fn kulikov_plan_shows_async_compute_sync_points_and_memory() {
 
 #[test]
 fn every_shipped_graph_compiles_through_the_cli() {
-    for entry in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/graphs")).unwrap() {
+    for entry in
+        std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/graphs")).unwrap()
+    {
         let path = entry.unwrap().path();
         let out = strandgraph(&["graph", "--quiet", path.to_str().unwrap()]);
-        assert!(out.status.success(), "{}: {}", path.display(), String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}: {}",
+            path.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
 }
 
 #[test]
 fn dot_export_renders_with_graphviz() {
-    let out = strandgraph(&["graph", "--quiet", "--dot", "-", "scenes/graphs/kulikov.ron"]);
+    let out = strandgraph(&[
+        "graph",
+        "--quiet",
+        "--dot",
+        "-",
+        "scenes/graphs/kulikov.ron",
+    ]);
     assert!(out.status.success());
     let dot = stdout(&out);
     assert!(dot.starts_with("digraph \"kulikov\""));
@@ -55,25 +72,57 @@ fn dot_export_renders_with_graphviz() {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("Graphviz `dot` must be installed to check the DOT export (apt-get install graphviz)");
+        .expect(
+            "Graphviz `dot` must be installed to check the DOT export (apt-get install graphviz)",
+        );
     use std::io::Write;
-    child.stdin.take().unwrap().write_all(dot.as_bytes()).unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(dot.as_bytes())
+        .unwrap();
     let rendered = child.wait_with_output().unwrap();
-    assert!(rendered.status.success(), "dot rejected the export: {}", String::from_utf8_lossy(&rendered.stderr));
+    assert!(
+        rendered.status.success(),
+        "dot rejected the export: {}",
+        String::from_utf8_lossy(&rendered.stderr)
+    );
     let svg = String::from_utf8_lossy(&rendered.stdout);
-    assert!(svg.contains("<svg") && svg.contains("raster"), "unexpected SVG");
+    assert!(
+        svg.contains("<svg") && svg.contains("raster"),
+        "unexpected SVG"
+    );
 }
 
 #[test]
 fn json_export_holds_plan_and_memory() {
-    let out = strandgraph(&["graph", "--quiet", "--json", "-", "--set", "width=1280", "--set", "height=720", "scenes/graphs/lipp.ron"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = strandgraph(&[
+        "graph",
+        "--quiet",
+        "--json",
+        "-",
+        "--set",
+        "width=1280",
+        "--set",
+        "height=720",
+        "scenes/graphs/lipp.ron",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
     assert_eq!(v["plan"]["name"], "lipp");
     assert!(!v["plan"]["sync_points"].as_array().unwrap().is_empty());
     assert_eq!(v["instance"]["quantities"]["width"], 1280);
-    let with = v["instance"]["memory"]["bytes_with_aliasing"].as_u64().unwrap();
-    let without = v["instance"]["memory"]["bytes_without_aliasing"].as_u64().unwrap();
+    let with = v["instance"]["memory"]["bytes_with_aliasing"]
+        .as_u64()
+        .unwrap();
+    let without = v["instance"]["memory"]["bytes_without_aliasing"]
+        .as_u64()
+        .unwrap();
     assert!(with > 0 && with <= without + 4096, "{with} vs {without}");
 }
 
