@@ -2,13 +2,19 @@
 
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::PathBuf;
+use strandgraph_assets::{Scene, SceneCounts};
 use strandgraph_graph::{Quantities, compile_file, export, report};
 use strandgraph_passes::Registry;
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// The graph file (RON), e.g. scenes/graphs/kulikov.ron.
-    pub file: PathBuf,
+    /// The graph file (RON), e.g. scenes/graphs/kulikov.ron. Defaults to the
+    /// graph named by `--scene`.
+    #[arg(required_unless_present = "scene")]
+    pub file: Option<PathBuf>,
+    /// Size resources for this scene's strands, vertices, meshes, lights and resolution.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
     /// Write the plan as Graphviz DOT to this file (`-` for stdout).
     #[arg(long)]
     pub dot: Option<PathBuf>,
@@ -26,8 +32,20 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let plan = compile_file(&args.file, &Registry)?;
-    let quantities = quantities(&args.set)?;
+    let scene = match &args.scene {
+        Some(path) => Some(Scene::load(path).map_err(|e| miette::miette!("{e}"))?),
+        None => None,
+    };
+    let file = match (&args.file, &scene) {
+        (Some(file), _) => file.clone(),
+        (None, Some(scene)) => scene.graph.clone(),
+        (None, None) => return Err(miette::miette!("give a graph file or --scene")),
+    };
+    let plan = compile_file(&file, &Registry)?;
+    let base = scene
+        .as_ref()
+        .map_or_else(Quantities::example, |s| from_scene(s.counts()));
+    let quantities = quantities(base, &args.set)?;
     let instance = plan.instantiate(&quantities)?;
     tracing::info!(
         passes = plan.order.len(),
@@ -56,8 +74,21 @@ fn write_out(path: &PathBuf, text: &str) -> Result<()> {
         .wrap_err_with(|| format!("writing {}", path.display()))
 }
 
-fn quantities(pairs: &[String]) -> Result<Quantities> {
-    let mut q = Quantities::example();
+fn from_scene(c: SceneCounts) -> Quantities {
+    Quantities {
+        strands: c.strands,
+        vertices: c.vertices,
+        segments: c.segments,
+        bundles: c.bundles,
+        models: c.models,
+        triangles: c.triangles,
+        lights: c.lights,
+        width: c.width,
+        height: c.height,
+    }
+}
+
+fn quantities(mut q: Quantities, pairs: &[String]) -> Result<Quantities> {
     for pair in pairs {
         let (name, value) = pair
             .split_once('=')

@@ -150,3 +150,27 @@ fn missing_file_exits_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("does/not/exist.ron"));
 }
+
+#[test]
+fn scene_sizes_the_plan_and_supplies_the_graph() {
+    let out = strandgraph(&["graph", "--scene", "scenes/showcase.ron"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = stdout(&out);
+    assert!(
+        text.contains("graph `kulikov`"),
+        "showcase runs the Kulikov graph:\n{text}"
+    );
+    // Sizes come from the scene, not the built-in example.
+    let example = stdout(&strandgraph(&["graph", "scenes/graphs/kulikov.ron"]));
+    let mem = |t: &str| {
+        t.lines()
+            .find(|l| l.starts_with("Memory for"))
+            .unwrap_or("")
+            .to_string()
+    };
+    assert_ne!(mem(&text), mem(&example));
+}
