@@ -49,13 +49,25 @@ impl TfxArrays {
         )?;
         let points = self.strands * self.per_strand;
         let arrays = [
-            (self.positions, points, self.position_size, true),
-            (self.strand_uv, self.strands, 8, false),
-            (self.vertex_uv, points, 8, false),
-            (self.strand_thickness, self.strands, 4, false),
-            (self.vertex_color, points, 16, false),
+            (
+                "vertex positions",
+                self.positions,
+                points,
+                self.position_size,
+                true,
+            ),
+            ("strand UVs", self.strand_uv, self.strands, 8, false),
+            ("vertex UVs", self.vertex_uv, points, 8, false),
+            (
+                "strand thicknesses",
+                self.strand_thickness,
+                self.strands,
+                4,
+                false,
+            ),
+            ("vertex colours", self.vertex_color, points, 16, false),
         ];
-        for ((field_off, at), count, size, required) in arrays {
+        for (name, (field_off, at), count, size, required) in arrays {
             if at == 0 && !required {
                 continue;
             }
@@ -68,7 +80,7 @@ impl TfxArrays {
                     )),
                 ));
             }
-            r.check_array(field_off, "array size", at, count, size)?;
+            r.check_array(field_off, name, at, count, size)?;
         }
         let (s, n) = (self.strands as usize, self.per_strand as usize);
         let p = s * n;
