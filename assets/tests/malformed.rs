@@ -261,6 +261,11 @@ fn inconsistent_headers_are_rejected() {
     let e = tfx2::parse(t.as_bytes()).unwrap_err();
     assert!(matches!(e.kind, FormatErrorKind::Syntax(_)), "{e}");
     assert!(matches!(e.location, Location::LineCol(12, _)), "{e}");
+    // OBJ face texcoord and normal indices out of range.
+    let e = obj::parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/5 2/1 3/1\n").unwrap_err();
+    assert_eq!(e.location, Location::LineCol(5, 3), "{e}");
+    let e = obj::parse(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//9 2//1 3//1\n").unwrap_err();
+    assert_eq!(e.location, Location::LineCol(4, 3), "{e}");
     // OBJ face with two vertices.
     let e = obj::parse(b"v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err();
     assert_eq!(e.location, Location::Line(3), "{e}");

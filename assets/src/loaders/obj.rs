@@ -9,6 +9,8 @@ use crate::mesh::TriMesh;
 /// Scans `v` and `f` lines for unparsable or non-finite numbers and out-of-range indices.
 fn prescan(text: &str) -> Result<(), FormatError> {
     let mut vertices: i64 = 0;
+    let mut texcoords: i64 = 0;
+    let mut normals: i64 = 0;
     for (i, line) in text.lines().enumerate() {
         let ln = i + 1;
         let col = |t: &str| t.as_ptr() as usize - line.as_ptr() as usize + 1;
@@ -40,25 +42,37 @@ fn prescan(text: &str) -> Result<(), FormatError> {
                 }
                 vertices += 1;
             }
+            Some("vt") => texcoords += 1,
+            Some("vn") => normals += 1,
             Some("f") => {
                 let mut n = 0;
                 for t in toks {
                     n += 1;
-                    let idx = t.split('/').next().unwrap_or("");
-                    let v: i64 = idx.parse().map_err(|_| {
-                        FormatError::syntax(
-                            Location::LineCol(ln, col(t)),
-                            format!("face vertex {t:?} is not an index"),
-                        )
-                    })?;
-                    let resolved = if v < 0 { vertices + v } else { v - 1 };
-                    if v == 0 || resolved < 0 || resolved >= vertices {
-                        return Err(FormatError::new(
-                            Location::LineCol(ln, col(t)),
-                            FormatErrorKind::Inconsistent(format!(
-                                "face index {v} is out of range: {vertices} vertices so far"
-                            )),
-                        ));
+                    // v, v/vt, v//vn or v/vt/vn; the vertex index is required.
+                    for (k, idx) in t.split('/').enumerate() {
+                        if k > 0 && idx.is_empty() {
+                            continue;
+                        }
+                        let (what, count) = match k {
+                            0 => ("vertex", vertices),
+                            1 => ("texcoord", texcoords),
+                            _ => ("normal", normals),
+                        };
+                        let v: i64 = idx.parse().map_err(|_| {
+                            FormatError::syntax(
+                                Location::LineCol(ln, col(t)),
+                                format!("face vertex {t:?} has a bad {what} index"),
+                            )
+                        })?;
+                        let resolved = if v < 0 { count + v } else { v - 1 };
+                        if k > 2 || v == 0 || resolved < 0 || resolved >= count {
+                            return Err(FormatError::new(
+                                Location::LineCol(ln, col(t)),
+                                FormatErrorKind::Inconsistent(format!(
+                                    "face {what} index {v} is out of range: {count} so far"
+                                )),
+                            ));
+                        }
                     }
                 }
                 if n < 3 {
