@@ -17,7 +17,7 @@ use crate::transform::Transform;
 
 pub use strandgen::StrandStyle;
 
-/// One layer of a bundle: a quad. Corner k has (u, v) = [(0,0), (1,0), (1,1), (0,1)][k].
+/// One layer of a bundle: a quad. Corner k has (u, v) = `[(0,0), (1,0), (1,1), (0,1)][k]`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Layer {

@@ -1,8 +1,8 @@
 //! TressFX 3 binary layout: a 296-byte header (f32 version, u32 numGuideHairStrands,
 //! u32 numVerticesPerStrand, u32 numFollowHairsPerGuideHair, u32 bothEndsImmovable,
-//! u32 reserved1[31], then at byte 144 the offsets of vertices, per-strand thickness,
+//! `u32 reserved1[31]`, then at byte 144 the offsets of vertices, per-strand thickness,
 //! per-strand texcoords, per-vertex colours, guide-strand data and per-vertex texcoords,
-//! u32 reserved2[32]); positions are float3.
+//! `u32 reserved2[32]`); positions are float3.
 
 use super::reader::Reader;
 use super::tfx4::{TfxArrays, check_version};

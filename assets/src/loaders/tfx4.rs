@@ -1,6 +1,6 @@
 //! TressFX 4 binary layout: a 160-byte header (f32 version, u32 numHairStrands,
 //! u32 numVerticesPerStrand, u32 offsets of positions, strand UVs, vertex UVs, strand
-//! thickness and vertex colours, 0 = absent; u32 reserved[32]), positions as float4
+//! thickness and vertex colours, 0 = absent; `u32 reserved[32]`), positions as float4
 //! (w = inverse mass).
 
 use glam::{Vec2, Vec3};

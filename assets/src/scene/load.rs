@@ -286,7 +286,7 @@ fn load_groom(
         hair_mesh = Some(HairMesh::fit(&groom, hm));
     }
     // Kulikov: a stable randomized strand order, so LOD draws a prefix.
-    if g.lod.enabled && hair_mesh.is_none() {
+    if g.lod.enabled {
         let order = groom.shuffled_order(g.lod.shuffle_seed);
         groom = groom.reordered(&order);
         if let Some(s) = skinning.as_mut() {
