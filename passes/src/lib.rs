@@ -8,9 +8,17 @@
 //! paper specifies it, so `strandgraph graph` can show where a pass comes from.
 
 mod catalogue;
+pub mod common;
+pub mod contract;
+pub mod sim;
 
 pub use catalogue::{KINDS, PassKind};
+pub use contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use strandgraph_graph::PassRegistry;
+
+/// Pass kinds that have kernels so far. A kind listed in [`KINDS`] but not
+/// here compiles in graphs; backends refuse to run it and say so.
+static DEFINITIONS: &[&dyn PassDef] = &[&common::clear::Clear];
 
 /// The built-in pass kinds.
 #[derive(Debug, Clone, Copy, Default)]
@@ -19,6 +27,18 @@ pub struct Registry;
 impl Registry {
     pub fn get(&self, kind: &str) -> Option<&'static PassKind> {
         KINDS.iter().find(|k| k.name == kind)
+    }
+}
+
+/// Where backends look up pass definitions; tests supply their own.
+pub trait Definitions: Sync {
+    /// The definition (interface, dispatch, kernels) of `kind`, if it has one yet.
+    fn definition(&self, kind: &str) -> Option<&dyn PassDef>;
+}
+
+impl Definitions for Registry {
+    fn definition(&self, kind: &str) -> Option<&dyn PassDef> {
+        DEFINITIONS.iter().copied().find(|d| d.kind() == kind)
     }
 }
 
@@ -48,6 +68,26 @@ mod tests {
                 !k.source.is_empty() && !k.summary.is_empty(),
                 "{} is undocumented",
                 k.name
+            );
+        }
+    }
+
+    #[test]
+    fn every_definition_is_in_the_catalogue() {
+        for d in DEFINITIONS {
+            assert!(
+                Registry.get(d.kind()).is_some(),
+                "{} is defined but not catalogued",
+                d.kind()
+            );
+            let wgsl = concat!(env!("CARGO_MANIFEST_DIR"), "/../shaders/");
+            let path = std::path::Path::new(wgsl).join(d.shader().file);
+            let text = std::fs::read_to_string(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(
+                text.contains(&format!("fn {}(", d.shader().entry)),
+                "{} lacks entry point",
+                path.display()
             );
         }
     }

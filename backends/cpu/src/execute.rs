@@ -1,0 +1,320 @@
+//! Running a plan: one thread per queue lane, sync points as timeline waits,
+//! workgroups in parallel.
+
+use crate::memory::{Inputs, Memory};
+use crate::timeline::{Timeline, WaitError};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use strandgraph_graph::resolve::PassId;
+use strandgraph_graph::{Instance, Plan, Queue};
+use strandgraph_passes::sim::{CounterValues, Counters, Ctx, Words};
+use strandgraph_passes::{CpuKernel, Definitions, Dispatch, PassDef, Registry};
+
+#[derive(Debug, thiserror::Error)]
+pub enum CpuError {
+    #[error("pass `{pass}`: kind `{kind}` has no CPU kernel yet")]
+    NoKernel { pass: String, kind: String },
+    #[error("pass `{pass}`: kind `{kind}` binds `{binding}`, which the graph does not give it")]
+    MissingBinding {
+        pass: String,
+        kind: String,
+        binding: String,
+    },
+    #[error(transparent)]
+    Param(#[from] strandgraph_passes::ParamError),
+    #[error("input `{resource}`: {message}")]
+    Input { resource: String, message: String },
+    #[error("pass `{pass}` waited {seconds} s for {queue} to signal {value}: sync deadlock")]
+    SyncTimeout {
+        pass: String,
+        queue: Queue,
+        value: u64,
+        seconds: u64,
+    },
+    #[error("pass `{pass}`: kernel panicked: {message}")]
+    KernelPanic { pass: String, message: String },
+}
+
+/// How the simulator runs.
+#[derive(Debug, Clone)]
+pub struct CpuBackend {
+    /// Emulated subgroup width (32 as on NVIDIA; lavapipe has 8).
+    pub subgroup_width: u32,
+    pub instrument: bool,
+    /// Place transients at the plan's aliasing offsets (off: separate ranges).
+    pub alias: bool,
+    /// How long a queue may wait at a sync point before the frame fails.
+    pub sync_timeout: Duration,
+}
+
+impl Default for CpuBackend {
+    fn default() -> Self {
+        Self {
+            subgroup_width: 32,
+            instrument: false,
+            alias: true,
+            sync_timeout: Duration::from_secs(120),
+        }
+    }
+}
+
+/// One pass's wall time on its queue thread, and its counters.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PassTiming {
+    pub pass: PassId,
+    pub name: String,
+    pub queue: Queue,
+    pub workgroups: u32,
+    pub millis: f64,
+    pub counters: CounterValues,
+}
+
+/// A finished frame: its memory, to read back, and per-pass timings in plan order.
+pub struct Frame {
+    pub memory: Memory,
+    pub timings: Vec<PassTiming>,
+}
+
+impl Frame {
+    pub fn read(&self, plan: &Plan, resource: &str) -> Option<Vec<u32>> {
+        self.memory.read(plan, resource)
+    }
+}
+
+struct Prepared<'d> {
+    kernel: Box<dyn CpuKernel>,
+    def: &'d dyn PassDef,
+    /// Binding name → resource id.
+    bindings: Vec<(String, usize)>,
+}
+
+impl CpuBackend {
+    /// Runs one frame with the built-in pass definitions.
+    pub fn execute(
+        &self,
+        plan: &Plan,
+        instance: &Instance,
+        inputs: &Inputs,
+    ) -> Result<Frame, CpuError> {
+        self.execute_with(&Registry, plan, instance, inputs)
+    }
+
+    /// Runs one frame, looking pass kinds up in `defs`.
+    pub fn execute_with(
+        &self,
+        defs: &dyn Definitions,
+        plan: &Plan,
+        instance: &Instance,
+        inputs: &Inputs,
+    ) -> Result<Frame, CpuError> {
+        let prepared = self.prepare(defs, plan)?;
+        let memory = Memory::new(plan, instance, inputs, self.alias)?;
+        let timelines: HashMap<Queue, Timeline> = plan
+            .lanes
+            .iter()
+            .map(|l| (l.queue, Timeline::default()))
+            .collect();
+        let abort = AtomicBool::new(false);
+        let failure: Mutex<Option<CpuError>> = Mutex::new(None);
+        let timings: Mutex<Vec<PassTiming>> = Mutex::new(Vec::new());
+
+        std::thread::scope(|scope| {
+            for lane in &plan.lanes {
+                let (memory, prepared, timelines, abort, failure, timings) =
+                    (&memory, &prepared, &timelines, &abort, &failure, &timings);
+                scope.spawn(move || {
+                    for (i, &p) in lane.passes.iter().enumerate() {
+                        if abort.load(Ordering::Relaxed) {
+                            return;
+                        }
+                        let result = self
+                            .wait_for(plan, p, timelines, abort)
+                            .and_then(|()| self.run_pass(plan, instance, p, &prepared[&p], memory));
+                        match result {
+                            Ok(t) => timings.lock().unwrap_or_else(|e| e.into_inner()).push(t),
+                            Err(e) => {
+                                failure
+                                    .lock()
+                                    .unwrap_or_else(|e| e.into_inner())
+                                    .get_or_insert(e);
+                                abort.store(true, Ordering::Relaxed);
+                                timelines.values().for_each(Timeline::wake);
+                                return;
+                            }
+                        }
+                        timelines[&lane.queue].signal(i as u64 + 1);
+                    }
+                });
+            }
+        });
+        if let Some(e) = failure.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            return Err(e);
+        }
+        let mut timings = timings.into_inner().unwrap_or_else(|e| e.into_inner());
+        timings.sort_by_key(|t| plan.position(t.pass));
+        Ok(Frame { memory, timings })
+    }
+
+    /// Looks up every live pass's definition, binds it and builds its kernel.
+    fn prepare<'d>(
+        &self,
+        defs: &'d dyn Definitions,
+        plan: &Plan,
+    ) -> Result<HashMap<PassId, Prepared<'d>>, CpuError> {
+        let g = &plan.graph;
+        let mut out = HashMap::new();
+        for &p in &plan.order {
+            let pass = &g.passes[p];
+            let def = defs
+                .definition(&pass.kind)
+                .ok_or_else(|| CpuError::NoKernel {
+                    pass: pass.name.clone(),
+                    kind: pass.kind.clone(),
+                })?;
+            let given: Vec<(String, usize)> = pass
+                .accesses
+                .iter()
+                .map(|a| (g.resources[a.resource].name.clone(), a.resource))
+                .collect();
+            let bindings = match def.bindings() {
+                None => pass
+                    .accesses
+                    .iter()
+                    .filter(|a| a.mode.writes())
+                    .map(|a| (g.resources[a.resource].name.clone(), a.resource))
+                    .collect(),
+                Some(wanted) => wanted
+                    .iter()
+                    .map(|b| {
+                        given
+                            .iter()
+                            .find(|(n, _)| n == b.name)
+                            .cloned()
+                            .ok_or_else(|| CpuError::MissingBinding {
+                                pass: pass.name.clone(),
+                                kind: pass.kind.clone(),
+                                binding: b.name.to_string(),
+                            })
+                    })
+                    .collect::<Result<_, _>>()?,
+            };
+            let kernel = def.cpu_kernel(&pass.params)?;
+            out.insert(
+                p,
+                Prepared {
+                    kernel,
+                    def,
+                    bindings,
+                },
+            );
+        }
+        Ok(out)
+    }
+
+    fn wait_for(
+        &self,
+        plan: &Plan,
+        p: PassId,
+        timelines: &HashMap<Queue, Timeline>,
+        abort: &AtomicBool,
+    ) -> Result<(), CpuError> {
+        for s in plan.sync_points.iter().filter(|s| s.before == p) {
+            let waited = timelines[&s.signal_queue]
+                .wait(s.value, self.sync_timeout, || abort.load(Ordering::Relaxed));
+            match waited {
+                Ok(()) => {}
+                Err(WaitError::Aborted) => return Ok(()),
+                Err(WaitError::TimedOut) => {
+                    return Err(CpuError::SyncTimeout {
+                        pass: plan.pass_name(p).to_string(),
+                        queue: s.signal_queue,
+                        value: s.value,
+                        seconds: self.sync_timeout.as_secs(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn run_pass(
+        &self,
+        plan: &Plan,
+        instance: &Instance,
+        p: PassId,
+        prep: &Prepared<'_>,
+        memory: &Memory,
+    ) -> Result<PassTiming, CpuError> {
+        let pass = &plan.graph.passes[p];
+        let bindings: HashMap<&str, Words<'_>> = prep
+            .bindings
+            .iter()
+            .map(|(name, r)| {
+                (
+                    name.as_str(),
+                    Words::new(memory.words(plan, *r), &memory.out_of_bounds),
+                )
+            })
+            .collect();
+        let groups = match prep.def.dispatch() {
+            Dispatch::Fixed(n) => n,
+            Dispatch::PerElement {
+                quantity,
+                per_group,
+            } => u32::try_from(
+                instance
+                    .quantities
+                    .count(quantity)
+                    .div_ceil(u64::from(per_group.max(1))),
+            )
+            .unwrap_or(u32::MAX),
+            Dispatch::Indirect { binding, word } => {
+                bindings.get(binding).map_or(0, |w| w.load(word))
+            }
+            Dispatch::CoverWrites { words_per_group } => {
+                let most = bindings.values().map(Words::len).max().unwrap_or(0);
+                u32::try_from(most.div_ceil(words_per_group.max(1) as usize)).unwrap_or(u32::MAX)
+            }
+        };
+        let counters = Counters::default();
+        let ctx = Ctx {
+            bindings,
+            quantities: instance.quantities,
+            workgroups: groups,
+            workgroup_size: prep.def.workgroup_size(),
+            subgroup_width: self.subgroup_width,
+            instrument: self.instrument,
+            counters: &counters,
+        };
+        let start = Instant::now();
+        let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            (0..groups)
+                .into_par_iter()
+                .for_each(|g| prep.kernel.run_workgroup(g, &ctx));
+        }));
+        let millis = start.elapsed().as_secs_f64() * 1e3;
+        if let Err(panic) = run {
+            let message = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            return Err(CpuError::KernelPanic {
+                pass: pass.name.clone(),
+                message,
+            });
+        }
+        tracing::debug!(pass = %pass.name, groups, millis, "ran");
+        Ok(PassTiming {
+            pass: p,
+            name: pass.name.clone(),
+            queue: pass.queue,
+            workgroups: groups,
+            millis,
+            counters: counters.snapshot(),
+        })
+    }
+}

@@ -1,0 +1,139 @@
+//! Resource memory: one arena for transients (at the plan's offsets) and one
+//! allocation per imported or history resource.
+
+use crate::execute::CpuError;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU32, AtomicU64};
+use strandgraph_graph::alias::HeapKind;
+use strandgraph_graph::{Instance, LifetimeClass, Plan};
+
+/// Initial contents of imported and history resources, by resource name, as 32-bit words.
+#[derive(Debug, Default, Clone)]
+pub struct Inputs {
+    pub words: HashMap<String, Vec<u32>>,
+}
+
+impl Inputs {
+    pub fn set(&mut self, name: &str, words: Vec<u32>) {
+        self.words.insert(name.to_string(), words);
+    }
+}
+
+/// Where a declared resource's words are.
+#[derive(Debug, Clone, Copy)]
+enum Home {
+    /// Range of words in the transient arena.
+    Arena { start: usize, len: usize },
+    /// Index into the owned allocations.
+    Owned(usize),
+    /// Declared but used by no live pass.
+    Unused,
+}
+
+/// All memory of one frame.
+pub struct Memory {
+    arena: Vec<AtomicU32>,
+    owned: Vec<Vec<AtomicU32>>,
+    homes: Vec<Home>,
+    /// Counts out-of-range accesses of every kernel.
+    pub out_of_bounds: AtomicU64,
+    /// Bytes the arena holds (aliased or not).
+    pub arena_bytes: u64,
+}
+
+fn words_of(bytes: u64) -> usize {
+    bytes.div_ceil(4) as usize
+}
+
+impl Memory {
+    /// Lays out memory for `instance`. With `alias` false every transient
+    /// gets its own range, the reference the aliased layout is diffed against.
+    pub fn new(
+        plan: &Plan,
+        instance: &Instance,
+        inputs: &Inputs,
+        alias: bool,
+    ) -> Result<Memory, CpuError> {
+        let g = &plan.graph;
+        let mut homes = vec![Home::Unused; g.resources.len()];
+        // Heaps sit back to back in one arena: buffers, then images.
+        let mut heap_base: HashMap<HeapKind, u64> = HashMap::new();
+        let mut cursor = 0u64;
+        for h in &instance.memory.heaps {
+            heap_base.insert(h.heap, cursor);
+            cursor += h.bytes.next_multiple_of(4);
+        }
+        if alias {
+            for p in &instance.memory.placements {
+                let start = heap_base[&p.heap] + p.offset;
+                debug_assert_eq!(start % 4, 0, "placements are aligned");
+                homes[p.resource] = Home::Arena {
+                    start: (start / 4) as usize,
+                    len: words_of(p.size),
+                };
+            }
+        } else {
+            cursor = 0;
+            for p in &instance.memory.placements {
+                homes[p.resource] = Home::Arena {
+                    start: (cursor / 4) as usize,
+                    len: words_of(p.size),
+                };
+                cursor += p.size.next_multiple_of(256);
+            }
+        }
+        let arena_bytes = cursor;
+        let arena = (0..words_of(arena_bytes))
+            .map(|_| AtomicU32::new(0))
+            .collect();
+
+        let mut owned = Vec::new();
+        for (r, res) in g.resources.iter().enumerate() {
+            if res.version_of.is_some() || res.decl.lifetime() == LifetimeClass::Transient {
+                continue;
+            }
+            let len = words_of(instance.sizes[r].bytes);
+            let init = inputs.words.get(&res.name);
+            if let Some(w) = init
+                && w.len() > len
+            {
+                return Err(CpuError::Input {
+                    resource: res.name.clone(),
+                    message: format!("{} words given, the plan sizes it at {len}", w.len()),
+                });
+            }
+            let mut words: Vec<AtomicU32> =
+                init.map_or_else(Vec::new, |w| w.iter().map(|&x| AtomicU32::new(x)).collect());
+            words.resize_with(len, || AtomicU32::new(0));
+            homes[r] = Home::Owned(owned.len());
+            owned.push(words);
+        }
+        Ok(Memory {
+            arena,
+            owned,
+            homes,
+            out_of_bounds: AtomicU64::new(0),
+            arena_bytes,
+        })
+    }
+
+    /// The words of resource `r` (a version resolves to its resource's memory).
+    pub fn words(&self, plan: &Plan, r: usize) -> &[AtomicU32] {
+        match self.homes[plan.graph.physical(r)] {
+            Home::Arena { start, len } => &self.arena[start..start + len],
+            Home::Owned(i) => &self.owned[i],
+            Home::Unused => &[],
+        }
+    }
+
+    /// A copy of resource `name`'s words.
+    pub fn read(&self, plan: &Plan, name: &str) -> Option<Vec<u32>> {
+        let r = plan.graph.resource_id(name)?;
+        Some(
+            self.words(plan, r)
+                .iter()
+                .map(|w| w.load(std::sync::atomic::Ordering::Relaxed))
+                .collect(),
+        )
+    }
+}

@@ -1,0 +1,56 @@
+//! `common.clear`: fill every resource the pass writes with one 32-bit value.
+//!
+//! Atomic targets need it: `atomicMin` visibility buffers start at all-ones,
+//! `atomicAdd` counters at zero. (wgpu's `clear_buffer` only writes zeros,
+//! so the GPU backends run this as a compute pass; ash may use `vkCmdFillBuffer`.)
+
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::sim::Ctx;
+
+pub struct Clear;
+
+const GROUP: u32 = 256;
+
+impl PassDef for Clear {
+    fn kind(&self) -> &'static str {
+        "common.clear"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        None
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::CoverWrites {
+            words_per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "common/clear.wgsl",
+            entry: "clear",
+        }
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        Ok(Box::new(ClearKernel {
+            value: p.u32("value", 0)?,
+        }))
+    }
+}
+
+struct ClearKernel {
+    value: u32,
+}
+
+impl CpuKernel for ClearKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let start = group as usize * GROUP as usize;
+        for words in ctx.bindings.values() {
+            for i in start..(start + GROUP as usize).min(words.len()) {
+                words.store(i, self.value);
+            }
+        }
+    }
+}

@@ -1,0 +1,3 @@
+//! Passes every pipeline uses.
+
+pub mod clear;

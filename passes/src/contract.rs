@@ -1,0 +1,162 @@
+//! The pass contract: what every pass kind defines once, for every backend.
+//!
+//! A pass kind has an interface (named bindings that match the resource names
+//! its graph declares), parameters read from the graph's RON, a dispatch
+//! rule, a WGSL entry point for the GPU backends and a CPU kernel written per
+//! workgroup for the CPU simulator.
+
+use crate::sim::Ctx;
+use strandgraph_graph::schema::{AccessMode, Quantity};
+
+/// One resource a pass binds, by the name graph files give it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Binding {
+    pub name: &'static str,
+    pub mode: AccessMode,
+}
+
+/// How many workgroups a dispatch launches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dispatch {
+    /// A fixed count.
+    Fixed(u32),
+    /// One workgroup per `per_group` elements of a scene quantity.
+    PerElement { quantity: Quantity, per_group: u32 },
+    /// The count is the u32 of `binding` at word `word`, written by an earlier pass.
+    Indirect { binding: &'static str, word: usize },
+    /// One workgroup per `words_per_group` 32-bit words of the largest written binding.
+    CoverWrites { words_per_group: u32 },
+}
+
+/// A WGSL entry point in `shaders/`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shader {
+    /// Path under `shaders/`.
+    pub file: &'static str,
+    pub entry: &'static str,
+}
+
+/// A pass parameter that is missing, mistyped or out of range.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("pass kind `{kind}`: parameter `{param}`: {message}")]
+pub struct ParamError {
+    pub kind: &'static str,
+    pub param: String,
+    pub message: String,
+}
+
+/// A pass kind, defined once.
+pub trait PassDef: Send + Sync {
+    fn kind(&self) -> &'static str;
+    /// The bindings, or `None` when the pass binds whatever the graph gives it
+    /// (`common.clear` clears every resource it writes).
+    fn bindings(&self) -> Option<&'static [Binding]>;
+    fn workgroup_size(&self) -> u32;
+    fn dispatch(&self) -> Dispatch;
+    fn shader(&self) -> Shader;
+    /// Reads the graph's parameters and returns the CPU kernel configured by them.
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError>;
+}
+
+/// A kernel for the CPU simulator, run once per workgroup, workgroups in parallel.
+///
+/// Kernels see memory only through `ctx` (atomic words, as on a GPU) and use
+/// `ctx`'s subgroup emulation and counters, so results that are
+/// order-independent on a GPU are order-independent here too.
+pub trait CpuKernel: Send + Sync {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>);
+}
+
+/// Reads typed parameters out of a pass's RON map, with defaults.
+pub struct Params<'a> {
+    kind: &'static str,
+    map: Option<&'a ron::Map>,
+}
+
+impl<'a> Params<'a> {
+    pub fn new(kind: &'static str, value: &'a ron::Value) -> Result<Self, ParamError> {
+        match value {
+            ron::Value::Map(m) => Ok(Self { kind, map: Some(m) }),
+            ron::Value::Unit => Ok(Self { kind, map: None }),
+            _ => Err(ParamError {
+                kind,
+                param: "params".into(),
+                message: "expected a map".into(),
+            }),
+        }
+    }
+
+    fn get(&self, name: &str) -> Option<&'a ron::Value> {
+        self.map?.get(&ron::Value::String(name.to_string()))
+    }
+
+    fn error(&self, name: &str, message: impl Into<String>) -> ParamError {
+        ParamError {
+            kind: self.kind,
+            param: name.to_string(),
+            message: message.into(),
+        }
+    }
+
+    pub fn bool(&self, name: &str, default: bool) -> Result<bool, ParamError> {
+        match self.get(name) {
+            None => Ok(default),
+            Some(ron::Value::Bool(b)) => Ok(*b),
+            Some(v) => Err(self.error(name, format!("expected true or false, got {v:?}"))),
+        }
+    }
+
+    pub fn f32(&self, name: &str, default: f32) -> Result<f32, ParamError> {
+        match self.get(name) {
+            None => Ok(default),
+            Some(ron::Value::Number(n)) => Ok(n.into_f64() as f32),
+            Some(v) => Err(self.error(name, format!("expected a number, got {v:?}"))),
+        }
+    }
+
+    pub fn u32(&self, name: &str, default: u32) -> Result<u32, ParamError> {
+        match self.get(name) {
+            None => Ok(default),
+            Some(ron::Value::Number(n)) => {
+                let f = n.into_f64();
+                if f >= 0.0 && f <= f64::from(u32::MAX) && f.fract() == 0.0 {
+                    Ok(f as u32)
+                } else {
+                    Err(self.error(
+                        name,
+                        format!("expected a whole number in 0..=4294967295, got {f}"),
+                    ))
+                }
+            }
+            Some(v) => Err(self.error(name, format!("expected a number, got {v:?}"))),
+        }
+    }
+
+    pub fn string(&self, name: &str, default: &str) -> Result<String, ParamError> {
+        match self.get(name) {
+            None => Ok(default.to_string()),
+            Some(ron::Value::String(s)) => Ok(s.clone()),
+            Some(v) => Err(self.error(name, format!("expected a string, got {v:?}"))),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn typed_params_with_defaults_and_errors() {
+        let v: ron::Value =
+            ron::from_str(r#"{"a": true, "n": 64, "x": 0.5, "s": "Baked", "bad": -1}"#).unwrap();
+        let p = Params::new("test", &v).unwrap();
+        assert!(p.bool("a", false).unwrap());
+        assert!(p.bool("missing", true).unwrap());
+        assert_eq!(p.u32("n", 0).unwrap(), 64);
+        assert_eq!(p.f32("x", 0.0).unwrap(), 0.5);
+        assert_eq!(p.string("s", "").unwrap(), "Baked");
+        let e = p.u32("bad", 0).unwrap_err();
+        assert!(e.to_string().contains("`bad`"), "{e}");
+        assert!(p.bool("n", false).is_err());
+    }
+}
