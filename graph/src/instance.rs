@@ -8,7 +8,7 @@ use crate::schema::{BufferSize, ImageSize, Quantity, ResourceDecl};
 use serde::{Deserialize, Serialize};
 
 /// The scene quantities graph sizes refer to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct Quantities {
     pub strands: u64,
     pub vertices: u64,

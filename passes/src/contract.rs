@@ -64,6 +64,9 @@ pub trait PassDef: Send + Sync {
 /// `ctx`'s subgroup emulation and counters, so results that are
 /// order-independent on a GPU are order-independent here too.
 pub trait CpuKernel: Send + Sync {
+    /// Runs once before the workgroups, like a render pass's load op
+    /// (clearing attachments). Most kernels need nothing here.
+    fn prologue(&self, _ctx: &Ctx<'_>) {}
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>);
 }
 

@@ -10,7 +10,9 @@
 mod catalogue;
 pub mod common;
 pub mod contract;
+pub mod layout;
 pub mod sim;
+pub mod upload;
 
 pub use catalogue::{KINDS, PassKind};
 pub use contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};

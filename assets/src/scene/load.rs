@@ -34,6 +34,7 @@ pub struct SceneGroom {
     pub material: Material,
     pub lod: LodSettings,
     pub facial_hair: bool,
+    pub fedora: Option<super::Fedora>,
 }
 
 impl SceneGroom {
@@ -311,6 +312,7 @@ fn load_groom(
         material: g.material,
         lod: g.lod,
         facial_hair: g.facial_hair,
+        fedora: g.fedora,
     })
 }
 

@@ -150,6 +150,20 @@ pub struct GroomDesc {
     /// `HairMesh` source, generated procedurally.
     #[serde(default)]
     pub hair_mesh: Option<HairMeshParams>,
+    /// Kulikov's "fedora culling" shapes around a hat, in world space.
+    #[serde(default)]
+    pub fedora: Option<Fedora>,
+}
+
+/// Kulikov: segments inside the exclusion box are culled unless they are
+/// inside the inclusion sphere ("to accommodate area under fedora").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fedora {
+    pub box_min: [f32; 3],
+    pub box_max: [f32; 3],
+    pub sphere_center: [f32; 3],
+    pub sphere_radius: f32,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -291,6 +291,7 @@ impl CpuBackend {
         };
         let start = Instant::now();
         let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            prep.kernel.prologue(&ctx);
             (0..groups)
                 .into_par_iter()
                 .for_each(|g| prep.kernel.run_workgroup(g, &ctx));

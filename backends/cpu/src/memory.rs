@@ -7,17 +7,9 @@ use std::sync::atomic::{AtomicU32, AtomicU64};
 use strandgraph_graph::alias::HeapKind;
 use strandgraph_graph::{Instance, LifetimeClass, Plan};
 
-/// Initial contents of imported and history resources, by resource name, as 32-bit words.
-#[derive(Debug, Default, Clone)]
-pub struct Inputs {
-    pub words: HashMap<String, Vec<u32>>,
-}
-
-impl Inputs {
-    pub fn set(&mut self, name: &str, words: Vec<u32>) {
-        self.words.insert(name.to_string(), words);
-    }
-}
+/// Initial contents of imported and history resources, by resource name, as
+/// 32-bit words (what [`strandgraph_passes::upload::upload`] packs from a scene).
+pub type Inputs = strandgraph_passes::upload::Upload;
 
 /// Where a declared resource's words are.
 #[derive(Debug, Clone, Copy)]
@@ -93,7 +85,7 @@ impl Memory {
                 continue;
             }
             let len = words_of(instance.sizes[r].bytes);
-            let init = inputs.words.get(&res.name);
+            let init = inputs.resources.get(&res.name);
             if let Some(w) = init
                 && w.len() > len
             {

@@ -1,6 +1,7 @@
 //! What CPU kernels see: memory as atomic 32-bit words, emulated subgroups
 //! and instrumentation counters. The CPU backend builds a [`Ctx`] per pass.
 
+pub mod harness;
 pub mod subgroup;
 
 use std::collections::HashMap;

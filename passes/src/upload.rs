@@ -1,0 +1,251 @@
+//! Packs a loaded scene into the imported resources the graphs declare
+//! (`frame`, `models`, `lights`, `mesh.triangles`, `groom.*`), as 32-bit
+//! words every backend uploads unchanged.
+
+use crate::layout::{
+    FrameData, LightData, MODEL_FACIAL_HAIR, MODEL_LOD_ENABLED, ModelData, TriangleData, words_of,
+};
+use glam::{Mat4, Vec3};
+use std::collections::BTreeMap;
+use strandgraph_assets::Scene;
+use strandgraph_assets::scene::Light;
+use strandgraph_graph::Quantities;
+
+/// Near plane distance in metres; hair closer than this is clipped.
+pub const NEAR: f32 = 0.02;
+/// Far plane distance in metres.
+pub const FAR: f32 = 500.0;
+
+/// Imported resources by name, plus the quantities that size the plan.
+#[derive(Debug, Clone, Default)]
+pub struct Upload {
+    pub resources: BTreeMap<String, Vec<u32>>,
+    pub quantities: Quantities,
+    pub frame: Option<FrameData>,
+    pub models: Vec<ModelData>,
+}
+
+impl Upload {
+    pub fn set(&mut self, name: &str, words: Vec<u32>) {
+        self.resources.insert(name.to_string(), words);
+    }
+}
+
+/// Camera matrices for a scene at a resolution.
+pub fn frame(scene: &Scene, width: u32, height: u32, models: u32) -> FrameData {
+    let (eye, target, fov) = scene.desc.camera.eye_target_fov();
+    let (eye, target) = (Vec3::from(eye), Vec3::from(target));
+    let view = Mat4::look_at_rh(eye, target, Vec3::Y);
+    let proj = Mat4::perspective_rh(
+        fov.to_radians(),
+        width as f32 / height.max(1) as f32,
+        NEAR,
+        FAR,
+    );
+    let view_proj = proj * view;
+    FrameData {
+        view_proj: view_proj.to_cols_array(),
+        inv_view_proj: view_proj.inverse().to_cols_array(),
+        camera_pos: [eye.x, eye.y, eye.z, 1.0],
+        screen: [
+            width as f32,
+            height as f32,
+            1.0 / width as f32,
+            1.0 / height as f32,
+        ],
+        near: NEAR,
+        far: FAR,
+        model_count: models,
+        light_count: scene.desc.lights.len() as u32,
+        pixels_per_unit: proj.y_axis.y * height as f32 * 0.5,
+        _pad: [0; 19],
+    }
+}
+
+/// Packs `scene` for a `width`×`height` frame.
+pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
+    let mut up = Upload::default();
+    let mut vertices: Vec<[f32; 4]> = Vec::new();
+    let mut strands: Vec<[u32; 2]> = Vec::new();
+    let mut skinning: Vec<[u32; 4]> = Vec::new();
+    let mut models = Vec::new();
+    let mut triangles = Vec::new();
+    let mut triangle_first = Vec::new();
+    let mut segments = 0u64;
+
+    for (i, m) in scene.meshes.iter().enumerate() {
+        triangle_first.push(triangles.len() as u32);
+        let world = m.mesh.transform.matrix();
+        for t in 0..m.mesh.triangle_count() {
+            let [a, b, c] = m.mesh.corners(t).map(|p| world.transform_point3(p));
+            triangles.push(TriangleData {
+                a: [a.x, a.y, a.z, i as f32],
+                b: [b.x, b.y, b.z, 0.0],
+                c: [c.x, c.y, c.z, 0.0],
+            });
+        }
+    }
+
+    for g in &scene.grooms {
+        // The pipelines index segments as strand × (points − 1): resample
+        // grooms whose strands vary in length to the longest strand's count.
+        let resampled;
+        let groom = match g.groom.uniform_points_per_strand() {
+            Some(_) => &g.groom,
+            None => {
+                let n = (0..g.groom.strand_count())
+                    .map(|s| g.groom.strand_range(s).len())
+                    .max()
+                    .unwrap_or(2);
+                tracing::info!(groom = %g.name, points = n, "resampling strands to a uniform point count");
+                resampled = g.groom.resampled(n);
+                &resampled
+            }
+        };
+        let points = groom.uniform_points_per_strand().unwrap_or(2) as u32;
+        let bounds = g.world_bounds();
+        let mesh_rotation = g
+            .parent
+            .map_or(Mat4::IDENTITY, |p| scene.meshes[p].mesh.transform.matrix());
+        let rot = glam::Mat3::from_mat4(mesh_rotation);
+        let row = |r: usize| [rot.row(r).x, rot.row(r).y, rot.row(r).z, 0.0];
+        let color = g
+            .material
+            .color
+            .unwrap_or_else(|| melanin_color(g.material.melanin.unwrap_or(0.5)));
+        let fedora = g.fedora;
+        let skinned = g.parent.is_some()
+            && g.skinning
+                .as_ref()
+                .is_some_and(|s| s.len() == groom.strand_count());
+        models.push(ModelData {
+            world: g.world.to_cols_array(),
+            bounds_min: [bounds.min.x, bounds.min.y, bounds.min.z, 0.0],
+            bounds_max: [bounds.max.x, bounds.max.y, bounds.max.z, 0.0],
+            strand_first: strands.len() as u32,
+            strand_count: groom.strand_count() as u32,
+            points_per_strand: points,
+            vertex_first: vertices.len() as u32,
+            segment_first: segments as u32,
+            skinned: u32::from(skinned),
+            triangle_first: g.parent.map_or(0, |p| triangle_first[p]),
+            flags: if g.lod.enabled { MODEL_LOD_ENABLED } else { 0 }
+                | if g.facial_hair { MODEL_FACIAL_HAIR } else { 0 },
+            mesh_rotation: [row(0), row(1), row(2)],
+            color: [color[0], color[1], color[2], g.material.roughness],
+            fedora_min: fedora.map_or([0.0; 4], |f| {
+                [f.box_min[0], f.box_min[1], f.box_min[2], 1.0]
+            }),
+            fedora_max: fedora.map_or([0.0; 4], |f| {
+                [f.box_max[0], f.box_max[1], f.box_max[2], 0.0]
+            }),
+            fedora_sphere: fedora.map_or([0.0; 4], |f| {
+                [
+                    f.sphere_center[0],
+                    f.sphere_center[1],
+                    f.sphere_center[2],
+                    f.sphere_radius,
+                ]
+            }),
+            min_fraction: g.lod.min_fraction,
+            _pad: [0; 3],
+        });
+        segments += groom.strand_count() as u64 * u64::from(points - 1);
+        for s in 0..groom.strand_count() {
+            let range = groom.strand_range(s);
+            strands.push([vertices.len() as u32, range.len() as u32]);
+            for p in range {
+                let q = groom.positions[p];
+                vertices.push([q.x, q.y, q.z, groom.thickness[p]]);
+            }
+            let info = g
+                .skinning
+                .as_ref()
+                .filter(|_| skinned)
+                .and_then(|k| k.get(s));
+            skinning.push(info.map_or([0; 4], |k| {
+                [
+                    k.idx_triangle,
+                    k.barycentrics,
+                    k.triangle_normal,
+                    k.triangle_tangent,
+                ]
+            }));
+        }
+    }
+
+    let lights: Vec<LightData> = scene
+        .desc
+        .lights
+        .iter()
+        .map(|l| match *l {
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+            } => {
+                let d = Vec3::from(direction).normalize_or(Vec3::NEG_Y);
+                LightData {
+                    position_or_direction: [d.x, d.y, d.z, 0.0],
+                    radiance: [
+                        color[0] * intensity,
+                        color[1] * intensity,
+                        color[2] * intensity,
+                        0.0,
+                    ],
+                    _pad: [0; 8],
+                }
+            }
+            Light::Point {
+                position,
+                color,
+                intensity,
+            } => LightData {
+                position_or_direction: [position[0], position[1], position[2], 1.0],
+                radiance: [
+                    color[0] * intensity,
+                    color[1] * intensity,
+                    color[2] * intensity,
+                    0.0,
+                ],
+                _pad: [0; 8],
+            },
+        })
+        .collect();
+
+    let frame = frame(scene, width, height, models.len() as u32);
+    up.quantities = Quantities {
+        strands: strands.len() as u64,
+        vertices: vertices.len() as u64,
+        segments,
+        bundles: scene
+            .grooms
+            .iter()
+            .map(|g| g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64))
+            .sum(),
+        models: models.len() as u64,
+        triangles: triangles.len() as u64,
+        lights: lights.len() as u64,
+        width,
+        height,
+    };
+    up.set("frame", words_of(&[frame]));
+    up.set("models", words_of(&models));
+    up.set("lights", words_of(&lights));
+    up.set("mesh.triangles", words_of(&triangles));
+    up.set("groom.vertices", bytemuck::cast_slice(&vertices).to_vec());
+    up.set("groom.strands", bytemuck::cast_slice(&strands).to_vec());
+    up.set("groom.skinning", bytemuck::cast_slice(&skinning).to_vec());
+    up.frame = Some(frame);
+    up.models = models;
+    up
+}
+
+/// A display colour for a melanin concentration (0 blond … 1 black), for
+/// visualisations before the shading passes run.
+pub fn melanin_color(melanin: f32) -> [f32; 3] {
+    let m = melanin.clamp(0.0, 1.0);
+    let blond = [0.75, 0.55, 0.30];
+    let black = [0.04, 0.03, 0.02];
+    [0, 1, 2].map(|i| blond[i] + (black[i] - blond[i]) * m.powf(0.5))
+}
