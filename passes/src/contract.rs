@@ -28,12 +28,15 @@ pub enum Dispatch {
     CoverWrites { words_per_group: u32 },
 }
 
-/// A WGSL entry point in `shaders/`.
+/// WGSL entry points in `shaders/`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shader {
     /// Path under `shaders/`.
     pub file: &'static str,
+    /// The compute entry point, or the vertex entry point of a raster pass.
     pub entry: &'static str,
+    /// The fragment entry point of a raster pass (one with colour or depth attachments).
+    pub fragment: Option<&'static str>,
 }
 
 /// A pass parameter that is missing, mistyped or out of range.

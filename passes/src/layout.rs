@@ -73,13 +73,18 @@ pub struct LightData {
     pub _pad: [u32; 8],
 }
 
-/// `mesh.triangles`: three world-space corners; `a.w` holds the mesh index.
+/// `mesh.triangles`: three world-space corners (16 words). Each corner's `w`
+/// holds its smooth vertex normal, octahedral-packed (`pack_unit_vector`),
+/// as raw bits.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable)]
 pub struct TriangleData {
     pub a: [f32; 4],
     pub b: [f32; 4],
     pub c: [f32; 4],
+    /// Index of the mesh in the scene.
+    pub mesh: u32,
+    pub _pad: [u32; 3],
 }
 
 /// Words of a `Pod` value, for uploads.
@@ -103,6 +108,6 @@ mod tests {
         assert_eq!(std::mem::size_of::<FrameData>(), 256);
         assert_eq!(std::mem::size_of::<ModelData>(), 256);
         assert_eq!(std::mem::size_of::<LightData>(), 64);
-        assert_eq!(std::mem::size_of::<TriangleData>(), 48);
+        assert_eq!(std::mem::size_of::<TriangleData>(), 64);
     }
 }

@@ -8,6 +8,7 @@ use crate::layout::{
 use glam::{Mat4, Vec3};
 use std::collections::BTreeMap;
 use strandgraph_assets::Scene;
+use strandgraph_assets::octahedral::pack_unit_vector;
 use strandgraph_assets::scene::Light;
 use strandgraph_graph::Quantities;
 
@@ -76,12 +77,20 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
     for (i, m) in scene.meshes.iter().enumerate() {
         triangle_first.push(triangles.len() as u32);
         let world = m.mesh.transform.matrix();
-        for t in 0..m.mesh.triangle_count() {
+        let normal_matrix = glam::Mat3::from_mat4(world).inverse().transpose();
+        let normals = m.mesh.vertex_normals();
+        for (t, tri) in m.mesh.triangles.iter().enumerate() {
             let [a, b, c] = m.mesh.corners(t).map(|p| world.transform_point3(p));
+            let n = |k: usize| {
+                let v = normals.get(tri[k] as usize).copied().unwrap_or(Vec3::Y);
+                f32::from_bits(pack_unit_vector((normal_matrix * v).normalize_or(Vec3::Y)))
+            };
             triangles.push(TriangleData {
-                a: [a.x, a.y, a.z, i as f32],
-                b: [b.x, b.y, b.z, 0.0],
-                c: [c.x, c.y, c.z, 0.0],
+                a: [a.x, a.y, a.z, n(0)],
+                b: [b.x, b.y, b.z, n(1)],
+                c: [c.x, c.y, c.z, n(2)],
+                mesh: i as u32,
+                _pad: [0; 3],
             });
         }
     }

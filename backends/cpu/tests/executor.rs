@@ -35,6 +35,7 @@ fn shader() -> Shader {
     Shader {
         file: "test.wgsl",
         entry: "main",
+        fragment: None,
     }
 }
 

@@ -30,6 +30,7 @@ impl PassDef for Clear {
         Shader {
             file: "common/clear.wgsl",
             entry: "clear",
+            fragment: None,
         }
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
