@@ -11,6 +11,7 @@ mod catalogue;
 pub mod common;
 pub mod contract;
 pub mod layout;
+pub mod scene;
 pub mod sim;
 pub mod upload;
 
@@ -20,7 +21,10 @@ use strandgraph_graph::PassRegistry;
 
 /// Pass kinds that have kernels so far. A kind listed in [`KINDS`] but not
 /// here compiles in graphs; backends refuse to run it and say so.
-static DEFINITIONS: &[&dyn PassDef] = &[&common::clear::Clear];
+static DEFINITIONS: &[&dyn PassDef] = &[
+    &common::clear::Clear,
+    &scene::depth_prepass::DepthPrepass, &scene::opaque::Opaque,
+];
 
 /// The built-in pass kinds.
 #[derive(Debug, Clone, Copy, Default)]

@@ -1,0 +1,363 @@
+//! Triangle rasterization shared by `scene.depth_prepass` and `scene.opaque`.
+//!
+//! The CPU kernels must make the same coverage decisions as the GPU
+//! backends' hardware rasterizers, and the opaque pass must reproduce the
+//! prepass's depth bit for bit (it shades where depth is *equal*). So the
+//! rules here are the ones D3D11 and Vulkan specify for hardware:
+//!
+//! - corners snap to a fixed-point grid of 1/256 pixel (8 sub-pixel bits, the
+//!   usual `VkPhysicalDeviceLimits::subPixelPrecisionBits`; D3D11 functional
+//!   spec §15.5 "Fixed point rasterization" also uses 8 bits), and the edge
+//!   functions are evaluated exactly in integers;
+//! - coverage is sampled at pixel centres (+0.5, +0.5);
+//! - a centre exactly on an edge belongs to the triangle only when that edge
+//!   is a *top* or *left* edge (D3D11 §3.4.1 "Triangle Rasterization Rules
+//!   (Without Multisampling)"; Vulkan spec §28.7 "Polygons" / "Basic Polygon
+//!   Rasterization", the same rule). Adjacent triangles therefore cover each
+//!   pixel of their union exactly once;
+//! - depth (NDC z/w) is interpolated linearly in screen space, attributes
+//!   perspective-correctly (Vulkan §28.7.1 "Polygon Interpolation").
+//!
+//! Front faces are counter-clockwise in NDC (y up), the convention of glam's
+//! `perspective_rh` and wgpu's default `FrontFace::Ccw`.
+
+use glam::Vec4;
+
+/// Sub-pixel precision: corners snap to 1/2^8 pixel.
+pub const SUBPIXEL_BITS: u32 = 8;
+const ONE: i64 = 1 << SUBPIXEL_BITS;
+const HALF: i64 = ONE / 2;
+
+/// Corners farther than this (pixels) from the screen origin are outside the
+/// guard band: the triangle is dropped rather than risk overflow. With
+/// |coordinate| ≤ 2^28 sub-pixel units, edge functions stay below 2^60 in i64.
+/// Hardware clips such triangles instead; heads and bodies never reach it.
+pub const GUARD_BAND: f32 = 1_048_576.0;
+
+/// One covered pixel centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fragment {
+    pub x: u32,
+    pub y: u32,
+    /// NDC depth z/w, interpolated linearly in screen space.
+    pub depth: f32,
+    /// Screen-space barycentrics of the source corners a, b, c (sum to 1).
+    pub screen: [f32; 3],
+}
+
+/// A front-facing triangle ready to rasterize.
+#[derive(Debug, Clone, Copy)]
+pub struct Setup {
+    /// Snapped corners, reordered so that the signed area is positive.
+    x: [i64; 3],
+    y: [i64; 3],
+    /// Twice the signed area, in sub-pixel units squared (> 0).
+    area: i64,
+    /// 0 for a top or left edge, 1 otherwise: ties on other edges fail `E >= bias`.
+    /// Edge `i` is the one opposite vertex `i`.
+    bias: [i64; 3],
+    /// Which source corner (0 = a, 1 = b, 2 = c) each setup vertex is.
+    order: [usize; 3],
+    /// Per source corner: NDC depth and 1/w.
+    z: [f32; 3],
+    inv_w: [f32; 3],
+    /// Inclusive pixel bounds clipped to the screen: x0, y0, x1, y1.
+    bounds: [u32; 4],
+}
+
+impl Setup {
+    /// Sets up the triangle with clip-space corners `clip`, or `None` when it
+    /// is culled: a back face, degenerate after snapping, off screen, or with
+    /// a corner at or behind the near plane (w ≤ `near`). Dropping near-plane
+    /// crossers instead of clipping them is deliberate: heads never cross the
+    /// near plane in our scenes, and the WGSL vertex shaders drop them the same
+    /// way so every backend agrees.
+    pub fn from_clip(clip: [Vec4; 3], near: f32, width: u32, height: u32) -> Option<Self> {
+        let near = near.max(0.0);
+        let mut xy = [[0.0f32; 2]; 3];
+        let mut z = [0.0f32; 3];
+        let mut inv_w = [0.0f32; 3];
+        for (k, c) in clip.iter().enumerate() {
+            if c.w.is_nan() || c.w <= near {
+                return None;
+            }
+            let iw = 1.0 / c.w;
+            let ndc = [c.x * iw, c.y * iw];
+            // Viewport transform, y down (D3D/Vulkan/WebGPU framebuffer coordinates).
+            xy[k] = [
+                (ndc[0] * 0.5 + 0.5) * width as f32,
+                (0.5 - ndc[1] * 0.5) * height as f32,
+            ];
+            z[k] = c.z * iw;
+            inv_w[k] = iw;
+        }
+        Self::from_screen(xy, z, inv_w, width, height)
+    }
+
+    /// Sets up a triangle from screen positions (pixels, y down), per-corner
+    /// depth and 1/w. Culls back faces and degenerate triangles.
+    pub fn from_screen(
+        xy: [[f32; 2]; 3],
+        z: [f32; 3],
+        inv_w: [f32; 3],
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        let mut sx = [0i64; 3];
+        let mut sy = [0i64; 3];
+        for k in 0..3 {
+            let [x, y] = xy[k];
+            if !(x.abs() <= GUARD_BAND && y.abs() <= GUARD_BAND) {
+                return None;
+            }
+            // Round to the nearest 1/256 pixel (scaling by 2^8 is exact in f32).
+            sx[k] = (x * ONE as f32).round() as i64;
+            sy[k] = (y * ONE as f32).round() as i64;
+        }
+        // Twice the signed area in y-down coordinates: a triangle that is
+        // counter-clockwise in NDC (y up) comes out negative here. The winding
+        // is decided on the *snapped* corners so that every backend agrees.
+        let signed = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sy[1] - sy[0]) * (sx[2] - sx[0]);
+        if signed >= 0 {
+            return None; // back face or degenerate
+        }
+        // Swap b and c so the area is positive and interior edge functions are > 0.
+        let order = [0usize, 2, 1];
+        let x = order.map(|k| sx[k]);
+        let y = order.map(|k| sy[k]);
+        let bias = [0, 1, 2].map(|i| {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let (dx, dy) = (x[k] - x[j], y[k] - y[j]);
+            // With positive area and y down, the triangle lies to the right of
+            // each directed edge: a left edge goes up (dy < 0), a top edge is
+            // horizontal going right (dy == 0, dx > 0).
+            let top_left = dy < 0 || (dy == 0 && dx > 0);
+            i64::from(!top_left)
+        });
+        // Pixels whose centre (p + 0.5) lies within the snapped bounding box.
+        let lo = |v: i64| (v - HALF + ONE - 1).div_euclid(ONE);
+        let hi = |v: i64| (v - HALF).div_euclid(ONE);
+        let (x0, x1) = (lo(*x.iter().min()?).max(0), hi(*x.iter().max()?));
+        let (y0, y1) = (lo(*y.iter().min()?).max(0), hi(*y.iter().max()?));
+        let (x1, y1) = (x1.min(i64::from(width) - 1), y1.min(i64::from(height) - 1));
+        if x1 < x0 || y1 < y0 {
+            return None;
+        }
+        Some(Self {
+            x,
+            y,
+            area: -signed,
+            bias,
+            order,
+            z,
+            inv_w,
+            bounds: [x0 as u32, y0 as u32, x1 as u32, y1 as u32],
+        })
+    }
+
+    /// Inclusive pixel bounds clipped to the screen: x0, y0, x1, y1.
+    pub fn bounds(&self) -> [u32; 4] {
+        self.bounds
+    }
+
+    /// Edge function of the edge opposite vertex `i` at sub-pixel point (px, py).
+    fn edge(&self, i: usize, px: i64, py: i64) -> i64 {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        (self.x[k] - self.x[j]) * (py - self.y[j]) - (self.y[k] - self.y[j]) * (px - self.x[j])
+    }
+
+    /// Calls `f` for every covered pixel centre, row by row.
+    pub fn rasterize(&self, mut f: impl FnMut(Fragment)) {
+        let [x0, y0, x1, y1] = self.bounds;
+        let (px, py) = (i64::from(x0) * ONE + HALF, i64::from(y0) * ONE + HALF);
+        let mut row = [0, 1, 2].map(|i| self.edge(i, px, py));
+        // Exact integer steps, so stepping equals evaluating at every pixel.
+        let step_x = [0, 1, 2].map(|i| -(self.y[(i + 2) % 3] - self.y[(i + 1) % 3]) * ONE);
+        let step_y = [0, 1, 2].map(|i| (self.x[(i + 2) % 3] - self.x[(i + 1) % 3]) * ONE);
+        let area = self.area as f64;
+        for y in y0..=y1 {
+            let mut e = row;
+            for x in x0..=x1 {
+                if e.iter().zip(&self.bias).all(|(ei, b)| ei >= b) {
+                    let mut screen = [0.0f32; 3];
+                    let mut depth = 0.0f64;
+                    for (&ei, &src) in e.iter().zip(&self.order) {
+                        let w = ei as f64 / area;
+                        screen[src] = w as f32;
+                        depth += w * f64::from(self.z[src]);
+                    }
+                    f(Fragment {
+                        x,
+                        y,
+                        depth: depth as f32,
+                        screen,
+                    });
+                }
+                for (ei, s) in e.iter_mut().zip(step_x) {
+                    *ei += s;
+                }
+            }
+            for (r, s) in row.iter_mut().zip(step_y) {
+                *r += s;
+            }
+        }
+    }
+
+    /// Perspective-correct barycentrics of the source corners from screen-space
+    /// ones (what `@interpolate(perspective)` gives a fragment shader).
+    pub fn perspective(&self, screen: [f32; 3]) -> [f32; 3] {
+        let q = [0, 1, 2].map(|k| screen[k] * self.inv_w[k]);
+        let sum = q[0] + q[1] + q[2];
+        if sum > 0.0 {
+            q.map(|v| v / sum)
+        } else {
+            screen
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Covered pixel centres of a screen-space triangle (either winding).
+    fn cover(tri: [[f32; 2]; 3], w: u32, h: u32) -> Vec<(u32, u32)> {
+        let mut out = Vec::new();
+        for t in [tri, [tri[0], tri[2], tri[1]]] {
+            if let Some(s) = Setup::from_screen(t, [0.5; 3], [1.0; 3], w, h) {
+                s.rasterize(|f| out.push((f.x, f.y)));
+            }
+        }
+        out
+    }
+
+    fn area_and_perimeter(t: [[f32; 2]; 3]) -> (f32, f32) {
+        let d = |a: [f32; 2], b: [f32; 2]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt();
+        let cross =
+            (t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) - (t[1][1] - t[0][1]) * (t[2][0] - t[0][0]);
+        (
+            cross.abs() * 0.5,
+            d(t[0], t[1]) + d(t[1], t[2]) + d(t[2], t[0]),
+        )
+    }
+
+    #[test]
+    fn covered_pixels_match_the_analytic_area() {
+        // A small deterministic generator: no dependency for a few numbers.
+        let mut seed = 0x2545_f491_u32;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            (seed >> 8) as f32 / (1 << 24) as f32
+        };
+        for _ in 0..200 {
+            let tri = [0; 3].map(|_| [next() * 60.0 + 2.0, next() * 60.0 + 2.0]);
+            let (area, perimeter) = area_and_perimeter(tri);
+            let n = cover(tri, 64, 64).len() as f32;
+            // Pixels whose centre is covered differ from the area by at most
+            // the band of pixels the perimeter passes through.
+            assert!(
+                (n - area).abs() <= perimeter + 1.0,
+                "{tri:?}: {n} pixels, area {area}"
+            );
+        }
+        // An axis-aligned right triangle through pixel centres: exact count.
+        // Legs along x = 0.5 (left edge, kept) and y = 0.5 (top edge, kept);
+        // the hypotenuse is a right edge, so centres on it are dropped.
+        let n = cover([[0.5, 0.5], [10.5, 0.5], [0.5, 10.5]], 16, 16).len();
+        assert_eq!(n, (1..=10).sum::<usize>());
+    }
+
+    #[test]
+    fn triangles_sharing_edges_cover_every_pixel_once() {
+        let (w, h) = (24u32, 24u32);
+        // A fan of 8 triangles around a pixel centre, rim corners on pixel
+        // centres: every shared edge passes through pixel centres, and so does
+        // the hub, the worst case for the fill rule.
+        let hub = [12.5f32, 12.5];
+        let rim: [[f32; 2]; 8] = [
+            [2.5, 2.5],
+            [12.5, 0.5],
+            [22.5, 2.5],
+            [23.5, 12.5],
+            [22.5, 22.5],
+            [12.5, 23.5],
+            [2.5, 22.5],
+            [0.5, 12.5],
+        ];
+        let mut count = vec![0u32; (w * h) as usize];
+        for k in 0..8 {
+            for (x, y) in cover([hub, rim[k], rim[(k + 1) % 8]], w, h) {
+                count[(y * w + x) as usize] += 1;
+            }
+        }
+        // Every centre strictly inside the convex octagon is covered once,
+        // nothing is covered twice.
+        let inside = |p: [f32; 2]| {
+            (0..8).all(|k| {
+                let (a, b) = (rim[k], rim[(k + 1) % 8]);
+                // Clockwise on screen (y down) means the interior is to the right.
+                (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0.0
+            })
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let c = count[(y * w + x) as usize];
+                assert!(c <= 1, "pixel ({x}, {y}) covered {c} times");
+                if inside([x as f32 + 0.5, y as f32 + 0.5]) {
+                    assert_eq!(c, 1, "pixel ({x}, {y}) missed");
+                }
+            }
+        }
+        // Two triangles of a rectangle: the union is exactly the pixels
+        // whose centres lie in [0.5, 20.5) × [0.5, 10.5) (top and left kept).
+        let q = [[0.5f32, 0.5], [20.5, 0.5], [20.5, 10.5], [0.5, 10.5]];
+        let mut count = vec![0u32; (w * h) as usize];
+        for t in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            for (x, y) in cover(t, w, h) {
+                count[(y * w + x) as usize] += 1;
+            }
+        }
+        for y in 0..h {
+            for x in 0..w {
+                let expected = u32::from(x < 20 && y < 10);
+                assert_eq!(count[(y * w + x) as usize], expected, "({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn back_faces_and_degenerates_are_culled() {
+        // Rows grow downwards, so (1,1) → (9,1) → (1,9) turns clockwise as
+        // seen on the monitor: clockwise in NDC too, a back face.
+        let back = [[1.0f32, 1.0], [9.0, 1.0], [1.0, 9.0]];
+        let front = [back[0], back[2], back[1]];
+        assert!(Setup::from_screen(back, [0.5; 3], [1.0; 3], 16, 16).is_none());
+        assert!(Setup::from_screen(front, [0.5; 3], [1.0; 3], 16, 16).is_some());
+        let line = [[1.0f32, 1.0], [5.0, 5.0], [9.0, 9.0]];
+        assert!(Setup::from_screen(line, [0.5; 3], [1.0; 3], 16, 16).is_none());
+        let nan = [[f32::NAN, 1.0], [9.0, 1.0], [1.0, 9.0]];
+        assert!(Setup::from_screen(nan, [0.5; 3], [1.0; 3], 16, 16).is_none());
+        let offscreen = [[-9.0f32, -9.0], [-1.0, -9.0], [-9.0, -1.0]];
+        assert!(Setup::from_screen(offscreen, [0.5; 3], [1.0; 3], 16, 16).is_none());
+    }
+
+    #[test]
+    fn depth_interpolates_linearly_and_attributes_perspectively() {
+        let tri = [[0.5f32, 0.5], [0.5, 16.5], [16.5, 0.5]];
+        let s = Setup::from_screen(tri, [0.0, 1.0, 0.5], [1.0, 0.25, 1.0], 32, 32).unwrap();
+        let mut seen = 0;
+        s.rasterize(|f| {
+            seen += 1;
+            let sum: f32 = f.screen.iter().sum();
+            assert!((sum - 1.0).abs() < 1e-5);
+            let lin = f.screen[1] + 0.5 * f.screen[2];
+            assert!((f.depth - lin).abs() < 1e-6);
+            let p = s.perspective(f.screen);
+            // The far corner b (1/w = 0.25) gets less weight than on screen.
+            assert!(p[1] <= f.screen[1] + 1e-6);
+        });
+        assert!(seen > 100);
+    }
+}

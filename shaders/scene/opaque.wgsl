@@ -1,0 +1,152 @@
+// scene.opaque: shade opaque meshes where they won the depth prepass.
+//
+// A raster pipeline; the CPU kernel is passes/src/scene/opaque.rs.
+// Pipeline state the backend sets: topology TriangleList, FrontFace::Ccw,
+// CullMode::Back; depth attachment `scene.depth` loaded (not cleared), compare
+// Equal, writes off; colour attachment 0 `output` (Rgba16Float) cleared to
+// params.background, alpha 1. Draw 3 × triangles vertices, no vertex buffers.
+//
+// Bindings (group 0), in the order of the pass's bindings less its attachments,
+// every record a storage buffer: 0 = frame, 1 = mesh.triangles, 2 = lights.
+// Parameters are pipeline-overridable constants (OpaqueParams::pipeline_constants).
+//
+// The structs mirror passes/src/layout.rs (and shaders/common/layout.wgsl)
+// field for field; naga reports the same sizes and offsets as the Rust structs.
+
+// FrameData (256 bytes).
+struct FrameData {
+    view_proj: mat4x4<f32>,
+    inv_view_proj: mat4x4<f32>,
+    camera_pos: vec4<f32>,
+    screen: vec4<f32>,
+    near: f32,
+    far: f32,
+    model_count: u32,
+    light_count: u32,
+    pixels_per_unit: f32,
+    _pad: array<u32, 19>,
+}
+
+// TriangleData (64 bytes). Each corner's w holds its
+// smooth normal, octahedral-packed (assets/src/octahedral.rs), as raw bits:
+// only ever bitcast, never used as a float, so the bits survive.
+struct TriangleData {
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+    mesh: u32,
+    _pad: array<u32, 3>,
+}
+
+// LightData (64 bytes). w = 0: xyz is the direction
+// the light travels; w = 1: xyz is a point light's position.
+struct LightData {
+    position_or_direction: vec4<f32>,
+    radiance: vec4<f32>,
+    _pad: array<u32, 8>,
+}
+
+@group(0) @binding(0) var<storage, read> frame: FrameData;
+@group(0) @binding(1) var<storage, read> triangles: array<TriangleData>;
+@group(0) @binding(2) var<storage, read> lights: array<LightData>;
+
+// passes/src/scene/opaque.rs: OpaqueParams (defaults equal the Rust ones).
+// `background` is the colour attachment's clear value, not a shader input.
+override albedo_r: f32 = 0.75;
+override albedo_g: f32 = 0.55;
+override albedo_b: f32 = 0.45;
+override ambient: f32 = 0.05;
+
+const PI: f32 = 3.14159265358979;
+
+struct VertexOut {
+    // Invariant: must match scene.depth_prepass bit for bit (depth Equal).
+    @invariant @builtin(position) position: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    // Geometric normal, the fallback when the corner normals cancel out.
+    @location(2) @interpolate(flat) face: vec3<f32>,
+}
+
+// assets/src/octahedral.rs: unpack_unit_vector (two snorm16, x low, y high;
+// Cigolle et al. 2014). unpack2x16snorm clamps at -1 like unsnorm16.
+fn sign_not_zero(v: vec2<f32>) -> vec2<f32> {
+    return select(vec2<f32>(-1.0), vec2<f32>(1.0), v >= vec2<f32>(0.0));
+}
+
+fn unpack_unit_vector(bits: u32) -> vec3<f32> {
+    let e = unpack2x16snorm(bits);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    var xy = e;
+    if z < 0.0 {
+        xy = (vec2<f32>(1.0) - abs(e.yx)) * sign_not_zero(e);
+    }
+    let n = vec3<f32>(xy, z);
+    let len2 = dot(n, n);
+    if len2 > 0.0 {
+        return n * inverseSqrt(len2);
+    }
+    return vec3<f32>(0.0);
+}
+
+fn corner(t: TriangleData, k: u32) -> vec4<f32> {
+    if k == 1u {
+        return t.b;
+    } else if k == 2u {
+        return t.c;
+    }
+    return t.a;
+}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
+    let t = triangles[vertex / 3u];
+    let w_a = (frame.view_proj * vec4<f32>(t.a.xyz, 1.0)).w;
+    let w_b = (frame.view_proj * vec4<f32>(t.b.xyz, 1.0)).w;
+    let w_c = (frame.view_proj * vec4<f32>(t.c.xyz, 1.0)).w;
+    let p = corner(t, vertex % 3u);
+    var out: VertexOut;
+    out.world = p.xyz;
+    out.normal = unpack_unit_vector(bitcast<u32>(p.w));
+    let f = cross(t.b.xyz - t.a.xyz, t.c.xyz - t.a.xyz);
+    out.face = select(vec3<f32>(0.0, 0.0, 1.0), normalize(f), dot(f, f) > 0.0);
+    // The same near-plane drop as depth_prepass.wgsl and the CPU kernels.
+    if min(w_a, min(w_b, w_c)) <= frame.near {
+        out.position = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return out;
+    }
+    out.position = frame.view_proj * vec4<f32>(p.xyz, 1.0);
+    return out;
+}
+
+// Lambert (BRDF albedo/π) over every light plus ambient × albedo, as
+// `shade` in passes/src/scene/opaque.rs. Linear RGB.
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    // Perspective-correct interpolation (the default) of the corner normals.
+    var n = in.face;
+    if dot(in.normal, in.normal) > 0.0 {
+        n = normalize(in.normal);
+    }
+    let count = min(frame.light_count, arrayLength(&lights));
+    var irradiance = vec3<f32>(0.0);
+    for (var i = 0u; i < count; i += 1u) {
+        let l = lights[i];
+        var to_light: vec3<f32>;
+        var falloff = 1.0;
+        if l.position_or_direction.w == 0.0 {
+            let d = l.position_or_direction.xyz;
+            to_light = select(vec3<f32>(0.0), -normalize(d), dot(d, d) > 0.0);
+        } else {
+            let d = l.position_or_direction.xyz - in.world;
+            // Clamped at 1 cm, as in the CPU kernel.
+            let d2 = max(dot(d, d), 1e-4);
+            to_light = d * inverseSqrt(d2);
+            falloff = 1.0 / d2;
+        }
+        irradiance += l.radiance.rgb * (max(dot(n, to_light), 0.0) * falloff);
+    }
+    let albedo = vec3<f32>(albedo_r, albedo_g, albedo_b);
+    let color = albedo * (irradiance / PI + vec3<f32>(ambient));
+    return vec4<f32>(color, 1.0);
+}
