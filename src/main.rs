@@ -5,6 +5,7 @@
 
 mod graph_cmd;
 mod info;
+mod render_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,6 +23,8 @@ enum Command {
     Graph(graph_cmd::Args),
     /// Print strands, points, segments, bounds and memory of a scene, groom or mesh file.
     Info(info::Args),
+    /// Render a scene on a backend to PNG and print per-pass times.
+    Render(render_cmd::Args),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Graph(args) => graph_cmd::run(args),
         Command::Info(args) => info::run(args),
+        Command::Render(args) => render_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -67,6 +67,11 @@ pub static KINDS: &[PassKind] = &[
         "Kulikov 2025, 'Visibility buffer: tile allocation, downscale'",
     ),
     kind(
+        "kulikov.sort_scan",
+        "prefix sum over sort buckets; writes the raster's indirect dispatch",
+        "Kulikov 2025, 'Sort everything!'",
+    ),
+    kind(
         "kulikov.sort",
         "global counting sort of visible segments by screen bucket",
         "Kulikov 2025, 'Sort everything!'",
@@ -75,6 +80,11 @@ pub static KINDS: &[PassKind] = &[
         "kulikov.raster",
         "conservative software rasterizer into a 3-layer 32-bit visibility atlas plus additive coverage",
         "Kulikov 2025, 'Rasterization', 'Divergence', 'Pixel request stack'",
+    ),
+    kind(
+        "kulikov.debug_resolve",
+        "resolve the visibility atlas to screen: coverage over the opaque image, layer depths",
+        "Kulikov 2025, 'Visibility buffer' (debug view)",
     ),
     kind(
         "kulikov.shade_sort",

@@ -10,6 +10,7 @@
 mod catalogue;
 pub mod common;
 pub mod contract;
+pub mod kulikov;
 pub mod layout;
 pub mod scene;
 pub mod sim;
@@ -23,7 +24,17 @@ use strandgraph_graph::PassRegistry;
 /// here compiles in graphs; backends refuse to run it and say so.
 static DEFINITIONS: &[&dyn PassDef] = &[
     &common::clear::Clear,
-    &scene::depth_prepass::DepthPrepass, &scene::opaque::Opaque,
+    &scene::depth_prepass::DepthPrepass,
+    &scene::opaque::Opaque,
+    &kulikov::lod::Lod,
+    &kulikov::skin::Skin,
+    &kulikov::hiz::DepthDownsample,
+    &kulikov::cull::Cull,
+    &kulikov::tiles::TileAlloc,
+    &kulikov::sort::SortScan,
+    &kulikov::sort::Sort,
+    &kulikov::raster::Raster,
+    &kulikov::debug_resolve::DebugResolve,
 ];
 
 /// The built-in pass kinds.

@@ -1,0 +1,343 @@
+//! `kulikov.cull`: frustum, occlusion and fedora culling per segment, with a
+//! visibility bit, per-model screen bounds and sort-bin counts as output.
+//!
+//! Kulikov, "Culling": "Occlusion cull against downscaled depth ... Fedora
+//! culling: exclusion box, inclusion sphere ... atomically raise a visibility
+//! bit ... utilize wave intrinsics and only do actual atomic write once per
+//! wave. ... compute real screen boundaries for each hair model". The sort
+//! bins are filled here too ("Populate sorting bins in visibility culling pass").
+
+use super::{ModelLod, Scene, TILE, clip_to_screen, transform};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::layout::ModelData;
+use crate::sim::{CounterValues, Ctx, Words};
+use std::collections::BTreeMap;
+use strandgraph_graph::AccessMode::{Atomic, Read};
+use strandgraph_graph::schema::Quantity;
+
+pub struct Cull;
+
+pub const GROUP: u32 = 256;
+
+#[derive(Debug, Clone, Copy)]
+pub struct CullParams {
+    pub frustum: bool,
+    pub occlusion: bool,
+    pub fedora: bool,
+    /// One atomic per subgroup and target instead of one per lane.
+    pub wave_aggregated_atomics: bool,
+}
+
+impl PassDef for Cull {
+    fn kind(&self) -> &'static str {
+        "kulikov.cull"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "frame",
+                mode: Read,
+            },
+            Binding {
+                name: "models",
+                mode: Read,
+            },
+            Binding {
+                name: "lod_models",
+                mode: Read,
+            },
+            Binding {
+                name: "clip_positions",
+                mode: Read,
+            },
+            Binding {
+                name: "hiz",
+                mode: Read,
+            },
+            Binding {
+                name: "segment_visibility",
+                mode: Atomic,
+            },
+            Binding {
+                name: "screen_bounds",
+                mode: Atomic,
+            },
+            Binding {
+                name: "sort_bins",
+                mode: Atomic,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Segments,
+            per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/cull.wgsl",
+            entry: "cull",
+            fragment: None,
+        }
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        Ok(Box::new(CullKernel(CullParams {
+            frustum: p.bool("frustum", true)?,
+            occlusion: p.bool("occlusion", true)?,
+            fedora: p.bool("fedora", true)?,
+            wave_aggregated_atomics: p.bool("wave_aggregated_atomics", true)?,
+        })))
+    }
+}
+
+struct CullKernel(CullParams);
+
+/// A drawn segment: its model, both vertices' global indices, its local index.
+#[derive(Debug, Clone, Copy)]
+pub struct DrawnSegment {
+    pub model: usize,
+    pub local: u32,
+    pub v0: u32,
+    pub v1: u32,
+}
+
+/// Maps a global segment id to its drawn vertices, or `None` when LOD dropped it.
+pub fn drawn_segment(scene: &Scene, lods: &[ModelLod], id: u32) -> Option<DrawnSegment> {
+    let (m, local) = scene.segment_model(id)?;
+    let md = &scene.models[m];
+    let per = md.points_per_strand - 1;
+    let (strand, k) = (local / per, local % per);
+    let lod = &lods[m];
+    if strand >= lod.strands || k >= lod.segments_per_strand {
+        return None;
+    }
+    let (a, b) = lod.segment_vertices(md.points_per_strand, k);
+    let base = md.vertex_first + strand * md.points_per_strand;
+    Some(DrawnSegment {
+        model: m,
+        local,
+        v0: base + a,
+        v1: base + b,
+    })
+}
+
+/// The sort bucket of a segment: the 64×64 screen tile of its midpoint.
+pub fn screen_bin(w: f32, h: f32, s0: [f32; 3], s1: [f32; 3]) -> u32 {
+    let x = (0.5 * (s0[0] + s1[0])).clamp(0.0, w - 1.0) as u32;
+    let y = (0.5 * (s0[1] + s1[1])).clamp(0.0, h - 1.0) as u32;
+    y / TILE * (w as u32).div_ceil(TILE) + x / TILE
+}
+
+/// Kulikov's fedora test: inside the exclusion box and outside the inclusion sphere.
+pub fn fedora_culls(m: &ModelData, p: [f32; 3]) -> bool {
+    if m.fedora_min[3] == 0.0 {
+        return false;
+    }
+    let in_box = (0..3).all(|a| p[a] >= m.fedora_min[a] && p[a] <= m.fedora_max[a]);
+    let d2: f32 = (0..3).map(|a| (p[a] - m.fedora_sphere[a]).powi(2)).sum();
+    in_box && d2 > m.fedora_sphere[3] * m.fedora_sphere[3]
+}
+
+/// What a visible segment contributes.
+struct Visible {
+    id: u32,
+    model: usize,
+    bounds: [u32; 4],
+    bin: u32,
+}
+
+impl CullKernel {
+    fn test(
+        &self,
+        scene: &Scene,
+        hiz: &Words<'_>,
+        seg: &DrawnSegment,
+        c0: [f32; 4],
+        c1: [f32; 4],
+    ) -> Option<([u32; 4], u32)> {
+        let f = &scene.frame;
+        // Segments reaching behind the near plane would need clipping; hair that
+        // close to the camera is not drawn.
+        if c0[3] <= f.near || c1[3] <= f.near {
+            return None;
+        }
+        if self.0.frustum {
+            let out = |axis: usize, sign: f32| sign * c0[axis] > c0[3] && sign * c1[axis] > c1[3];
+            if out(0, 1.0)
+                || out(0, -1.0)
+                || out(1, 1.0)
+                || out(1, -1.0)
+                || out(2, 1.0)
+                || (c0[2] < 0.0 && c1[2] < 0.0)
+            {
+                return None;
+            }
+        }
+        if self.0.fedora {
+            let world = |c: [f32; 4]| {
+                let p = transform(&f.inv_view_proj, c);
+                [p[0] / p[3], p[1] / p[3], p[2] / p[3]]
+            };
+            let m = &scene.models[seg.model];
+            if fedora_culls(m, world(c0)) && fedora_culls(m, world(c1)) {
+                return None;
+            }
+        }
+        let (w, h) = (f.screen[0], f.screen[1]);
+        let (s0, s1) = (clip_to_screen(c0, w, h), clip_to_screen(c1, w, h));
+        let clampx = |x: f32| x.clamp(0.0, w - 1.0) as u32;
+        let clampy = |y: f32| y.clamp(0.0, h - 1.0) as u32;
+        let bounds = [
+            clampx(s0[0].min(s1[0])),
+            clampy(s0[1].min(s1[1])),
+            clampx(s0[0].max(s1[0])),
+            clampy(s0[1].max(s1[1])),
+        ];
+        if self.0.occlusion {
+            let f16 = super::hiz::FACTOR;
+            let hw = (w as u32).div_ceil(f16);
+            let (tx0, ty0, tx1, ty1) = (
+                bounds[0] / f16,
+                bounds[1] / f16,
+                bounds[2] / f16,
+                bounds[3] / f16,
+            );
+            // Long segments span many blocks; testing them is not worth the reads.
+            if (tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= 16 {
+                let nearest = s0[2].min(s1[2]);
+                let farthest = (ty0..=ty1)
+                    .flat_map(|ty| (tx0..=tx1).map(move |tx| (ty * hw + tx) as usize))
+                    .map(|i| hiz.load_f32(i))
+                    .fold(0.0f32, f32::max);
+                if nearest > farthest {
+                    return None;
+                }
+            }
+        }
+        Some((bounds, screen_bin(w, h, s0, s1)))
+    }
+}
+
+impl CpuKernel for CullKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let lods_w = ctx.words("lod_models");
+        let lods: Vec<ModelLod> = (0..scene.models.len())
+            .map(|m| ModelLod::load(&lods_w, m))
+            .collect();
+        let (clip, hiz) = (ctx.words("clip_positions"), ctx.words("hiz"));
+        let (bits, bounds, bins) = (
+            ctx.words("segment_visibility"),
+            ctx.words("screen_bounds"),
+            ctx.words("sort_bins"),
+        );
+        let total = ctx.quantities.segments;
+        let width = ctx.subgroup_width.max(1);
+        let mut local = CounterValues::default();
+        for sub in 0..GROUP.div_ceil(width) {
+            let lanes = (sub * width..((sub + 1) * width).min(GROUP)).map(|l| group * GROUP + l);
+            let visible: Vec<Visible> = lanes
+                .filter(|&id| u64::from(id) < total)
+                .filter_map(|id| {
+                    let seg = drawn_segment(&scene, &lods, id)?;
+                    let (c0, c1) = (
+                        clip.load_vec4(seg.v0 as usize),
+                        clip.load_vec4(seg.v1 as usize),
+                    );
+                    let (b, bin) = self.test(&scene, &hiz, &seg, c0, c1)?;
+                    Some(Visible {
+                        id,
+                        model: seg.model,
+                        bounds: b,
+                        bin,
+                    })
+                })
+                .collect();
+            local.atomics += self.publish(&visible, &bits, &bounds, &bins);
+        }
+        if ctx.instrument {
+            ctx.counters.add(&local);
+        }
+    }
+}
+
+impl CullKernel {
+    /// Writes one subgroup's results; returns the atomics issued.
+    fn publish(
+        &self,
+        visible: &[Visible],
+        bits: &Words<'_>,
+        bounds: &Words<'_>,
+        bins: &Words<'_>,
+    ) -> u64 {
+        let bound = |b: &Words<'_>, m: usize, v: [u32; 4]| {
+            // Maxima are stored inverted so that all four are atomicMin.
+            b.fetch_min(4 * m, v[0]);
+            b.fetch_min(4 * m + 1, v[1]);
+            b.fetch_min(4 * m + 2, !v[2]);
+            b.fetch_min(4 * m + 3, !v[3]);
+        };
+        if !self.0.wave_aggregated_atomics {
+            for v in visible {
+                bits.fetch_or((v.id / 32) as usize, 1 << (v.id % 32));
+                bound(bounds, v.model, v.bounds);
+                bins.fetch_add(v.bin as usize, 1);
+            }
+            return 6 * visible.len() as u64;
+        }
+        // subgroupOr / subgroupMin / per-bin counts, then one atomic per target.
+        let mut words: BTreeMap<u32, u32> = BTreeMap::new();
+        let mut models: BTreeMap<usize, [u32; 4]> = BTreeMap::new();
+        let mut counts: BTreeMap<u32, u32> = BTreeMap::new();
+        for v in visible {
+            *words.entry(v.id / 32).or_default() |= 1 << (v.id % 32);
+            let e = models.entry(v.model).or_insert([u32::MAX, u32::MAX, 0, 0]);
+            *e = [
+                e[0].min(v.bounds[0]),
+                e[1].min(v.bounds[1]),
+                e[2].max(v.bounds[2]),
+                e[3].max(v.bounds[3]),
+            ];
+            *counts.entry(v.bin).or_default() += 1;
+        }
+        for (w, mask) in &words {
+            bits.fetch_or(*w as usize, *mask);
+        }
+        for (m, b) in &models {
+            bound(bounds, *m, *b);
+        }
+        for (bin, n) in &counts {
+            bins.fetch_add(*bin as usize, *n);
+        }
+        (words.len() + 4 * models.len() + counts.len()) as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fedora_box_culls_except_inside_the_sphere() {
+        let mut m: ModelData = bytemuck::Zeroable::zeroed();
+        m.fedora_min = [-0.2, 0.1, -0.2, 1.0];
+        m.fedora_max = [0.2, 0.4, 0.2, 0.0];
+        m.fedora_sphere = [0.0, 0.1, 0.0, 0.12];
+        assert!(
+            fedora_culls(&m, [0.15, 0.3, 0.0]),
+            "inside the box, outside the sphere: culled"
+        );
+        assert!(
+            !fedora_culls(&m, [0.0, 0.15, 0.0]),
+            "inside the sphere: kept"
+        );
+        assert!(!fedora_culls(&m, [0.5, 0.3, 0.0]), "outside the box: kept");
+        m.fedora_min[3] = 0.0;
+        assert!(!fedora_culls(&m, [0.15, 0.3, 0.0]), "disabled");
+    }
+}

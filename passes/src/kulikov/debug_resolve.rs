@@ -1,0 +1,139 @@
+//! `kulikov.debug_resolve`: the visibility atlas resolved to screen, so a user
+//! can look at it before shading exists.
+//!
+//! Writes the reconstructed coverage of every model, in its material colour,
+//! over the opaque image (Kulikov's quadratic coverage fit), and an RGBA8
+//! image of the three layers' 10-bit depths (R, G, B: brighter is nearer)
+//! and total coverage (A).
+
+use super::payload::{EMPTY, depth_of, total_coverage};
+use super::raster::LAYERS;
+use super::tiles::ModelTiles;
+use super::{Scene, TILE_TEXELS};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
+use crate::sim::{Ctx, Words};
+use half::f16;
+use strandgraph_graph::AccessMode::{Read, Write};
+use strandgraph_graph::schema::Quantity;
+
+pub struct DebugResolve;
+
+const GROUP: u32 = 256;
+
+impl PassDef for DebugResolve {
+    fn kind(&self) -> &'static str {
+        "kulikov.debug_resolve"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "frame",
+                mode: Read,
+            },
+            Binding {
+                name: "models",
+                mode: Read,
+            },
+            Binding {
+                name: "atlas_tiles",
+                mode: Read,
+            },
+            Binding {
+                name: "vis_atlas",
+                mode: Read,
+            },
+            Binding {
+                name: "coverage_atlas",
+                mode: Read,
+            },
+            Binding {
+                name: "output",
+                mode: Write,
+            },
+            Binding {
+                name: "debug_layers",
+                mode: Write,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Pixels,
+            per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/debug_resolve.wgsl",
+            entry: "resolve",
+            fragment: None,
+        }
+    }
+    fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(ResolveKernel))
+    }
+}
+
+struct ResolveKernel;
+
+/// Reads an Rgba16Float texel (two words: r | g << 16, b | a << 16).
+pub fn load_rgba16f(w: &Words<'_>, texel: usize) -> [f32; 4] {
+    let (lo, hi) = (w.load(2 * texel), w.load(2 * texel + 1));
+    [lo & 0xFFFF, lo >> 16, hi & 0xFFFF, hi >> 16].map(|h| f16::from_bits(h as u16).to_f32())
+}
+
+pub fn store_rgba16f(w: &Words<'_>, texel: usize, c: [f32; 4]) {
+    let h = c.map(|x| u32::from(f16::from_f32(x).to_bits()));
+    w.store(2 * texel, h[0] | (h[1] << 16));
+    w.store(2 * texel + 1, h[2] | (h[3] << 16));
+}
+
+impl CpuKernel for ResolveKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let (width, pixels) = (ctx.quantities.width, ctx.quantities.count(Quantity::Pixels));
+        let tiles_w = ctx.words("atlas_tiles");
+        let tiles: Vec<ModelTiles> = (0..scene.models.len())
+            .map(|m| ModelTiles::load(&tiles_w, m))
+            .collect();
+        let (vis, cov, out, layers) = (
+            ctx.words("vis_atlas"),
+            ctx.words("coverage_atlas"),
+            ctx.words("output"),
+            ctx.words("debug_layers"),
+        );
+        let stride = vis.len() / LAYERS;
+        debug_assert_eq!(stride % TILE_TEXELS as usize, 0);
+        for i in group * GROUP..((group + 1) * GROUP).min(pixels as u32) {
+            let (x, y) = (i % width, i / width);
+            let mut color = load_rgba16f(&out, i as usize);
+            let mut debug = 0u32;
+            for (m, t) in tiles.iter().enumerate() {
+                let Some(texel) = t.texel(x, y) else { continue };
+                let alpha = total_coverage(cov.load(texel as usize));
+                if alpha <= 0.0 {
+                    continue;
+                }
+                let c = scene.models[m].color;
+                for k in 0..3 {
+                    color[k] = color[k] * (1.0 - alpha) + c[k] * alpha;
+                }
+                if debug == 0 {
+                    let depth = |l: usize| {
+                        let p = vis.load(texel as usize + l * stride);
+                        if p == EMPTY { 0 } else { 255 - depth_of(p) / 4 }
+                    };
+                    debug = depth(0)
+                        | depth(1) << 8
+                        | depth(2) << 16
+                        | ((alpha * 255.0).round() as u32) << 24;
+                }
+            }
+            store_rgba16f(&out, i as usize, color);
+            layers.store(i as usize, debug);
+        }
+    }
+}

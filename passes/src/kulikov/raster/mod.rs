@@ -1,0 +1,363 @@
+//! `kulikov.raster`: the conservative software rasterizer into the tiled
+//! visibility atlas.
+//!
+//! Kulikov, "Rasterization" and "Visibility buffer": each lane takes one
+//! segment, rasterizes it as a trapezoid, depth-tests every covered pixel
+//! against the scene depth and writes a 32-bit payload (10-bit depth | 22-bit
+//! segment) into 3 ordered layers with chained `atomicMin`, plus additive
+//! coverage with `atomicAdd(coverage * 1024)`.
+//!
+//! Switches (pass parameters), so the talk's ablations can be measured:
+//! - `loop_flattening`: one loop over all pixels instead of nested x/y loops;
+//! - `last_layer_cull`: skip the layer atomics when the (non-atomic) last layer
+//!   already holds something nearer ("up to 50%");
+//! - `morton_sort`: order the workgroup's segments along a Morton curve;
+//! - `pixel_request_stack`, `depth_test_stack`: the LDS request stacks. They
+//!   change how a GPU schedules the same writes, not which writes happen, so
+//!   the CPU kernel accepts and reports them; the WGSL implements them.
+
+pub mod geometry;
+pub mod lanes;
+
+use super::cull::{DrawnSegment, drawn_segment};
+use super::payload::{COVERAGE_SCALE, EMPTY, linear_depth, pack, quantize_depth};
+use super::tiles::ModelTiles;
+use super::{ModelLod, Scene, TILE, TILE_TEXELS};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::sim::{CounterValues, Ctx, Words};
+use geometry::Trapezoid;
+use strandgraph_graph::AccessMode::{Atomic, Read};
+
+pub struct Raster;
+
+/// Segments per workgroup (Kulikov: "Need large groups (256/512/1024 lanes)").
+pub const GROUP: u32 = 256;
+/// Ordered visibility layers.
+pub const LAYERS: usize = 3;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RasterParams {
+    pub loop_flattening: bool,
+    pub pixel_request_stack: bool,
+    pub depth_test_stack: bool,
+    pub last_layer_cull: bool,
+    pub morton_sort: bool,
+}
+
+impl RasterParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new("kulikov.raster", v)?;
+        let size = p.u32("workgroup_size", GROUP)?;
+        if size != GROUP {
+            return Err(ParamError {
+                kind: "kulikov.raster",
+                param: "workgroup_size".into(),
+                message: format!(
+                    "the CPU kernel and the sort pass's dispatch use {GROUP}; got {size}"
+                ),
+            });
+        }
+        if p.f32("coverage_scale", COVERAGE_SCALE)? != COVERAGE_SCALE {
+            return Err(ParamError {
+                kind: "kulikov.raster",
+                param: "coverage_scale".into(),
+                message: "composition decodes coverage with the talk's scale of 1024".into(),
+            });
+        }
+        Ok(Self {
+            loop_flattening: p.bool("loop_flattening", true)?,
+            pixel_request_stack: p.bool("pixel_request_stack", true)?,
+            depth_test_stack: p.bool("depth_test_stack", true)?,
+            last_layer_cull: p.bool("last_layer_cull", true)?,
+            morton_sort: p.bool("morton_sort", true)?,
+        })
+    }
+}
+
+impl PassDef for Raster {
+    fn kind(&self) -> &'static str {
+        "kulikov.raster"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "raster_args",
+                mode: Read,
+            },
+            Binding {
+                name: "frame",
+                mode: Read,
+            },
+            Binding {
+                name: "models",
+                mode: Read,
+            },
+            Binding {
+                name: "lod_models",
+                mode: Read,
+            },
+            Binding {
+                name: "sorted_segments",
+                mode: Read,
+            },
+            Binding {
+                name: "clip_positions",
+                mode: Read,
+            },
+            Binding {
+                name: "groom.vertices",
+                mode: Read,
+            },
+            Binding {
+                name: "atlas_tiles",
+                mode: Read,
+            },
+            Binding {
+                name: "scene.depth",
+                mode: Read,
+            },
+            Binding {
+                name: "vis_atlas",
+                mode: Atomic,
+            },
+            Binding {
+                name: "coverage_atlas",
+                mode: Atomic,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::Indirect {
+            binding: "raster_args",
+            word: 0,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/raster.wgsl",
+            entry: "raster",
+            fragment: None,
+        }
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))
+    }
+}
+
+struct RasterKernel(RasterParams);
+
+/// One lane's segment, projected into its model's atlas grid.
+struct Lane {
+    trap: Trapezoid,
+    local: u32,
+    lod: ModelLod,
+    tiles: ModelTiles,
+    morton: u32,
+}
+
+fn morton(x: u32, y: u32) -> u32 {
+    let spread = |mut v: u32| {
+        v &= 0xFFFF;
+        v = (v | (v << 8)) & 0x00FF_00FF;
+        v = (v | (v << 4)) & 0x0F0F_0F0F;
+        v = (v | (v << 2)) & 0x3333_3333;
+        (v | (v << 1)) & 0x5555_5555
+    };
+    spread(x) | (spread(y) << 1)
+}
+
+/// Everything a pixel write needs, shared by the workgroup.
+struct Targets<'a> {
+    scene: &'a Scene,
+    depth: Words<'a>,
+    vis: Words<'a>,
+    coverage: Words<'a>,
+    layer_stride: usize,
+    width: u32,
+    height: u32,
+}
+
+impl RasterKernel {
+    fn project(
+        &self,
+        scene: &Scene,
+        ctx: &Ctx<'_>,
+        seg: &DrawnSegment,
+        lod: ModelLod,
+        tiles: ModelTiles,
+    ) -> Option<Lane> {
+        let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
+        let f = &scene.frame;
+        let (c0, c1) = (
+            clip.load_vec4(seg.v0 as usize),
+            clip.load_vec4(seg.v1 as usize),
+        );
+        if c0[3] <= f.near || c1[3] <= f.near || tiles.valid == 0 {
+            return None;
+        }
+        let d = tiles.downscale as f32;
+        let (ox, oy) = (
+            (tiles.origin_x * TILE) as f32,
+            (tiles.origin_y * TILE) as f32,
+        );
+        let to_raster = |c: [f32; 4]| {
+            let s = super::clip_to_screen(c, f.screen[0], f.screen[1]);
+            [s[0] / d - ox, s[1] / d - oy]
+        };
+        // Strand width in raster pixels: world thickness × LOD compensation × projection.
+        let half = |v: u32, w: f32| {
+            0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit
+                / w
+                / d
+        };
+        let trap = Trapezoid::new(
+            to_raster(c0),
+            to_raster(c1),
+            half(seg.v0, c0[3]),
+            half(seg.v1, c1[3]),
+            c0[3],
+            c1[3],
+        )?;
+        let mid = [0.5 * (trap.a[0] + trap.b[0]), 0.5 * (trap.a[1] + trap.b[1])];
+        let morton = morton(mid[0].max(0.0) as u32, mid[1].max(0.0) as u32);
+        Some(Lane {
+            trap,
+            local: seg.local,
+            lod,
+            tiles,
+            morton,
+        })
+    }
+
+    /// Rasterizes one lane; returns its pixel count per column (for lane statistics).
+    fn rasterize(&self, lane: &Lane, t: &Targets<'_>, tally: &mut CounterValues) -> Vec<u32> {
+        let grid_w = (lane.tiles.grid_w * TILE) as i32;
+        let grid_h = (lane.tiles.grid_h * TILE) as i32;
+        let (x0, x1) = lane.trap.columns();
+        let mut heights = Vec::new();
+        for x in x0.max(0)..=x1.min(grid_w - 1) {
+            let col = lane.trap.column(x);
+            if col.is_empty() {
+                heights.push(0);
+                continue;
+            }
+            let (lo, hi) = col.range(1);
+            let (y0, y1) = (
+                (lo.floor() as i32).max(0),
+                (hi.floor() as i32).min(grid_h - 1),
+            );
+            heights.push((y1 - y0 + 1).max(0) as u32);
+            for y in y0..=y1 {
+                let coverage = Trapezoid::coverage(&col, y);
+                if coverage > 0.0 {
+                    self.write_pixel(lane, x as u32, y as u32, coverage, t, tally);
+                }
+            }
+        }
+        heights
+    }
+
+    fn write_pixel(
+        &self,
+        lane: &Lane,
+        x: u32,
+        y: u32,
+        coverage: f32,
+        t: &Targets<'_>,
+        tally: &mut CounterValues,
+    ) {
+        let tiles = &lane.tiles;
+        let view_depth = lane.trap.depth_at(x as i32, y as i32);
+        // Depth test at the screen pixel under this atlas texel's centre.
+        let d = tiles.downscale;
+        let sx = ((tiles.origin_x * TILE + x) * d + d / 2).min(t.width - 1);
+        let sy = ((tiles.origin_y * TILE + y) * d + d / 2).min(t.height - 1);
+        let z = t.depth.load_f32((sy * t.width + sx) as usize);
+        if view_depth >= linear_depth(z, t.scene.frame.near, t.scene.frame.far) {
+            return;
+        }
+        let (tx, ty) = (x / TILE, y / TILE);
+        let texel = ((tiles.first_tile + ty * tiles.grid_w + tx) * TILE_TEXELS
+            + (y % TILE) * TILE
+            + x % TILE) as usize;
+        let mut payload = pack(
+            quantize_depth(view_depth, lane.lod.depth_near, lane.lod.depth_far),
+            lane.local,
+        );
+        tally.pixels_written += 1;
+        // Kulikov, "Last layer culling": a plain load of the last layer.
+        let culled =
+            self.0.last_layer_cull && t.vis.load(texel + (LAYERS - 1) * t.layer_stride) < payload;
+        if !culled {
+            // Kulikov's WritePixelToVisBuffer: the evicted value moves down a layer.
+            for layer in 0..LAYERS {
+                let prev = t.vis.fetch_min(texel + layer * t.layer_stride, payload);
+                tally.atomics += 1;
+                if prev == EMPTY {
+                    break;
+                }
+                payload = payload.max(prev);
+            }
+        }
+        t.coverage
+            .fetch_add(texel, (coverage * COVERAGE_SCALE).round() as u32);
+        tally.atomics += 1;
+    }
+}
+
+impl CpuKernel for RasterKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let count = ctx.words("raster_args").load(3);
+        let (lods_w, tiles_w, sorted) = (
+            ctx.words("lod_models"),
+            ctx.words("atlas_tiles"),
+            ctx.words("sorted_segments"),
+        );
+        let lods: Vec<ModelLod> = (0..scene.models.len())
+            .map(|m| ModelLod::load(&lods_w, m))
+            .collect();
+        let tiles: Vec<ModelTiles> = (0..scene.models.len())
+            .map(|m| ModelTiles::load(&tiles_w, m))
+            .collect();
+        let mut lanes: Vec<Lane> = (group * GROUP..((group + 1) * GROUP).min(count))
+            .filter_map(|i| {
+                let seg = drawn_segment(&scene, &lods, sorted.load(i as usize))?;
+                self.project(&scene, ctx, &seg, lods[seg.model], tiles[seg.model])
+            })
+            .collect();
+        if self.0.morton_sort {
+            // Kulikov: "sort according to Morton curve within each group".
+            lanes.sort_by_key(|l| l.morton);
+        }
+        let vis = ctx.words("vis_atlas");
+        let targets = Targets {
+            scene: &scene,
+            depth: ctx.words("scene.depth"),
+            layer_stride: vis.len() / LAYERS,
+            vis,
+            coverage: ctx.words("coverage_atlas"),
+            width: ctx.quantities.width,
+            height: ctx.quantities.height,
+        };
+        let mut tally = CounterValues::default();
+        let width = ctx.subgroup_width.max(1) as usize;
+        for sub in lanes.chunks(width) {
+            let heights: Vec<Vec<u32>> = sub
+                .iter()
+                .map(|l| self.rasterize(l, &targets, &mut tally))
+                .collect();
+            if ctx.instrument {
+                let (active, total) = lanes::utilisation(&heights, width, self.0.loop_flattening);
+                tally.active_lanes += active;
+                tally.total_lanes += total;
+            }
+        }
+        if ctx.instrument {
+            ctx.counters.add(&tally);
+        }
+    }
+}

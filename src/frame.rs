@@ -1,0 +1,57 @@
+//! One frame, prepared: the scene loaded and packed, the graph compiled and
+//! instantiated for it.
+
+use miette::{IntoDiagnostic, Result, WrapErr};
+use std::path::Path;
+use strandgraph_assets::Scene;
+use strandgraph_graph::{Instance, Plan, compile_file};
+use strandgraph_passes::Registry;
+use strandgraph_passes::upload::{Upload, upload};
+
+pub struct Prepared {
+    pub scene: Scene,
+    pub upload: Upload,
+    pub plan: Plan,
+    pub instance: Instance,
+}
+
+/// Loads `scene_path`, packs it at `size` (default: the scene's resolution),
+/// and compiles `graph` (default: the scene's graph).
+pub fn prepare(
+    scene_path: &Path,
+    graph: Option<&Path>,
+    size: Option<(u32, u32)>,
+) -> Result<Prepared> {
+    let scene = Scene::load(scene_path).map_err(|e| miette::miette!("{e}"))?;
+    let (w, h) = size.unwrap_or(scene.desc.resolution);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(miette::miette!(
+            "{}: resolution {w}x{h} is outside 1..=16384",
+            scene_path.display()
+        ));
+    }
+    let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
+    let plan = compile_file(&graph_path, &Registry)?;
+    let upload = upload(&scene, w, h);
+    let instance = plan.instantiate(&upload.quantities)?;
+    Ok(Prepared {
+        scene,
+        upload,
+        plan,
+        instance,
+    })
+}
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32)> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| miette::miette!("--size {s}: expected WxH, e.g. 1280x720"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .into_diagnostic()
+            .wrap_err_with(|| format!("--size {s}"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}

@@ -1,0 +1,6 @@
+//! `strandgraph` as a library: what the CLI, the end-to-end tests and the
+//! benches share — preparing a scene's frame for a graph, and turning
+//! rendered images into pictures.
+
+pub mod frame;
+pub mod images;
