@@ -1,0 +1,592 @@
+//! Reflects every pass's WGSL with naga and checks it against the pass
+//! contract (DESIGN.md, "A test reflects every WGSL module with naga").
+//!
+//! Shaders share `shaders/common/layout.wgsl` (and the Kulikov helpers in
+//! `shaders/kulikov/common.wgsl`) through naga_oil's `#import`: every file
+//! with a `#define_import_path` is added to one `Composer` as a composable
+//! module, and each pass's file is composed into a naga module from there.
+//!
+//! For every kind in `KINDS` that `Registry` defines:
+//! - the shader file exists, composes and validates with the capabilities
+//!   its tier allows (`capabilities_of`), no more;
+//! - the entry point exists: a compute entry with `@workgroup_size` equal to
+//!   `workgroup_size()`, or for a raster pass (`Shader.fragment` is `Some`)
+//!   a vertex entry and a fragment entry;
+//! - the resources the entry points use are `@group(0)`, numbered 0..=N
+//!   without gaps: binding 0 is the uniform block of the pass parameters (a
+//!   struct), bindings 1..=N are `bindings()` in order (for a raster pass,
+//!   the leading ones: its trailing colour and depth attachments are not
+//!   bound), named as the binding
+//!   with `.` written `_` (or `<entry>_<name>` where one file holds several
+//!   entry points that bind the same resource at different numbers), and
+//!   accessed as declared (Read: `read` storage,
+//!   a sampled texture or a read-only storage texture; Write: `read_write`
+//!   storage or a writable storage texture; Atomic: `read_write` storage
+//!   holding atomics).
+//!
+//! The shared records are checked against the Rust structs: naga's layout
+//! of each WGSL struct in layout.wgsl has the size (and the fields the CPU
+//! kernels decode, the offsets) of the `#[repr(C)]` struct of the same name,
+//! and so does every struct of that name in a pass's module (imported, or a
+//! copy in a shader that does not compose).
+
+use naga::valid::{Capabilities, ModuleInfo, ShaderStages, ValidationFlags, Validator};
+use naga::{AddressSpace, ImageClass, Module, ShaderStage, StorageAccess, TypeInner};
+use naga_oil::compose::{
+    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType,
+};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use strandgraph_graph::AccessMode;
+use strandgraph_passes::layout::{FrameData, LightData, ModelData, TriangleData};
+use strandgraph_passes::{Definitions, KINDS, PassDef, Registry};
+
+/// What every shader may use: subgroup operations and subgroup barriers
+/// (the Kulikov raster's request stacks, the cull's wave-aggregated atomics).
+const BASE: Capabilities = Capabilities::SUBGROUP.union(Capabilities::SUBGROUP_BARRIER);
+
+/// The capability tier of a shader file, beyond [`BASE`]. Capabilities are
+/// checked per module (DESIGN.md), so each file is validated with exactly its
+/// tier and a module that starts using more fails here.
+fn capabilities_of(file: &str) -> Capabilities {
+    match file {
+        // The segment budget's proportional reduction is done in f64, as the
+        // CPU kernel does (`budget as f64 / total as f64`).
+        "kulikov/lod.wgsl" => BASE | Capabilities::FLOAT64,
+        _ => BASE,
+    }
+}
+
+/// Everything any module may use; the composer validates with this.
+fn all_capabilities() -> Capabilities {
+    BASE | Capabilities::FLOAT64
+}
+
+fn shaders_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders")
+}
+
+fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            wgsl_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            out.push(path);
+        }
+    }
+}
+
+fn relative(path: &Path) -> String {
+    path.strip_prefix(shaders_dir())
+        .unwrap_or(path)
+        .to_string_lossy()
+        .replace('\\', "/")
+}
+
+/// A composer holding every composable module under `shaders/`, added in
+/// dependency order.
+fn composer() -> Composer {
+    let mut composer = Composer::default().with_capabilities(all_capabilities());
+    let mut files = Vec::new();
+    wgsl_files(&shaders_dir(), &mut files);
+    let mut pending: Vec<(String, String, Vec<String>, String)> = files
+        .iter()
+        .filter_map(|path| {
+            let source = std::fs::read_to_string(path).unwrap();
+            let (name, imports, _) = naga_oil::compose::get_preprocessor_data(&source);
+            let name = name?;
+            let imports = imports.into_iter().map(|i| i.import).collect();
+            Some((name, relative(path), imports, source))
+        })
+        .collect();
+    while !pending.is_empty() {
+        let ready = pending.iter().position(|(_, _, imports, _)| {
+            imports
+                .iter()
+                .all(|i| composer.contains_module(i) || !pending.iter().any(|p| &p.0 == i))
+        });
+        let Some(ready) = ready else {
+            let names: Vec<&str> = pending.iter().map(|p| p.1.as_str()).collect();
+            panic!("composable modules import each other in a cycle: {names:?}");
+        };
+        let (name, file, _, source) = pending.remove(ready);
+        let added = composer.add_composable_module(ComposableModuleDescriptor {
+            source: &source,
+            file_path: &file,
+            language: ShaderLanguage::Wgsl,
+            ..Default::default()
+        });
+        if let Err(e) = added {
+            panic!("{file} ({name}): {}", e.emit_to_string(&composer));
+        }
+    }
+    composer
+}
+
+/// Composes and validates one top-level shader with the given capabilities.
+fn compose(
+    composer: &mut Composer,
+    file: &str,
+    source: &str,
+    caps: Capabilities,
+) -> Result<(Module, ModuleInfo), String> {
+    let made = composer.make_naga_module(NagaModuleDescriptor {
+        source,
+        file_path: file,
+        shader_type: ShaderType::Wgsl,
+        ..Default::default()
+    });
+    let module = made.map_err(|e| e.emit_to_string(composer))?;
+    let info = Validator::new(ValidationFlags::all(), caps)
+        .subgroup_stages(ShaderStages::COMPUTE | ShaderStages::FRAGMENT)
+        .validate(&module)
+        .map_err(|e| format!("{file}: validation with {caps:?}: {e:?}"))?;
+    Ok((module, info))
+}
+
+/// A resource an entry point uses, as reflected from the module.
+#[derive(Debug)]
+struct Reflected {
+    name: String,
+    kind: Kind,
+}
+
+#[derive(Debug, PartialEq)]
+enum Kind {
+    Uniform { is_struct: bool },
+    Storage { access: StorageAccess, atomic: bool },
+    StorageTexture { access: StorageAccess },
+    Texture,
+    Sampler,
+    Other(String),
+}
+
+fn contains_atomic(module: &Module, ty: naga::Handle<naga::Type>) -> bool {
+    match &module.types[ty].inner {
+        TypeInner::Atomic(_) => true,
+        TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => {
+            contains_atomic(module, *base)
+        }
+        TypeInner::Struct { members, .. } => members.iter().any(|m| contains_atomic(module, m.ty)),
+        _ => false,
+    }
+}
+
+/// The group-0 resources the named entry points use, by binding number.
+fn reflect(
+    module: &Module,
+    info: &ModuleInfo,
+    entries: &[&str],
+) -> Result<BTreeMap<u32, Reflected>, String> {
+    let mut out = BTreeMap::new();
+    for (index, ep) in module.entry_points.iter().enumerate() {
+        if !entries.contains(&ep.name.as_str()) {
+            continue;
+        }
+        let uses = info.get_entry_point(index);
+        for (handle, var) in module.global_variables.iter() {
+            if uses[handle].is_empty() {
+                continue;
+            }
+            let Some(rb) = &var.binding else { continue };
+            let name = var.name.clone().unwrap_or_default();
+            if rb.group != 0 {
+                return Err(format!("`{name}` is in group {}, expected 0", rb.group));
+            }
+            let inner = &module.types[var.ty].inner;
+            let kind = match (var.space, inner) {
+                (AddressSpace::Uniform, inner) => Kind::Uniform {
+                    is_struct: matches!(inner, TypeInner::Struct { .. }),
+                },
+                (AddressSpace::Storage { access }, _) => Kind::Storage {
+                    access,
+                    atomic: contains_atomic(module, var.ty),
+                },
+                (AddressSpace::Handle, TypeInner::Image { class, .. }) => match class {
+                    ImageClass::Storage { access, .. } => Kind::StorageTexture { access: *access },
+                    _ => Kind::Texture,
+                },
+                (AddressSpace::Handle, TypeInner::Sampler { .. }) => Kind::Sampler,
+                (space, inner) => Kind::Other(format!("{space:?} {inner:?}")),
+            };
+            if let Some(prev) = out.get(&rb.binding) {
+                let prev: &Reflected = prev;
+                if prev.name != name {
+                    return Err(format!(
+                        "binding {} is both `{}` and `{name}`",
+                        rb.binding, prev.name
+                    ));
+                }
+                continue;
+            }
+            out.insert(rb.binding, Reflected { name, kind });
+        }
+    }
+    Ok(out)
+}
+
+fn access_matches(mode: AccessMode, kind: &Kind) -> bool {
+    let rw = StorageAccess::LOAD | StorageAccess::STORE;
+    match (mode, kind) {
+        (AccessMode::Read, Kind::Storage { access, .. }) => *access == StorageAccess::LOAD,
+        (AccessMode::Read, Kind::StorageTexture { access }) => *access == StorageAccess::LOAD,
+        (AccessMode::Read, Kind::Texture | Kind::Uniform { .. }) => true,
+        (AccessMode::Write, Kind::Storage { access, .. }) => *access == rw,
+        (AccessMode::Write, Kind::StorageTexture { access }) => {
+            access.contains(StorageAccess::STORE)
+        }
+        (AccessMode::Atomic, Kind::Storage { access, atomic }) => *access == rw && *atomic,
+        (AccessMode::Atomic, Kind::StorageTexture { access }) => *access == rw,
+        _ => false,
+    }
+}
+
+/// The shared records and their sizes on the Rust side.
+fn record_sizes() -> [(&'static str, usize); 6] {
+    use strandgraph_passes::kulikov::{ModelLod, tiles::ModelTiles};
+    [
+        ("FrameData", std::mem::size_of::<FrameData>()),
+        ("ModelData", std::mem::size_of::<ModelData>()),
+        ("LightData", std::mem::size_of::<LightData>()),
+        ("TriangleData", std::mem::size_of::<TriangleData>()),
+        ("ModelLod", ModelLod::WORDS * 4),
+        ("ModelTiles", ModelTiles::WORDS * 4),
+    ]
+}
+
+/// Structs of a module that carry a shared record's name (imported from
+/// layout.wgsl, or a copy) but not its size.
+fn record_size_errors(module: &Module) -> Vec<String> {
+    let mut layouter = naga::proc::Layouter::default();
+    if let Err(e) = layouter.update(module.to_ctx()) {
+        return vec![format!("layout: {e:?}")];
+    }
+    let mut errors = Vec::new();
+    for (handle, ty) in module.types.iter() {
+        let Some(name) = ty.name.as_deref() else {
+            continue;
+        };
+        for (record, size) in record_sizes() {
+            let decorated = Composer::decorated_name(Some("strandgraph::layout"), record);
+            if (name == record || name == decorated) && layouter[handle].size as usize != size {
+                errors.push(format!(
+                    "struct {record} is {} bytes, the Rust record {size}",
+                    layouter[handle].size
+                ));
+            }
+        }
+    }
+    errors
+}
+
+/// Checks one definition's shader; returns what is wrong with it.
+fn check_definition(composer: &mut Composer, def: &dyn PassDef) -> Result<(), String> {
+    let shader = def.shader();
+    let path = shaders_dir().join(shader.file);
+    let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let (module, info) = compose(composer, shader.file, &source, capabilities_of(shader.file))?;
+
+    let find = |name: &str| module.entry_points.iter().find(|ep| ep.name == name);
+    let entry = find(shader.entry).ok_or_else(|| format!("no entry point `{}`", shader.entry))?;
+    let mut entries = vec![shader.entry];
+    match shader.fragment {
+        None => {
+            if entry.stage != ShaderStage::Compute {
+                return Err(format!(
+                    "`{}` is {:?}, expected a compute entry",
+                    shader.entry, entry.stage
+                ));
+            }
+            let expected = [def.workgroup_size(), 1, 1];
+            if entry.workgroup_size != expected {
+                return Err(format!(
+                    "`{}` has @workgroup_size{:?}, the definition says {expected:?}",
+                    shader.entry, entry.workgroup_size
+                ));
+            }
+        }
+        Some(fragment) => {
+            if entry.stage != ShaderStage::Vertex {
+                return Err(format!(
+                    "`{}` is {:?}, expected a vertex entry",
+                    shader.entry, entry.stage
+                ));
+            }
+            let frag = find(fragment).ok_or_else(|| format!("no fragment entry `{fragment}`"))?;
+            if frag.stage != ShaderStage::Fragment {
+                return Err(format!(
+                    "`{fragment}` is {:?}, expected a fragment entry",
+                    frag.stage
+                ));
+            }
+            entries.push(fragment);
+        }
+    }
+
+    let used = reflect(&module, &info, &entries)?;
+    let mut errors = record_size_errors(&module);
+    let numbers: Vec<u32> = used.keys().copied().collect();
+    let expected_numbers: Vec<u32> = (0..numbers.len() as u32).collect();
+    if numbers != expected_numbers {
+        errors.push(format!(
+            "bindings in use are {numbers:?}, expected 0..{}",
+            numbers.len()
+        ));
+    }
+    // Binding 0 is the parameter block; without one, the resources are
+    // compared from binding 0 on, so every mismatch is reported at once.
+    let first = match used.values().next() {
+        Some(Reflected {
+            kind: Kind::Uniform { is_struct: true },
+            ..
+        }) => 1,
+        other => {
+            let found = other.map_or("nothing".to_string(), |r| {
+                format!("`{}` ({:?})", r.name, r.kind)
+            });
+            errors.push(format!(
+                "binding 0 must be the uniform struct of the pass parameters, found {found}"
+            ));
+            0
+        }
+    };
+    let resources: Vec<(u32, &Reflected)> = used.iter().skip(first).map(|(n, r)| (*n, r)).collect();
+    match def.bindings() {
+        Some(declared) => {
+            // A raster pass binds its declared resources up to its attachments
+            // (colour and depth targets are not bound), which come last.
+            let bound = if shader.fragment.is_some() {
+                resources.len().min(declared.len())
+            } else {
+                declared.len()
+            };
+            let declared = &declared[..bound];
+            if resources.len() != declared.len() {
+                let names: Vec<&str> = resources.iter().map(|(_, r)| r.name.as_str()).collect();
+                errors.push(format!(
+                    "{} bound resources after the parameters ({names:?}), the definition declares {}",
+                    resources.len(),
+                    declared.len()
+                ));
+            }
+            for (b, (number, r)) in declared.iter().zip(&resources) {
+                let want = b.name.replace('.', "_");
+                let prefixed = format!("{}_{want}", shader.entry);
+                if r.name != want && r.name != prefixed {
+                    errors.push(format!(
+                        "binding {number} is `{}`, expected `{want}`",
+                        r.name
+                    ));
+                }
+                if !access_matches(b.mode, &r.kind) {
+                    errors.push(format!(
+                        "binding {number} `{}` is {:?}, declared {:?}",
+                        r.name, r.kind, b.mode
+                    ));
+                }
+            }
+        }
+        // The pass binds whatever the graph gives it, one written resource at a time.
+        None => {
+            if resources.is_empty()
+                || !resources
+                    .iter()
+                    .all(|(_, r)| access_matches(AccessMode::Write, &r.kind))
+            {
+                errors.push(format!(
+                    "expected writable resources after the parameters, found {resources:?}"
+                ));
+            }
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors.join("; "))
+    }
+}
+
+#[test]
+fn every_definition_has_a_valid_shader_matching_its_interface() {
+    let mut composer = composer();
+    let mut checked = Vec::new();
+    let mut failures = Vec::new();
+    for kind in KINDS {
+        let Some(def) = Registry.definition(kind.name) else {
+            continue; // catalogued, not defined yet: backends refuse it
+        };
+        let file = def.shader().file;
+        match check_definition(&mut composer, def) {
+            Ok(()) => checked.push(format!("{} ({file})", kind.name)),
+            Err(e) => failures.push(format!("{} ({file}): {e}", kind.name)),
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} shader(s) do not match their definition:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    assert!(!checked.is_empty(), "no definition was checked");
+    eprintln!(
+        "checked {} definitions:\n{}",
+        checked.len(),
+        checked.join("\n")
+    );
+}
+
+/// Composes a probe that binds every shared record, so their layouts can be read.
+fn layout_probe(composer: &mut Composer) -> Module {
+    let source = "
+#import strandgraph::layout::{FrameData, ModelData, LightData, TriangleData, ModelLod, ModelTiles}
+@group(0) @binding(0) var<storage> frame: FrameData;
+@group(0) @binding(1) var<storage> models: array<ModelData>;
+@group(0) @binding(2) var<storage> lights: array<LightData>;
+@group(0) @binding(3) var<storage> triangles: array<TriangleData>;
+@group(0) @binding(4) var<storage> lods: array<ModelLod>;
+@group(0) @binding(5) var<storage> tiles: array<ModelTiles>;
+@compute @workgroup_size(1)
+fn probe() {
+    _ = frame.near;
+    _ = models[0].flags;
+    _ = lights[0].radiance;
+    _ = triangles[0].mesh;
+    _ = lods[0].strands;
+    _ = tiles[0].valid;
+}
+";
+    compose(composer, "layout_probe.wgsl", source, BASE)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0
+}
+
+#[test]
+fn shared_layout_matches_the_rust_records() {
+    let mut composer = composer();
+    let module = layout_probe(&mut composer);
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let size_of_wgsl = |name: &str| {
+        let decorated = Composer::decorated_name(Some("strandgraph::layout"), name);
+        let (handle, _) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(&decorated) || t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("layout.wgsl has no struct {name}"));
+        layouter[handle].size as usize
+    };
+    let expected = record_sizes();
+    for (name, size) in expected {
+        assert_eq!(size_of_wgsl(name), size, "WGSL {name} vs the Rust record");
+    }
+}
+
+/// Field offsets the CPU kernels decode by word index must match the WGSL structs.
+#[test]
+fn shared_layout_field_offsets_match() {
+    let mut composer = composer();
+    let module = layout_probe(&mut composer);
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).unwrap();
+    let offsets = |name: &str| -> BTreeMap<String, u32> {
+        let decorated = Composer::decorated_name(Some("strandgraph::layout"), name);
+        let ty = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(&decorated))
+            .unwrap_or_else(|| panic!("layout.wgsl has no struct {name}"))
+            .1;
+        let TypeInner::Struct { members, .. } = &ty.inner else {
+            panic!("{name} is not a struct")
+        };
+        members
+            .iter()
+            .map(|m| (m.name.clone().unwrap(), m.offset))
+            .collect()
+    };
+    let frame = offsets("FrameData");
+    assert_eq!(
+        (
+            frame["camera_pos"],
+            frame["screen"],
+            frame["near"],
+            frame["pixels_per_unit"],
+            frame["_pad"]
+        ),
+        (
+            std::mem::offset_of!(FrameData, camera_pos) as u32,
+            std::mem::offset_of!(FrameData, screen) as u32,
+            std::mem::offset_of!(FrameData, near) as u32,
+            std::mem::offset_of!(FrameData, pixels_per_unit) as u32,
+            std::mem::offset_of!(FrameData, _pad) as u32,
+        )
+    );
+    let model = offsets("ModelData");
+    for (field, rust) in [
+        ("bounds_min", std::mem::offset_of!(ModelData, bounds_min)),
+        (
+            "strand_first",
+            std::mem::offset_of!(ModelData, strand_first),
+        ),
+        ("flags", std::mem::offset_of!(ModelData, flags)),
+        (
+            "mesh_rotation",
+            std::mem::offset_of!(ModelData, mesh_rotation),
+        ),
+        ("color", std::mem::offset_of!(ModelData, color)),
+        (
+            "fedora_sphere",
+            std::mem::offset_of!(ModelData, fedora_sphere),
+        ),
+        (
+            "min_fraction",
+            std::mem::offset_of!(ModelData, min_fraction),
+        ),
+    ] {
+        assert_eq!(model[field] as usize, rust, "ModelData.{field}");
+    }
+    let tri = offsets("TriangleData");
+    assert_eq!(
+        tri["mesh"] as usize,
+        std::mem::offset_of!(TriangleData, mesh)
+    );
+    let light = offsets("LightData");
+    assert_eq!(
+        light["radiance"] as usize,
+        std::mem::offset_of!(LightData, radiance)
+    );
+    // The 8-word records, word by word (ModelLod::load, ModelTiles::load).
+    let lod = offsets("ModelLod");
+    let words: Vec<u32> = [
+        "strands",
+        "vertex_step",
+        "thickness_scale",
+        "segments_per_strand",
+        "strand_prefix",
+        "depth_near",
+        "depth_far",
+    ]
+    .iter()
+    .map(|f| lod[*f] / 4)
+    .collect();
+    assert_eq!(words, vec![0, 1, 2, 3, 4, 5, 6]);
+    let tiles = offsets("ModelTiles");
+    let words: Vec<u32> = [
+        "first_tile",
+        "grid_w",
+        "grid_h",
+        "origin_x",
+        "origin_y",
+        "downscale",
+        "valid",
+    ]
+    .iter()
+    .map(|f| tiles[*f] / 4)
+    .collect();
+    assert_eq!(words, vec![0, 1, 2, 3, 4, 5, 6]);
+}

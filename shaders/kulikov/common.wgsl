@@ -1,0 +1,289 @@
+// Helpers every Kulikov kernel shares, ported operation for operation from
+// passes/src/kulikov/{mod,payload,cull}.rs and raster/geometry.rs, so that
+// GPU results can be diffed bit for bit against the CPU kernels (up to FMA
+// contraction, which WGSL leaves to the implementation).
+//   #import strandgraph::kulikov::{...}
+#define_import_path strandgraph::kulikov
+// (naga_oil: identifiers of a composable module must not end in a digit.)
+
+#import strandgraph::layout::{ModelData, ModelLod, ModelTiles}
+
+// Atlas tile edge in texels (kulikov::TILE) and texels per tile.
+const TILE: u32 = 64u;
+const TILE_TEXELS: u32 = 4096u;
+// Payload: depth10 << 22 | segment (kulikov::payload).
+const SEGMENT_BITS: u32 = 22u;
+const SEGMENT_MASK: u32 = 0x3FFFFFu;
+const MAX_SEGMENTS_PER_MODEL: u32 = 0x400000u;
+const DEPTH_LEVELS: u32 = 1024u;
+// An empty visibility texel (the clear value).
+const EMPTY: u32 = 0xFFFFFFFFu;
+const COVERAGE_SCALE: f32 = 1024.0;
+// Ordered visibility layers.
+const LAYERS: u32 = 3u;
+// Hi-Z block edge (kulikov::hiz::FACTOR).
+const HIZ_FACTOR: u32 = 16u;
+// Sub-pixel snap grid (raster::geometry::SNAP).
+const SNAP: f32 = 256.0;
+// f32::MAX and f32::MIN.
+const F32_MAX: f32 = 3.40282347e38;
+const F32_MIN: f32 = -3.40282347e38;
+
+// Rust's f32::round: halves away from zero (WGSL's round() goes to even).
+// x - trunc(x) is exact, so this is exact for every finite x.
+fn round_away(x: f32) -> f32 {
+    let t = trunc(x);
+    if abs(x - t) >= 0.5 {
+        return t + sign(x);
+    }
+    return t;
+}
+
+// ModelLod::load (a vertex step of 0 reads as 1).
+fn load_lod(l: ModelLod) -> ModelLod {
+    var out = l;
+    out.vertex_step = max(l.vertex_step, 1u);
+    return out;
+}
+
+// ModelTiles::load (a downscale of 0 reads as 1).
+fn load_tiles(t: ModelTiles) -> ModelTiles {
+    var out = t;
+    out.downscale = max(t.downscale, 1u);
+    return out;
+}
+
+// kulikov::transform: column-major 4x4 times a point, summed in column order.
+fn transform(m: mat4x4<f32>, p: vec4<f32>) -> vec4<f32> {
+    return m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] * p.w;
+}
+
+// kulikov::clip_to_screen: pixels (y down) and NDC depth.
+fn clip_to_screen(c: vec4<f32>, width: f32, height: f32) -> vec3<f32> {
+    let iw = 1.0 / c.w;
+    return vec3<f32>((c.x * iw * 0.5 + 0.5) * width, (0.5 - c.y * iw * 0.5) * height, c.z * iw);
+}
+
+// Drawn segments per strand of `points` points at a vertex step.
+fn drawn_segments(points: u32, step: u32) -> u32 {
+    let s = max(step, 1u);
+    let n = select(0u, points - 1u, points >= 1u);
+    return (n + s - 1u) / s;
+}
+
+// Scene::segment_model: whether global segment `id` belongs to model `m`.
+fn segment_in_model(m: ModelData, id: u32) -> bool {
+    let per = select(0u, m.points_per_strand - 1u, m.points_per_strand >= 1u);
+    let count = m.strand_count * per;
+    return id >= m.segment_first && id < m.segment_first + count;
+}
+
+// cull::DrawnSegment: both vertices' global indices and the model-local index.
+struct DrawnSegment {
+    valid: bool,
+    model: u32,
+    local: u32,
+    // Global vertex indices of the two ends.
+    va: u32,
+    vb: u32,
+}
+
+// cull::drawn_segment for a segment already known to lie in model `model`.
+fn drawn_in_model(md: ModelData, lod: ModelLod, model: u32, id: u32) -> DrawnSegment {
+    var out = DrawnSegment(false, model, id - md.segment_first, 0u, 0u);
+    let per = md.points_per_strand - 1u;
+    let strand = out.local / per;
+    let k = out.local % per;
+    if strand >= lod.strands || k >= lod.segments_per_strand {
+        return out;
+    }
+    // ModelLod::segment_vertices.
+    let a = k * lod.vertex_step;
+    let b = min(a + lod.vertex_step, md.points_per_strand - 1u);
+    let base = md.vertex_first + strand * md.points_per_strand;
+    out.valid = true;
+    out.va = base + a;
+    out.vb = base + b;
+    return out;
+}
+
+// cull::screen_bin: the 64x64 screen tile of the segment's midpoint.
+fn screen_bin(w: f32, h: f32, sa: vec3<f32>, sb: vec3<f32>) -> u32 {
+    let x = u32(clamp(0.5 * (sa.x + sb.x), 0.0, w - 1.0));
+    let y = u32(clamp(0.5 * (sa.y + sb.y), 0.0, h - 1.0));
+    return y / TILE * ((u32(w) + TILE - 1u) / TILE) + x / TILE;
+}
+
+// ModelTiles::texel: the atlas texel of screen pixel (x, y), or EMPTY.
+fn tile_texel(t: ModelTiles, x: u32, y: u32) -> u32 {
+    if t.valid == 0u {
+        return EMPTY;
+    }
+    let u = x / t.downscale;
+    let v = y / t.downscale;
+    if u < t.origin_x * TILE || v < t.origin_y * TILE {
+        return EMPTY;
+    }
+    let uu = u - t.origin_x * TILE;
+    let vv = v - t.origin_y * TILE;
+    let tx = uu / TILE;
+    let ty = vv / TILE;
+    if tx >= t.grid_w || ty >= t.grid_h {
+        return EMPTY;
+    }
+    return (t.first_tile + ty * t.grid_w + tx) * TILE * TILE + (vv % TILE) * TILE + uu % TILE;
+}
+
+// payload::quantize_depth: linear view depth normalised to the model's range, 10 bits.
+fn quantize_depth(view_depth: f32, near: f32, far: f32) -> u32 {
+    let t = clamp((view_depth - near) / max(far - near, 1e-6), 0.0, 1.0);
+    return min(u32(round_away(t * f32(DEPTH_LEVELS - 1u))), DEPTH_LEVELS - 1u);
+}
+
+fn pack_payload(depth_q: u32, segment: u32) -> u32 {
+    return (depth_q << SEGMENT_BITS) | (segment & SEGMENT_MASK);
+}
+
+fn depth_of(payload: u32) -> u32 {
+    return payload >> SEGMENT_BITS;
+}
+
+// payload::total_coverage: Kulikov's quadratic fit from additive coverage.
+fn total_coverage(additive: u32) -> f32 {
+    let x = f32(additive) / COVERAGE_SCALE;
+    return clamp(x - 0.5 * x * clamp(0.5 * x, 0.0, 1.0), 0.0, 1.0);
+}
+
+// payload::linear_depth: view depth from NDC depth of perspective_rh.
+fn linear_depth(z_ndc: f32, near: f32, far: f32) -> f32 {
+    return near * far / (far - z_ndc * (far - near));
+}
+
+// raster::geometry::snap.
+fn snap(x: f32) -> f32 {
+    return round_away(x * SNAP) / SNAP;
+}
+
+// raster::geometry::Poly: a convex polygon of at most 8 vertices.
+struct Poly {
+    pts: array<vec2<f32>, 8>,
+    n: u32,
+}
+
+// Poly::clip: keeps sign * (p[axis] - at) >= 0 (one Sutherland-Hodgman plane).
+fn poly_clip(src: Poly, axis: u32, at: f32, sign: f32) -> Poly {
+    var s = src;
+    var out: Poly;
+    out.n = 0u;
+    for (var i = 0u; i < s.n; i++) {
+        let a = s.pts[i];
+        let b = s.pts[(i + 1u) % s.n];
+        let ia = sign * (a[axis] - at) >= 0.0;
+        let ib = sign * (b[axis] - at) >= 0.0;
+        if ia && out.n < 8u {
+            out.pts[out.n] = a;
+            out.n += 1u;
+        }
+        if ia != ib && out.n < 8u {
+            let t = (at - a[axis]) / (b[axis] - a[axis]);
+            out.pts[out.n] = vec2<f32>(a.x + t * (b.x - a.x), a.y + t * (b.y - a.y));
+            out.n += 1u;
+        }
+    }
+    return out;
+}
+
+// Poly::strip: the part within lo <= p[axis] <= hi.
+fn poly_strip(p: Poly, axis: u32, lo: f32, hi: f32) -> Poly {
+    return poly_clip(poly_clip(p, axis, lo, 1.0), axis, hi, -1.0);
+}
+
+// Poly::area (shoelace, summed in vertex order).
+fn poly_area(src: Poly) -> f32 {
+    var p = src;
+    var twice = 0.0;
+    for (var i = 0u; i < p.n; i++) {
+        let a = p.pts[i];
+        let b = p.pts[(i + 1u) % p.n];
+        twice += a.x * b.y - b.x * a.y;
+    }
+    return 0.5 * abs(twice);
+}
+
+// Poly::range: (min, max) of one coordinate.
+fn poly_range(src: Poly, axis: u32) -> vec2<f32> {
+    var p = src;
+    var r = vec2<f32>(F32_MAX, F32_MIN);
+    for (var i = 0u; i < p.n; i++) {
+        r = vec2<f32>(min(r.x, p.pts[i][axis]), max(r.y, p.pts[i][axis]));
+    }
+    return r;
+}
+
+// raster::geometry::Trapezoid: a projected segment in raster pixels.
+struct Trapezoid {
+    valid: bool,
+    a: vec2<f32>,
+    b: vec2<f32>,
+    wa: f32,
+    wb: f32,
+    quad: Poly,
+}
+
+// Trapezoid::new: snapped ends and half widths; invalid when degenerate.
+fn trapezoid_new(a_in: vec2<f32>, b_in: vec2<f32>, half_a: f32, half_b: f32, wa: f32, wb: f32) -> Trapezoid {
+    var t: Trapezoid;
+    t.valid = false;
+    t.a = vec2<f32>(snap(a_in.x), snap(a_in.y));
+    t.b = vec2<f32>(snap(b_in.x), snap(b_in.y));
+    t.wa = wa;
+    t.wb = wb;
+    let ha = max(snap(half_a), 1.0 / SNAP);
+    let hb = max(snap(half_b), 1.0 / SNAP);
+    let d = vec2<f32>(t.b.x - t.a.x, t.b.y - t.a.y);
+    let len = sqrt(d.x * d.x + d.y * d.y);
+    // !(len > 1/SNAP) || !len.is_finite(); NaN fails the first test.
+    if !(len > 1.0 / SNAP) || len > F32_MAX {
+        return t;
+    }
+    let n = vec2<f32>(-d.y / len, d.x / len);
+    t.quad.n = 4u;
+    t.quad.pts[0] = vec2<f32>(t.a.x + n.x * ha, t.a.y + n.y * ha);
+    t.quad.pts[1] = vec2<f32>(t.b.x + n.x * hb, t.b.y + n.y * hb);
+    t.quad.pts[2] = vec2<f32>(t.b.x - n.x * hb, t.b.y - n.y * hb);
+    t.quad.pts[3] = vec2<f32>(t.a.x - n.x * ha, t.a.y - n.y * ha);
+    t.valid = true;
+    return t;
+}
+
+// Trapezoid::column: the part over pixel column x (Kulikov's TrapezoidSlice).
+fn trapezoid_column(quad: Poly, x: i32) -> Poly {
+    return poly_strip(quad, 0u, f32(x), f32(x) + 1.0);
+}
+
+// Trapezoid::coverage: exact area inside pixel (x, y) of a column slice.
+fn column_coverage(column: Poly, y: i32) -> f32 {
+    return min(poly_area(poly_strip(column, 1u, f32(y), f32(y) + 1.0)), 1.0);
+}
+
+// Trapezoid::depth_at: view depth at the pixel centre projected on the axis.
+fn trapezoid_depth_at(a: vec2<f32>, b: vec2<f32>, wa: f32, wb: f32, x: i32, y: i32) -> f32 {
+    let p = vec2<f32>(f32(x) + 0.5, f32(y) + 0.5);
+    let d = vec2<f32>(b.x - a.x, b.y - a.y);
+    let t = ((p.x - a.x) * d.x + (p.y - a.y) * d.y) / (d.x * d.x + d.y * d.y);
+    let tc = clamp(t, 0.0, 1.0);
+    return wa + tc * (wb - wa);
+}
+
+// raster::morton: interleaved bits of x (even) and y (odd), 16 bits each.
+fn morton_spread(v_in: u32) -> u32 {
+    var v = v_in & 0xFFFFu;
+    v = (v | (v << 8u)) & 0x00FF00FFu;
+    v = (v | (v << 4u)) & 0x0F0F0F0Fu;
+    v = (v | (v << 2u)) & 0x33333333u;
+    return (v | (v << 1u)) & 0x55555555u;
+}
+
+fn morton_code(x: u32, y: u32) -> u32 {
+    return morton_spread(x) | (morton_spread(y) << 1u);
+}

@@ -1,0 +1,90 @@
+// kulikov.sort_scan (`scan`) and kulikov.sort (`scatter`): a global counting
+// sort of visible segments into 64x64 screen buckets.
+// Port of passes/src/kulikov/sort.rs.
+
+#import strandgraph::layout::{FrameData, ModelData, ModelLod}
+#import strandgraph::kulikov::{clip_to_screen, load_lod, segment_in_model, drawn_in_model, DrawnSegment, screen_bin, TILE}
+
+struct SortParams {
+    // kulikov.sort `enabled` (scatter only).
+    enabled: u32,
+    // Scene quantities: segments in the full numbering, and sort bins
+    // (64x64 screen tiles); the word after the bins is the arrival counter.
+    segments: u32,
+    bins: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: SortParams;
+
+// --- scan: sort_bins, sort_offsets, raster_args ---
+// Both entry points bind `sort_offsets` at different numbers (binding 2
+// written here, binding 6 atomic in scatter), so this one carries the
+// entry point as a prefix (`scan_sort_offsets`); passes/tests/wgsl.rs
+// accepts `<entry>_<binding>` names for that reason.
+@group(0) @binding(1) var<storage, read> sort_bins: array<u32>;
+@group(0) @binding(2) var<storage, read_write> scan_sort_offsets: array<u32>;
+@group(0) @binding(3) var<storage, read_write> raster_args: array<u32>;
+
+// Raster workgroup size (raster::GROUP).
+const RASTER_GROUP: u32 = 256u;
+
+@compute @workgroup_size(1)
+fn scan() {
+    let bins = params.bins;
+    var sum = 0u;
+    for (var b = 0u; b < bins; b++) {
+        scan_sort_offsets[b] = sum;
+        sum += sort_bins[b];
+    }
+    // Header after the bins: the arrival counter the unsorted variant uses.
+    scan_sort_offsets[bins] = 0u;
+    raster_args[0] = (sum + RASTER_GROUP - 1u) / RASTER_GROUP;
+    raster_args[1] = 1u;
+    raster_args[2] = 1u;
+    raster_args[3] = sum;
+}
+
+// --- scatter: frame, models, lod_models, clip_positions, segment_visibility,
+// sort_offsets, sorted_segments ---
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> models: array<ModelData>;
+@group(0) @binding(3) var<storage, read> lod_models: array<ModelLod>;
+@group(0) @binding(4) var<storage, read> clip_positions: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> segment_visibility: array<u32>;
+@group(0) @binding(6) var<storage, read_write> sort_offsets: array<atomic<u32>>;
+@group(0) @binding(7) var<storage, read_write> sorted_segments: array<u32>;
+
+const GROUP: u32 = 256u;
+
+fn drawn_segment(id: u32) -> DrawnSegment {
+    for (var m = 0u; m < frame.model_count; m++) {
+        let md = models[m];
+        if segment_in_model(md, id) {
+            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
+        }
+    }
+    return DrawnSegment(false, 0u, 0u, 0u, 0u);
+}
+
+@compute @workgroup_size(256)
+fn scatter(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let id = wg.x * GROUP + lane;
+    if id >= params.segments || (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
+        return;
+    }
+    var slot = 0u;
+    if params.enabled != 0u {
+        let seg = drawn_segment(id);
+        if !seg.valid {
+            return;
+        }
+        let w = frame.screen.x;
+        let h = frame.screen.y;
+        let s0 = clip_to_screen(clip_positions[seg.va], w, h);
+        let s1 = clip_to_screen(clip_positions[seg.vb], w, h);
+        slot = atomicAdd(&sort_offsets[screen_bin(w, h, s0, s1)], 1u);
+    } else {
+        slot = atomicAdd(&sort_offsets[params.bins], 1u);
+    }
+    sorted_segments[slot] = id;
+}
