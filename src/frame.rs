@@ -55,3 +55,31 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     };
     Ok((parse(w)?, parse(h)?))
 }
+
+/// Applies `PASS.PARAM=VALUE` (VALUE in RON: `false`, `64`, `"Baked"`) to a
+/// compiled plan: how ablations run without editing the graph file.
+pub fn override_param(plan: &mut Plan, spec: &str) -> Result<()> {
+    let bad = || {
+        miette::miette!(
+            "--param {spec}: expected PASS.PARAM=VALUE, e.g. raster.loop_flattening=false"
+        )
+    };
+    let (target, value) = spec.split_once('=').ok_or_else(bad)?;
+    let (pass, param) = target.split_once('.').ok_or_else(bad)?;
+    let value: ron::Value = ron::from_str(value.trim())
+        .map_err(|e| miette::miette!("--param {spec}: value is not RON: {e}"))?;
+    let p = plan.graph.pass_id(pass.trim()).ok_or_else(|| {
+        miette::miette!(
+            "--param {spec}: graph `{}` has no pass `{pass}`",
+            plan.graph.name
+        )
+    })?;
+    let params = &mut plan.graph.passes[p].params;
+    if !matches!(params, ron::Value::Map(_)) {
+        *params = ron::Value::Map(ron::Map::new());
+    }
+    if let ron::Value::Map(m) = params {
+        m.insert(ron::Value::String(param.trim().to_string()), value);
+    }
+    Ok(())
+}

@@ -3,7 +3,7 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::PathBuf;
 use std::time::Instant;
-use strandgraph::frame::{parse_size, prepare};
+use strandgraph::frame::{override_param, parse_size, prepare};
 use strandgraph::images::to_picture;
 use strandgraph_cpu::{CpuBackend, PassTiming};
 use strandgraph_graph::Plan;
@@ -40,6 +40,10 @@ pub struct Args {
     /// Give every transient its own memory instead of the plan's aliasing.
     #[arg(long)]
     pub no_alias: bool,
+    /// Override a pass parameter, as PASS.PARAM=VALUE (repeatable), e.g.
+    /// `--param raster.loop_flattening=false`.
+    #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
+    pub params: Vec<String>,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -50,7 +54,10 @@ pub fn run(args: Args) -> Result<()> {
     }
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let t0 = Instant::now();
-    let p = prepare(&args.scene, args.graph.as_deref(), size)?;
+    let mut p = prepare(&args.scene, args.graph.as_deref(), size)?;
+    for spec in &args.params {
+        override_param(&mut p.plan, spec)?;
+    }
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",

@@ -277,6 +277,7 @@ mod tests {
         ]);
         let mut p = params();
         p.segments_per_tile = u32::MAX / 4096; // isolate the cap
+        p.segment_budget = u32::MAX;
         let l = choose(&p, &s);
         assert_eq!(l[0].strands, 65536);
         assert_eq!(l[1].strands, 3_000, "small models are not reduced");
@@ -302,6 +303,7 @@ mod tests {
             .collect();
         let mut p = params();
         p.max_strands = 1 << 20;
+        p.segments_per_tile = u32::MAX / 4096; // close-ups: the budget is what binds
         let l = choose(&p, &scene(models));
         let total: u64 = l
             .iter()

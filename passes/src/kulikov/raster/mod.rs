@@ -361,3 +361,6 @@ impl CpuKernel for RasterKernel {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,170 @@
+//! The Kulikov visibility pipeline end to end on the CPU backend.
+
+use std::path::Path;
+use std::process::Command;
+use strandgraph::frame::{Prepared, prepare};
+use strandgraph_cpu::{CpuBackend, Frame};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn visibility(scene: &str, w: u32, h: u32) -> Prepared {
+    let graph = root().join("scenes/graphs/kulikov_visibility.ron");
+    prepare(&root().join(scene), Some(&graph), Some((w, h))).unwrap_or_else(|e| panic!("{e:?}"))
+}
+
+fn run(p: &Prepared, backend: &CpuBackend) -> Frame {
+    let f = backend
+        .execute(&p.plan, &p.instance, &p.upload)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        f.memory
+            .out_of_bounds
+            .load(std::sync::atomic::Ordering::Relaxed),
+        0,
+        "out-of-range accesses"
+    );
+    f
+}
+
+fn covered_texels(p: &Prepared, f: &Frame) -> usize {
+    f.read(&p.plan, "coverage_atlas")
+        .unwrap()
+        .iter()
+        .filter(|&&c| c > 0)
+        .count()
+}
+
+#[test]
+fn showcase_rasterizes_hair_over_the_head() {
+    let p = visibility("scenes/showcase.ron", 320, 180);
+    let f = run(&p, &CpuBackend::default());
+    assert!(
+        covered_texels(&p, &f) > 5_000,
+        "too little hair: {}",
+        covered_texels(&p, &f)
+    );
+    // The debug view differs from the opaque image exactly where hair is.
+    let layers = f.read(&p.plan, "debug_layers").unwrap();
+    let hair = layers.iter().filter(|&&w| w >> 24 > 0).count();
+    assert!(hair > 3_000 && hair < 320 * 180, "{hair} hair pixels");
+    // Every model got atlas tiles at full resolution.
+    let tiles = f.read(&p.plan, "atlas_tiles").unwrap();
+    for m in 0..p.upload.models.len() {
+        assert_eq!(
+            (tiles[8 * m + 5], tiles[8 * m + 6]),
+            (1, 1),
+            "model {m}: downscale, valid"
+        );
+    }
+}
+
+#[test]
+fn crowd_renders_every_visible_character() {
+    let p = visibility("scenes/crowd.ron", 320, 180);
+    assert!(p.upload.models.len() >= 12);
+    let f = run(
+        &p,
+        &CpuBackend {
+            subgroup_width: 8,
+            ..CpuBackend::default()
+        },
+    );
+    let tiles = f.read(&p.plan, "atlas_tiles").unwrap();
+    let drawn = (0..p.upload.models.len())
+        .filter(|m| tiles[8 * m + 6] == 1)
+        .count();
+    assert!(drawn >= 6, "only {drawn} models reached the atlas");
+    assert!(covered_texels(&p, &f) > 2_000);
+}
+
+#[test]
+fn aliasing_plan_does_not_change_the_frame() {
+    let p = visibility("scenes/showcase.ron", 256, 144);
+    assert!(p.instance.memory.bytes_with_aliasing < p.instance.memory.bytes_without_aliasing);
+    let aliased = run(&p, &CpuBackend::default());
+    let separate = run(
+        &p,
+        &CpuBackend {
+            alias: false,
+            ..CpuBackend::default()
+        },
+    );
+    for r in [
+        "vis_atlas",
+        "coverage_atlas",
+        "output",
+        "debug_layers",
+        "atlas_tiles",
+    ] {
+        assert_eq!(
+            aliased.read(&p.plan, r),
+            separate.read(&p.plan, r),
+            "{r} differs"
+        );
+    }
+}
+
+#[test]
+fn render_command_writes_pngs_and_a_timing_table() {
+    let dir = std::env::temp_dir().join(format!("strandgraph-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("showcase.png");
+    let o = Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+        .current_dir(root())
+        .args([
+            "render",
+            "scenes/showcase.ron",
+            "--graph",
+            "scenes/graphs/kulikov_visibility.ron",
+        ])
+        .args([
+            "--size",
+            "200x120",
+            "--instrument",
+            "--param",
+            "raster.loop_flattening=false",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success(),
+        "{text}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        text.contains("kulikov.raster") && text.contains("async-compute  total"),
+        "{text}"
+    );
+    let img = image::open(&out).unwrap();
+    assert_eq!((img.width(), img.height()), (200, 120));
+    assert!(out.with_extension("debug_layers.png").exists());
+}
+
+#[test]
+fn render_rejects_a_bad_parameter_by_name() {
+    let o = Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+        .current_dir(root())
+        .args([
+            "render",
+            "scenes/showcase.ron",
+            "--graph",
+            "scenes/graphs/kulikov_visibility.ron",
+        ])
+        .args([
+            "--size",
+            "64x64",
+            "--param",
+            "raster.workgroup_size=128",
+            "-o",
+            "/dev/null",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("workgroup_size"));
+}
