@@ -109,7 +109,8 @@ impl Trapezoid {
         let (ha, hb) = (snap(half_a).max(1.0 / SNAP), snap(half_b).max(1.0 / SNAP));
         let d = [b[0] - a[0], b[1] - a[1]];
         let len = (d[0] * d[0] + d[1] * d[1]).sqrt();
-        if !(len > 1.0 / SNAP) || !len.is_finite() {
+        // Written so that NaN lengths are rejected too.
+        if len.is_nan() || len <= 1.0 / SNAP || !len.is_finite() {
             return None;
         }
         let n = [-d[1] / len, d[0] / len];
