@@ -426,6 +426,11 @@ fn every_definition_has_a_valid_shader_matching_its_interface() {
             Err(e) => failures.push(format!("{} ({file}): {e}", kind.name)),
         }
     }
+    eprintln!(
+        "{} definitions match their shader:\n{}",
+        checked.len(),
+        checked.join("\n")
+    );
     assert!(
         failures.is_empty(),
         "{} shader(s) do not match their definition:\n{}",
@@ -433,11 +438,6 @@ fn every_definition_has_a_valid_shader_matching_its_interface() {
         failures.join("\n")
     );
     assert!(!checked.is_empty(), "no definition was checked");
-    eprintln!(
-        "checked {} definitions:\n{}",
-        checked.len(),
-        checked.join("\n")
-    );
 }
 
 /// Composes a probe that binds every shared record, so their layouts can be read.
