@@ -371,6 +371,12 @@ fn morton_sort(seg_in: Segment, index: u32, first: u32) -> Segment {
     return seg;
 }
 
+// A pixel is written when its coverage quantises to at least 1/1024: slivers
+// thinner than that are float noise that backends need not agree on.
+fn covers(coverage: f32) -> bool {
+    return round(coverage * 1024.0) >= 1.0;
+}
+
 @compute @workgroup_size(256)
 fn raster(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -441,7 +447,7 @@ fn raster(
             var req: Request;
             if alive {
                 let coverage = column_coverage(col, y);
-                if coverage > 0.0 {
+                if covers(coverage) {
                     has = true;
                     req = pixel_request(seg, x, y, coverage);
                 }
@@ -492,7 +498,7 @@ fn raster(
                 var req: Request;
                 if busy {
                     let coverage = column_coverage(col, y);
-                    if coverage > 0.0 {
+                    if covers(coverage) {
                         has = true;
                         req = pixel_request(seg, x, y, coverage);
                     }

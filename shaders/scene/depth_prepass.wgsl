@@ -8,37 +8,18 @@
 //
 // Bindings (group 0), in the order of the pass's bindings less its attachments,
 // every record a storage buffer (as shaders/common/layout.wgsl assumes):
-// 0 = frame, 1 = mesh.triangles.
+// 0 = the parameter block, 1 = frame, 2 = mesh.triangles.
 //
-// The structs mirror passes/src/layout.rs (and shaders/common/layout.wgsl)
-// field for field; naga reports the same sizes and offsets as the Rust structs.
+#import strandgraph::layout::{FrameData, TriangleData}
 
-// FrameData (256 bytes).
-struct FrameData {
-    view_proj: mat4x4<f32>,
-    inv_view_proj: mat4x4<f32>,
-    camera_pos: vec4<f32>,
-    screen: vec4<f32>,
-    near: f32,
-    far: f32,
-    model_count: u32,
-    light_count: u32,
-    pixels_per_unit: f32,
-    _pad: array<u32, 19>,
+// The pass has no parameters; the block keeps binding 0 the same for every pass.
+struct DepthPrepassParams {
+    unused: u32,
 }
 
-// TriangleData (64 bytes). Each corner's w holds its
-// octahedral-packed smooth normal as raw bits (unused here).
-struct TriangleData {
-    a: vec4<f32>,
-    b: vec4<f32>,
-    c: vec4<f32>,
-    mesh: u32,
-    _pad: array<u32, 3>,
-}
-
-@group(0) @binding(0) var<storage, read> frame: FrameData;
-@group(0) @binding(1) var<storage, read> triangles: array<TriangleData>;
+@group(0) @binding(0) var<uniform> params: DepthPrepassParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> mesh_triangles: array<TriangleData>;
 
 struct VertexOut {
     // Invariant: scene.opaque recomputes the same position and tests depth
@@ -58,7 +39,9 @@ fn clip_corner(t: TriangleData, k: u32) -> vec4<f32> {
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
-    let t = triangles[vertex / 3u];
+    // Keeps the (empty) parameter block bound, as every pass's is.
+    _ = params.unused;
+    let t = mesh_triangles[vertex / 3u];
     let clip_a = clip_corner(t, 0u);
     let clip_b = clip_corner(t, 1u);
     let clip_c = clip_corner(t, 2u);

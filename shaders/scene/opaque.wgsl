@@ -8,54 +8,22 @@
 //
 // Bindings (group 0), in the order of the pass's bindings less its attachments,
 // every record a storage buffer: 0 = frame, 1 = mesh.triangles, 2 = lights.
-// Parameters are pipeline-overridable constants (OpaqueParams::pipeline_constants).
+// Parameters are the uniform block at binding 0 (OpaqueParams::uniform).
 //
-// The structs mirror passes/src/layout.rs (and shaders/common/layout.wgsl)
-// field for field; naga reports the same sizes and offsets as the Rust structs.
+#import strandgraph::layout::{FrameData, TriangleData, LightData}
 
-// FrameData (256 bytes).
-struct FrameData {
-    view_proj: mat4x4<f32>,
-    inv_view_proj: mat4x4<f32>,
-    camera_pos: vec4<f32>,
-    screen: vec4<f32>,
-    near: f32,
-    far: f32,
-    model_count: u32,
-    light_count: u32,
-    pixels_per_unit: f32,
-    _pad: array<u32, 19>,
+// passes/src/scene/opaque.rs: OpaqueParams. `background` is the colour
+// attachment's clear value, not a shader input.
+struct OpaqueParams {
+    // rgb: albedo; a: ambient.
+    albedo_ambient: vec4<f32>,
 }
 
-// TriangleData (64 bytes). Each corner's w holds its
-// smooth normal, octahedral-packed (assets/src/octahedral.rs), as raw bits:
-// only ever bitcast, never used as a float, so the bits survive.
-struct TriangleData {
-    a: vec4<f32>,
-    b: vec4<f32>,
-    c: vec4<f32>,
-    mesh: u32,
-    _pad: array<u32, 3>,
-}
+@group(0) @binding(0) var<uniform> params: OpaqueParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> mesh_triangles: array<TriangleData>;
+@group(0) @binding(3) var<storage, read> lights: array<LightData>;
 
-// LightData (64 bytes). w = 0: xyz is the direction
-// the light travels; w = 1: xyz is a point light's position.
-struct LightData {
-    position_or_direction: vec4<f32>,
-    radiance: vec4<f32>,
-    _pad: array<u32, 8>,
-}
-
-@group(0) @binding(0) var<storage, read> frame: FrameData;
-@group(0) @binding(1) var<storage, read> triangles: array<TriangleData>;
-@group(0) @binding(2) var<storage, read> lights: array<LightData>;
-
-// passes/src/scene/opaque.rs: OpaqueParams (defaults equal the Rust ones).
-// `background` is the colour attachment's clear value, not a shader input.
-override albedo_r: f32 = 0.75;
-override albedo_g: f32 = 0.55;
-override albedo_b: f32 = 0.45;
-override ambient: f32 = 0.05;
 
 const PI: f32 = 3.14159265358979;
 
@@ -100,7 +68,7 @@ fn corner(t: TriangleData, k: u32) -> vec4<f32> {
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
-    let t = triangles[vertex / 3u];
+    let t = mesh_triangles[vertex / 3u];
     let w_a = (frame.view_proj * vec4<f32>(t.a.xyz, 1.0)).w;
     let w_b = (frame.view_proj * vec4<f32>(t.b.xyz, 1.0)).w;
     let w_c = (frame.view_proj * vec4<f32>(t.c.xyz, 1.0)).w;
@@ -146,7 +114,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         }
         irradiance += l.radiance.rgb * (max(dot(n, to_light), 0.0) * falloff);
     }
-    let albedo = vec3<f32>(albedo_r, albedo_g, albedo_b);
-    let color = albedo * (irradiance / PI + vec3<f32>(ambient));
+    let albedo = params.albedo_ambient.rgb;
+    let color = albedo * (irradiance / PI + vec3<f32>(params.albedo_ambient.a));
     return vec4<f32>(color, 1.0);
 }

@@ -21,7 +21,7 @@
 //! On the GPU backends this is a raster pipeline (`shaders/scene/opaque.wgsl`):
 //! colour attachment cleared to `background`, depth attachment `scene.depth`
 //! loaded with compare `Equal` and writes off, `FrontFace::Ccw`,
-//! `CullMode::Back`; [`OpaqueParams::pipeline_constants`] sets its `override`s.
+//! `CullMode::Back`; [`OpaqueParams::uniform`] fills its parameter block.
 
 use super::{GROUP, View, corner_normals, corners, dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
@@ -125,14 +125,9 @@ impl OpaqueParams {
     /// Values for the WGSL pipeline-overridable constants of
     /// `shaders/scene/opaque.wgsl` (wgpu `PipelineCompilationOptions::constants`,
     /// Vulkan specialization constants). `background` is the clear colour.
-    pub fn pipeline_constants(&self) -> [(&'static str, f64); 4] {
-        let [r, g, b] = self.albedo.map(f64::from);
-        [
-            ("albedo_r", r),
-            ("albedo_g", g),
-            ("albedo_b", b),
-            ("ambient", f64::from(self.ambient)),
-        ]
+    /// The WGSL `OpaqueParams` block at binding 0: albedo rgb, ambient.
+    pub fn uniform(&self) -> [f32; 4] {
+        [self.albedo[0], self.albedo[1], self.albedo[2], self.ambient]
     }
 }
 
@@ -311,16 +306,17 @@ mod tests {
     }
 
     #[test]
-    fn wgsl_overrides_default_to_the_rust_defaults() {
-        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shaders/scene/opaque.wgsl");
-        let wgsl = std::fs::read_to_string(path).unwrap();
-        for (name, value) in OpaqueParams::default().pipeline_constants() {
-            let decl = format!("override {name}: f32 = ");
-            let at = wgsl.find(&decl).unwrap_or_else(|| panic!("no {decl}")) + decl.len();
-            let text = &wgsl[at..at + wgsl[at..].find(';').unwrap()];
-            let parsed: f64 = text.parse().unwrap();
-            assert!((parsed - value).abs() < 1e-6, "{name}: {parsed} vs {value}");
-        }
+    fn uniform_block_carries_albedo_and_ambient() {
+        let p = OpaqueParams::default();
+        assert_eq!(
+            p.uniform(),
+            [p.albedo[0], p.albedo[1], p.albedo[2], p.ambient]
+        );
+        let wgsl = include_str!("../../../shaders/scene/opaque.wgsl");
+        assert!(
+            wgsl.contains("albedo_ambient: vec4<f32>"),
+            "WGSL block changed without the Rust side"
+        );
     }
 
     #[test]

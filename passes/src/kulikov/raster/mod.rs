@@ -252,7 +252,9 @@ impl RasterKernel {
             heights.push((y1 - y0 + 1).max(0) as u32);
             for y in y0..=y1 {
                 let coverage = Trapezoid::coverage(&col, y);
-                if coverage > 0.0 {
+                // Only coverage that quantises to at least 1/1024 counts: thinner
+                // slivers are float noise the GPU backends need not agree on.
+                if (coverage * COVERAGE_SCALE).round() >= 1.0 {
                     self.write_pixel(lane, x as u32, y as u32, coverage, t, tally);
                 }
             }
