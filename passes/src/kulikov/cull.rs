@@ -226,10 +226,7 @@ impl CullKernel {
 impl CpuKernel for CullKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
-        let lods_w = ctx.words("lod_models");
-        let lods: Vec<ModelLod> = (0..scene.models.len())
-            .map(|m| ModelLod::load(&lods_w, m))
-            .collect();
+        let lods = scene.lods(ctx);
         let (clip, hiz) = (ctx.words("clip_positions"), ctx.words("hiz"));
         let (bits, bounds, bins) = (
             ctx.words("segment_visibility"),

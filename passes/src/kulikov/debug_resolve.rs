@@ -8,7 +8,6 @@
 
 use super::payload::{EMPTY, depth_of, total_coverage};
 use super::raster::LAYERS;
-use super::tiles::ModelTiles;
 use super::{Scene, TILE_TEXELS};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
 use crate::sim::{Ctx, Words};
@@ -95,10 +94,7 @@ impl CpuKernel for ResolveKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
         let (width, pixels) = (ctx.quantities.width, ctx.quantities.count(Quantity::Pixels));
-        let tiles_w = ctx.words("atlas_tiles");
-        let tiles: Vec<ModelTiles> = (0..scene.models.len())
-            .map(|m| ModelTiles::load(&tiles_w, m))
-            .collect();
+        let tiles = scene.tiles(ctx);
         let (vis, cov, out, layers) = (
             ctx.words("vis_atlas"),
             ctx.words("coverage_atlas"),

@@ -101,6 +101,22 @@ impl Scene {
         })
     }
 
+    /// The LOD pass's decisions (`lod_models`), one per model.
+    pub fn lods(&self, ctx: &Ctx<'_>) -> Vec<ModelLod> {
+        let w = ctx.words("lod_models");
+        (0..self.models.len())
+            .map(|m| ModelLod::load(&w, m))
+            .collect()
+    }
+
+    /// The tile allocation (`atlas_tiles`), one per model.
+    pub fn tiles(&self, ctx: &Ctx<'_>) -> Vec<tiles::ModelTiles> {
+        let w = ctx.words("atlas_tiles");
+        (0..self.models.len())
+            .map(|m| tiles::ModelTiles::load(&w, m))
+            .collect()
+    }
+
     pub fn width(&self) -> u32 {
         self.frame.screen[0] as u32
     }

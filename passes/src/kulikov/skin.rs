@@ -8,7 +8,7 @@
 //! `p = root_now + R (p_bind - root_bind)`, `R = frame_now · frame_bindᵀ`.
 
 use super::lod::SKIN_GROUP;
-use super::{ModelLod, Scene, transform};
+use super::{Scene, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
 use crate::layout::{ModelData, TriangleData, read};
 use crate::sim::{Ctx, Words};
@@ -139,8 +139,7 @@ fn root_motion(
 impl CpuKernel for SkinKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
-        let (lods_w, verts, strands, skinning, tris, out) = (
-            ctx.words("lod_models"),
+        let (verts, strands, skinning, tris, out) = (
             ctx.words("groom.vertices"),
             ctx.words("groom.strands"),
             ctx.words("groom.skinning"),
@@ -148,9 +147,7 @@ impl CpuKernel for SkinKernel {
             ctx.words("clip_positions"),
         );
         let total = ctx.words("skin_args").load(3);
-        let lods: Vec<ModelLod> = (0..scene.models.len())
-            .map(|m| ModelLod::load(&lods_w, m))
-            .collect();
+        let lods = scene.lods(ctx);
         for lane in 0..SKIN_GROUP {
             let g = group * SKIN_GROUP + lane;
             if g >= total {

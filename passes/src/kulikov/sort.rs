@@ -8,7 +8,7 @@
 //! since strands are shuffled for LOD): the talk's "unsorted" baseline.
 
 use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
-use super::{ModelLod, Scene, clip_to_screen};
+use super::{Scene, clip_to_screen};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::Ctx;
 use strandgraph_graph::AccessMode::{Atomic, Read, Write};
@@ -146,10 +146,7 @@ struct ScatterKernel {
 impl CpuKernel for ScatterKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
-        let lods_w = ctx.words("lod_models");
-        let lods: Vec<ModelLod> = (0..scene.models.len())
-            .map(|m| ModelLod::load(&lods_w, m))
-            .collect();
+        let lods = scene.lods(ctx);
         let (clip, bits, offsets, out) = (
             ctx.words("clip_positions"),
             ctx.words("segment_visibility"),

@@ -314,17 +314,9 @@ impl CpuKernel for RasterKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
         let count = ctx.words("raster_args").load(3);
-        let (lods_w, tiles_w, sorted) = (
-            ctx.words("lod_models"),
-            ctx.words("atlas_tiles"),
-            ctx.words("sorted_segments"),
-        );
-        let lods: Vec<ModelLod> = (0..scene.models.len())
-            .map(|m| ModelLod::load(&lods_w, m))
-            .collect();
-        let tiles: Vec<ModelTiles> = (0..scene.models.len())
-            .map(|m| ModelTiles::load(&tiles_w, m))
-            .collect();
+        let sorted = ctx.words("sorted_segments");
+        let lods = scene.lods(ctx);
+        let tiles = scene.tiles(ctx);
         let mut lanes: Vec<Lane> = (group * GROUP..((group + 1) * GROUP).min(count))
             .filter_map(|i| {
                 let seg = drawn_segment(&scene, &lods, sorted.load(i as usize))?;
