@@ -6,6 +6,7 @@
 //! workgroup for the CPU simulator.
 
 use crate::sim::Ctx;
+use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::{AccessMode, Quantity};
 
 /// One resource a pass binds, by the name graph files give it.
@@ -59,6 +60,35 @@ pub trait PassDef: Send + Sync {
     fn shader(&self) -> Shader;
     /// Reads the graph's parameters and returns the CPU kernel configured by them.
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError>;
+    /// The WGSL parameter block (binding 0) as 32-bit words, in the field
+    /// order of the shader's params struct: the pass's switches read from the
+    /// graph's RON (with the CPU kernel's defaults and checks) and the scene
+    /// counts the shader needs. Its length is the WGSL struct's size / 4
+    /// (`passes/tests/gpu_params.rs` checks it with naga).
+    ///
+    /// For a pass whose `bindings()` is `None` (`common.clear`), the GPU
+    /// backends dispatch once per written resource and put that resource's
+    /// size in 32-bit words into the last word.
+    ///
+    /// The default refuses, naming the kind: a GPU backend cannot run the pass.
+    fn gpu_params(&self, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
+        let _ = (params, q);
+        Err(ParamError {
+            kind: self.kind(),
+            param: "params".into(),
+            message: "the pass has no GPU parameter block yet (PassDef::gpu_params)".into(),
+        })
+    }
+}
+
+/// `true`/`false` as a WGSL `u32` switch.
+pub fn flag(b: bool) -> u32 {
+    u32::from(b)
+}
+
+/// A scene count as a WGSL `u32` (saturating; no scene comes near 2^32).
+pub fn count(n: u64) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
 }
 
 /// A kernel for the CPU simulator, run once per workgroup, workgroups in parallel.

@@ -590,3 +590,46 @@ fn shared_layout_field_offsets_match() {
     .collect();
     assert_eq!(words, vec![0, 1, 2, 3, 4, 5, 6]);
 }
+
+/// `PassDef::gpu_params` fills the WGSL parameter block at binding 0: its
+/// length in bytes is the size naga's layouter gives the uniform struct.
+#[test]
+fn gpu_params_fill_the_wgsl_parameter_block() {
+    let mut composer = composer();
+    let q = strandgraph_graph::Quantities::example();
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for kind in KINDS {
+        let Some(def) = Registry.definition(kind.name) else {
+            continue;
+        };
+        let shader = def.shader();
+        let source = std::fs::read_to_string(shaders_dir().join(shader.file)).unwrap();
+        let (module, _) = compose(&mut composer, shader.file, &source, all_capabilities())
+            .unwrap_or_else(|e| panic!("{e}"));
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let block = module.global_variables.iter().find(|(_, v)| {
+            v.space == AddressSpace::Uniform
+                && v.binding
+                    .as_ref()
+                    .is_some_and(|b| b.group == 0 && b.binding == 0)
+        });
+        let Some((_, var)) = block else {
+            failures.push(format!("{}: no uniform at binding 0", kind.name));
+            continue;
+        };
+        let wgsl_bytes = layouter[var.ty].size as usize;
+        match def.gpu_params(&ron::Value::Unit, &q) {
+            Ok(words) if words.len() * 4 == wgsl_bytes => checked += 1,
+            Ok(words) => failures.push(format!(
+                "{}: gpu_params gives {} words, the WGSL block is {wgsl_bytes} bytes",
+                kind.name,
+                words.len()
+            )),
+            Err(e) => failures.push(format!("{}: {e}", kind.name)),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(checked > 0, "no definition was checked");
+}

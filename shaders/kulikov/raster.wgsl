@@ -373,8 +373,11 @@ fn morton_sort(seg_in: Segment, index: u32, first: u32) -> Segment {
 
 // A pixel is written when its coverage quantises to at least 1/1024: slivers
 // thinner than that are float noise that backends need not agree on.
+// round_away, as the CPU kernel's f32::round: WGSL's round() sends exactly
+// half a step (a common coverage on the snapped grid) to 0, and dropped those
+// fragments on wgpu (tests/diff_wgpu.rs found it).
 fn covers(coverage: f32) -> bool {
-    return round(coverage * 1024.0) >= 1.0;
+    return round_away(coverage * COVERAGE_SCALE) >= 1.0;
 }
 
 @compute @workgroup_size(256)

@@ -39,6 +39,15 @@ impl PassDef for Clear {
             value: p.u32("value", 0)?,
         }))
     }
+    /// `ClearParams`: value, words (the backend fills `words` per resource).
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        Ok(vec![p.u32("value", 0)?, 0])
+    }
 }
 
 struct ClearKernel {

@@ -93,6 +93,22 @@ impl PassDef for Cull {
             wave_aggregated_atomics: p.bool("wave_aggregated_atomics", true)?,
         })))
     }
+    /// `CullParams`: the four switches, then the segment count.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        let flag = |name| p.bool(name, true).map(crate::contract::flag);
+        Ok(vec![
+            flag("frustum")?,
+            flag("occlusion")?,
+            flag("fedora")?,
+            flag("wave_aggregated_atomics")?,
+            crate::contract::count(q.segments),
+        ])
+    }
 }
 
 struct CullKernel(CullParams);

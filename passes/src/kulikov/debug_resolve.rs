@@ -74,6 +74,17 @@ impl PassDef for DebugResolve {
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(ResolveKernel))
     }
+    /// `ResolveParams`: screen width and pixel count.
+    fn gpu_params(
+        &self,
+        _: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(vec![
+            q.width,
+            crate::contract::count(u64::from(q.width) * u64::from(q.height)),
+        ])
+    }
 }
 
 struct ResolveKernel;

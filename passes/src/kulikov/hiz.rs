@@ -50,6 +50,14 @@ impl PassDef for DepthDownsample {
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(DownsampleKernel))
     }
+    /// `HizParams`: the full-resolution screen size.
+    fn gpu_params(
+        &self,
+        _: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(vec![q.width, q.height])
+    }
 }
 
 struct DownsampleKernel;

@@ -93,6 +93,25 @@ impl PassDef for Lod {
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(LodKernel(LodParams::from_ron(params)?)))
     }
+    /// `LodParams` in shaders/kulikov/lod.wgsl.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = LodParams::from_ron(params)?;
+        Ok(vec![
+            crate::contract::flag(p.enabled),
+            p.max_strands,
+            p.small_model_strands,
+            p.segments_per_tile,
+            p.tile_size,
+            p.segment_budget,
+            crate::contract::flag(p.thickness_compensation),
+            p.max_thickness_scale.to_bits(),
+            p.skip_vertices_beyond_m.to_bits(),
+        ])
+    }
 }
 
 struct LodKernel(LodParams);

@@ -81,6 +81,14 @@ impl PassDef for Skin {
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(SkinKernel))
     }
+    /// `SkinParams`: one reserved word.
+    fn gpu_params(
+        &self,
+        _: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(vec![0])
+    }
 }
 
 struct SkinKernel;

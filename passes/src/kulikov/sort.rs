@@ -53,6 +53,14 @@ impl PassDef for SortScan {
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(ScanKernel))
     }
+    /// `SortParams` (shared with `kulikov.sort`; `enabled` unused by the scan).
+    fn gpu_params(
+        &self,
+        _: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(sort_params(true, q))
+    }
 }
 
 struct ScanKernel;
@@ -137,6 +145,24 @@ impl PassDef for Sort {
             enabled: p.bool("enabled", true)?,
         }))
     }
+    /// `SortParams`: enabled, segments, bins.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        Ok(sort_params(p.bool("enabled", true)?, q))
+    }
+}
+
+/// The WGSL `SortParams` block of both entry points in shaders/kulikov/sort.wgsl.
+fn sort_params(enabled: bool, q: &strandgraph_graph::Quantities) -> Vec<u32> {
+    vec![
+        crate::contract::flag(enabled),
+        crate::contract::count(q.segments),
+        crate::contract::count(q.count(Quantity::Tiles(super::TILE))),
+    ]
 }
 
 struct ScatterKernel {

@@ -193,6 +193,20 @@ impl PassDef for TileAlloc {
             max_downscale: p.u32("max_downscale", 8)?.max(1),
         }))
     }
+    /// `TileParams`: atlas tiles, max downscale, hair models (checked as the CPU kernel does).
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        self.cpu_kernel(params)?;
+        let p = Params::new(self.kind(), params)?;
+        Ok(vec![
+            p.u32("atlas_tiles", 512)?,
+            p.u32("max_downscale", 8)?.max(1),
+            crate::contract::count(q.models),
+        ])
+    }
 }
 
 struct AllocKernel {

@@ -57,6 +57,15 @@ impl PassDef for DepthPrepass {
         Params::new(self.kind(), params)?;
         Ok(Box::new(PrepassKernel))
     }
+    /// `DepthPrepassParams`: one unused word.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Params::new(self.kind(), params)?;
+        Ok(vec![0])
+    }
 }
 
 struct PrepassKernel;

@@ -81,6 +81,17 @@ impl PassDef for Opaque {
             params: OpaqueParams::from_ron(params)?,
         }))
     }
+    /// `OpaqueParams`: albedo rgb, ambient ([`OpaqueParams::uniform`]).
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(OpaqueParams::from_ron(params)?
+            .uniform()
+            .map(f32::to_bits)
+            .to_vec())
+    }
 }
 
 /// The pass's parameters, with their defaults.

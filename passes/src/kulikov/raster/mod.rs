@@ -145,6 +145,24 @@ impl PassDef for Raster {
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))
     }
+    /// `RasterParams`: the five switches, then the screen size.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = RasterParams::from_ron(params)?;
+        let flag = crate::contract::flag;
+        Ok(vec![
+            flag(p.loop_flattening),
+            flag(p.pixel_request_stack),
+            flag(p.depth_test_stack),
+            flag(p.last_layer_cull),
+            flag(p.morton_sort),
+            q.width,
+            q.height,
+        ])
+    }
 }
 
 struct RasterKernel(RasterParams);
