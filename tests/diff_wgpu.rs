@@ -1,0 +1,165 @@
+//! Differential test: the Kulikov visibility pipeline on the CPU simulator
+//! and on wgpu (lavapipe in CI, any Vulkan adapter elsewhere) must agree.
+//!
+//! Both sides snap to the same fixed-point grid and pack visibility the same
+//! way (DESIGN.md, "Determinism across backends"), so the three visibility
+//! layers must be identical on at least 99.9% of covered atlas texels; only
+//! a float rounding that flips a snap may differ. Coverage (an additive
+//! atomic sum) must agree within a small bound.
+//!
+//! No adapter is a failure, not a skip: CI installs lavapipe
+//! (`scripts/test.sh`).
+
+use std::path::{Path, PathBuf};
+use strandgraph::frame::{Prepared, prepare};
+use strandgraph::images::to_picture;
+use strandgraph_cpu::CpuBackend;
+use strandgraph_wgpu::WgpuBackend;
+
+const W: u32 = 256;
+const H: u32 = 144;
+const EMPTY: u32 = u32::MAX;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn out_dir() -> PathBuf {
+    let dir = root().join("target/diff_wgpu");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes both backends' `debug_layers` and a diff image (red: pixels that differ).
+fn write_images(p: &Prepared, cpu: &[u32], gpu: &[u32]) -> PathBuf {
+    let dir = out_dir();
+    let r = p.plan.graph.resource_id("debug_layers").unwrap();
+    for (name, words) in [("cpu", cpu), ("wgpu", gpu)] {
+        if let Some(img) = to_picture(&p.plan, r, words, W, H) {
+            img.save(dir.join(format!("debug_layers.{name}.png")))
+                .unwrap();
+        }
+    }
+    let mut diff = image::RgbaImage::new(W, H);
+    for (i, px) in diff.pixels_mut().enumerate() {
+        let (a, b) = (cpu.get(i), gpu.get(i));
+        *px = if a == b {
+            let g = a.map_or(0, |w| (w >> 24) as u8 / 2);
+            image::Rgba([g, g, g, 255])
+        } else {
+            image::Rgba([255, 0, 0, 255])
+        };
+    }
+    diff.save(dir.join("debug_layers.diff.png")).unwrap();
+    dir
+}
+
+#[test]
+fn showcase_visibility_matches_cpu_on_wgpu() {
+    let graph = root().join("scenes/graphs/kulikov_visibility.ron");
+    let p = prepare(
+        &root().join("scenes/showcase.ron"),
+        Some(&graph),
+        Some((W, H)),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+
+    let gpu = WgpuBackend::default()
+        .execute(&p.plan, &p.instance, &p.upload)
+        .unwrap_or_else(|e| {
+            panic!(
+                "wgpu backend failed: {e}\n(no adapter? install a Vulkan driver: \
+                 apt-get install mesa-vulkan-drivers libvulkan1, or run scripts/test.sh)"
+            )
+        });
+    for n in &gpu.notes {
+        eprintln!("wgpu: {n}");
+    }
+    // Without aliasing, so every transient can be read back at the end (wgpu
+    // cannot alias either); lavapipe's subgroups are 8 wide.
+    let cpu = CpuBackend {
+        subgroup_width: 8,
+        alias: false,
+        ..CpuBackend::default()
+    }
+    .execute(&p.plan, &p.instance, &p.upload)
+    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+
+    eprintln!("{:<16} {:>12} {:>12}", "pass", "cpu ms", "wgpu ms");
+    for (c, g) in cpu.timings.iter().zip(&gpu.timings) {
+        eprintln!("{:<16} {:>12.3} {:>12.3}", c.name, c.millis, g.millis);
+    }
+
+    let read_gpu = |name: &str| {
+        gpu.read(&p.plan, name)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .unwrap_or_else(|| panic!("{name}: no memory on wgpu"))
+    };
+    let read_cpu = |name: &str| cpu.read(&p.plan, name).unwrap();
+
+    // Everything before the raster is integer bookkeeping: exact.
+    for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
+        assert_eq!(read_cpu(name), read_gpu(name), "{name} differs");
+    }
+
+    let (cv, gv) = (read_cpu("vis_atlas"), read_gpu("vis_atlas"));
+    let (cc, gc) = (read_cpu("coverage_atlas"), read_gpu("coverage_atlas"));
+    assert_eq!(cv.len(), gv.len());
+    assert_eq!(cc.len(), gc.len());
+    let texels = cc.len();
+    assert_eq!(cv.len(), 3 * texels, "three visibility layers");
+
+    let mut covered = 0usize;
+    let mut same = 0usize;
+    let mut differing = Vec::new();
+    for t in 0..texels {
+        if cc[t] == 0 && gc[t] == 0 {
+            continue;
+        }
+        covered += 1;
+        let layers = |v: &[u32]| [v[t], v[texels + t], v[2 * texels + t]];
+        if layers(&cv) == layers(&gv) {
+            same += 1;
+        } else if differing.len() < 12 {
+            differing.push(format!(
+                "texel {t} (tile {}, x {}, y {}): cpu {:08x?} cov {} | wgpu {:08x?} cov {}",
+                t / 4096,
+                t % 64,
+                (t % 4096) / 64,
+                layers(&cv),
+                cc[t],
+                layers(&gv),
+                gc[t]
+            ));
+        }
+    }
+    let filled = |v: &[u32]| v.iter().filter(|&&w| w != EMPTY).count();
+    let covered_cpu = cc.iter().filter(|&&c| c > 0).count();
+    let covered_gpu = gc.iter().filter(|&&c| c > 0).count();
+    let sum = |v: &[u32]| v.iter().map(|&c| u64::from(c)).sum::<u64>();
+    let (sum_cpu, sum_gpu) = (sum(&cc), sum(&gc));
+    let agreement = same as f64 / covered.max(1) as f64;
+    let coverage_error = (sum_cpu as f64 - sum_gpu as f64).abs() / sum_cpu.max(1) as f64;
+    let texel_error = covered_cpu.abs_diff(covered_gpu) as f64 / covered_cpu.max(1) as f64;
+    eprintln!(
+        "covered texels: cpu {covered_cpu}, wgpu {covered_gpu}; layers identical on {same}/{covered} ({:.4}%); \
+         filled layer words cpu {} wgpu {}; coverage sum cpu {sum_cpu} wgpu {sum_gpu} ({:.4}% apart)",
+        agreement * 100.0,
+        filled(&cv),
+        filled(&gv),
+        coverage_error * 100.0
+    );
+
+    let (cd, gd) = (read_cpu("debug_layers"), read_gpu("debug_layers"));
+    let pass =
+        covered > 1000 && agreement >= 0.999 && coverage_error <= 0.002 && texel_error <= 0.002;
+    if !pass {
+        let dir = write_images(&p, &cd, &gd);
+        panic!(
+            "CPU and wgpu visibility differ (need >= 99.9% identical covered texels, coverage within 0.2%, \
+             at least 1000 covered texels):\n{}\nimages in {}",
+            differing.join("\n"),
+            dir.display()
+        );
+    }
+}
