@@ -48,8 +48,8 @@ pub static KINDS: &[PassKind] = &[
     ),
     kind(
         "kulikov.density",
-        "splat strands into a density voxel grid per model",
-        "Kulikov 2025, 'Simulation' (density output)",
+        "splat drawn segments' projected area into a 48^3 density grid per model (atomicAdd)",
+        "Kulikov 2025, 'Simulation' (density output), 'Hair volumetric shadows'",
     ),
     kind(
         "kulikov.depth_downsample",
@@ -93,7 +93,7 @@ pub static KINDS: &[PassKind] = &[
     ),
     kind(
         "kulikov.shade",
-        "per-vertex Marschner (R, TT, TRT, multiple scattering) with baked SH self-shadowing",
+        "per-vertex Marschner (Karis 2016 R, TT, TRT, multiple scattering), self-shadowing: none, voxel march, baked SH",
         "Kulikov 2025, 'Shading', 'Self-shadowing'",
     ),
     kind(

@@ -35,6 +35,9 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::sort::Sort,
     &kulikov::raster::Raster,
     &kulikov::debug_resolve::DebugResolve,
+    &kulikov::density::Density,
+    &kulikov::shade_sort::ShadeSort,
+    &kulikov::shade::Shade,
 ];
 
 /// The built-in pass kinds.

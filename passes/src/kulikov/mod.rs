@@ -4,10 +4,13 @@
 
 pub mod cull;
 pub mod debug_resolve;
+pub mod density;
 pub mod hiz;
 pub mod lod;
 pub mod payload;
 pub mod raster;
+pub mod shade;
+pub mod shade_sort;
 pub mod skin;
 pub mod sort;
 pub mod tiles;
@@ -142,4 +145,11 @@ pub fn clip_to_screen(c: [f32; 4], width: f32, height: f32) -> [f32; 3] {
         (0.5 - c[1] * iw * 0.5) * height,
         c[2] * iw,
     ]
+}
+
+/// World position of a post-transform cache entry: `inv_view_proj × clip`, divided by w.
+pub fn world_of_clip(inv_view_proj: &[f32; 16], c: [f32; 4]) -> [f32; 3] {
+    let p = transform(inv_view_proj, c);
+    let iw = 1.0 / p[3];
+    [p[0] * iw, p[1] * iw, p[2] * iw]
 }

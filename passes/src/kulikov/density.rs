@@ -1,0 +1,229 @@
+//! `kulikov.density`: splat the drawn hair into a per-model density grid.
+//!
+//! Kulikov, "Simulation": "We also output voxel density grids for each
+//! simulation. We need that for hair collision and for hair shadow
+//! calculations" (48x48x48 for shadows on skin). We have no simulation, so
+//! this pass builds the grid from the post-transform cache: every drawn
+//! segment adds its projected area (thickness × length, in units of
+//! [`AREA_UNIT`] m²) to the voxel of its midpoint with `atomicAdd`, over the
+//! model's world bounds. Divided by the voxel volume that is an extinction
+//! coefficient: optical depth along a ray is the expected number of strands
+//! it crosses, the quantity `kulikov.shade`'s `VoxelMarch` and the baked SH
+//! both count ("number of scattering events").
+
+use super::cull::{GROUP, drawn_segment};
+use super::{Scene, world_of_clip};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::layout::ModelData;
+use crate::sim::Ctx;
+use strandgraph_graph::AccessMode::{Atomic, Read};
+use strandgraph_graph::schema::Quantity;
+
+pub struct Density;
+
+/// Largest grid edge; `density_grid` holds `MAX_RESOLUTION³` words per model.
+pub const MAX_RESOLUTION: u32 = 48;
+/// Words per model in `density_grid`.
+pub const GRID_WORDS: u32 = MAX_RESOLUTION * MAX_RESOLUTION * MAX_RESOLUTION;
+/// Fixed-point unit of the splatted area: 1e-9 m² (0.001 mm²).
+pub const AREA_UNIT: f32 = 1e-9;
+
+impl PassDef for Density {
+    fn kind(&self) -> &'static str {
+        "kulikov.density"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "frame",
+                mode: Read,
+            },
+            Binding {
+                name: "models",
+                mode: Read,
+            },
+            Binding {
+                name: "lod_models",
+                mode: Read,
+            },
+            Binding {
+                name: "clip_positions",
+                mode: Read,
+            },
+            Binding {
+                name: "groom.vertices",
+                mode: Read,
+            },
+            Binding {
+                name: "density_grid",
+                mode: Atomic,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Segments,
+            per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/density.wgsl",
+            entry: "density",
+            fragment: None,
+        }
+    }
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Self::uniform(params, q)
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(DensityKernel {
+            resolution: resolution(self.kind(), params)?,
+        }))
+    }
+}
+
+impl Density {
+    /// The WGSL `DensityParams` block (binding 0): resolution, segments.
+    pub fn uniform(
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(vec![
+            resolution("kulikov.density", params)?,
+            u32::try_from(q.segments).unwrap_or(u32::MAX),
+        ])
+    }
+}
+
+/// Reads and checks the `resolution` parameter (1..=48).
+pub fn resolution(kind: &'static str, params: &ron::Value) -> Result<u32, ParamError> {
+    let r = Params::new(kind, params)?.u32("resolution", MAX_RESOLUTION)?;
+    if r == 0 || r > MAX_RESOLUTION {
+        return Err(ParamError {
+            kind,
+            param: "resolution".into(),
+            message: format!(
+                "expected 1..={MAX_RESOLUTION} (density_grid holds {MAX_RESOLUTION}³ voxels per model), got {r}"
+            ),
+        });
+    }
+    Ok(r)
+}
+
+/// A model's grid: its world bounds split into `resolution³` voxels.
+#[derive(Debug, Clone, Copy)]
+pub struct Grid {
+    pub min: [f32; 3],
+    pub size: [f32; 3],
+    pub resolution: u32,
+}
+
+impl Grid {
+    pub fn of(m: &ModelData, resolution: u32) -> Self {
+        let min = [m.bounds_min[0], m.bounds_min[1], m.bounds_min[2]];
+        let size = [0, 1, 2].map(|a| (m.bounds_max[a] - m.bounds_min[a]).max(1e-6));
+        Self {
+            min,
+            size,
+            resolution,
+        }
+    }
+    /// The voxel (index within the model's block) holding world point `p`.
+    pub fn voxel(&self, p: [f32; 3]) -> Option<u32> {
+        let r = self.resolution as f32;
+        let mut idx = [0u32; 3];
+        for a in 0..3 {
+            let f = (p[a] - self.min[a]) / self.size[a] * r;
+            // Written so NaN is rejected too.
+            if !(f >= 0.0 && f < r) {
+                return None;
+            }
+            idx[a] = f as u32;
+        }
+        Some((idx[2] * self.resolution + idx[1]) * self.resolution + idx[0])
+    }
+    pub fn voxel_volume(&self) -> f32 {
+        let r = self.resolution as f32;
+        self.size[0] * self.size[1] * self.size[2] / (r * r * r)
+    }
+    /// Extinction (strands crossed per metre) of a voxel holding `units`.
+    pub fn sigma(&self, units: u32) -> f32 {
+        units as f32 * AREA_UNIT / self.voxel_volume()
+    }
+}
+
+struct DensityKernel {
+    resolution: u32,
+}
+
+impl CpuKernel for DensityKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let lods = scene.lods(ctx);
+        let (clip, verts, grid) = (
+            ctx.words("clip_positions"),
+            ctx.words("groom.vertices"),
+            ctx.words("density_grid"),
+        );
+        let inv = scene.frame.inv_view_proj;
+        for lane in 0..GROUP {
+            let id = group * GROUP + lane;
+            if u64::from(id) >= ctx.quantities.segments {
+                break;
+            }
+            let Some(seg) = drawn_segment(&scene, &lods, id) else {
+                continue;
+            };
+            let g = Grid::of(&scene.models[seg.model], self.resolution);
+            let a = world_of_clip(&inv, clip.load_vec4(seg.v0 as usize));
+            let b = world_of_clip(&inv, clip.load_vec4(seg.v1 as usize));
+            let mid = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+            let Some(voxel) = g.voxel(mid) else { continue };
+            let len = ((0..3).map(|k| (b[k] - a[k]).powi(2)).sum::<f32>()).sqrt();
+            let thick = 0.5
+                * (verts.load_f32(4 * seg.v0 as usize + 3)
+                    + verts.load_f32(4 * seg.v1 as usize + 3))
+                * lods[seg.model].thickness_scale;
+            let units = (thick * len / AREA_UNIT).round();
+            if units >= 1.0 && units.is_finite() {
+                grid.fetch_add(
+                    (seg.model as u32 * GRID_WORDS + voxel) as usize,
+                    units.min(1e6) as u32,
+                );
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn voxels_cover_the_bounds() {
+        let mut m: ModelData = bytemuck::Zeroable::zeroed();
+        m.bounds_min = [0.0, 0.0, 0.0, 0.0];
+        m.bounds_max = [1.0, 2.0, 4.0, 0.0];
+        let g = Grid::of(&m, 4);
+        assert_eq!(g.voxel([0.1, 0.1, 0.1]), Some(0));
+        assert_eq!(g.voxel([0.9, 1.9, 3.9]), Some(63));
+        assert_eq!(g.voxel([1.0, 0.0, 0.0]), None);
+        assert_eq!(g.voxel([f32::NAN, 0.0, 0.0]), None);
+        assert!((g.voxel_volume() - 8.0 / 64.0).abs() < 1e-6);
+        assert!(
+            resolution(
+                "kulikov.density",
+                &ron::from_str("{\"resolution\": 64}").unwrap()
+            )
+            .is_err()
+        );
+    }
+}

@@ -1,0 +1,346 @@
+//! `kulikov.shade`: per-vertex hair lighting in strand space.
+//!
+//! Kulikov, "Shading": "We shade strands per vertex to get smoother shading
+//! and save performance", Marschner R/TT/TRT plus multiple scattering with a
+//! scalar per lobe ([`karis`]). One lane per visible segment of
+//! `shading_segments` (natural order, from `kulikov.shade_sort`): the lane
+//! shades the segment's root-side vertex, and its tip-side vertex too when
+//! the next segment of the strand is not visible, so every vertex of a
+//! visible segment is shaded by exactly one lane. World positions come from
+//! the post-transform cache (`inv_view_proj × clip`); the tangent is the
+//! segment's direction towards the root. Output: radiance towards the
+//! camera, `vertex_lighting` (rgba16f per vertex).
+//!
+//! Self-shadowing (`self_shadow`), Kulikov "Self-shadowing":
+//! - `"None"`: every light unshadowed;
+//! - `"VoxelMarch"`: march the model's `density_grid` towards each light
+//!   (`march_steps` samples, grid `resolution`), "Density volume raymarching
+//!   for each light"; visibility = exp(−absorption · strands crossed);
+//! - `"Baked"`: the offline ray-traced SH (`groom.shadow_sh`); not built
+//!   yet, so asking for it is an error naming the missing bake.
+
+pub mod karis;
+
+use super::cull::drawn_segment;
+use super::debug_resolve::store_rgba16f;
+use super::density::{GRID_WORDS, Grid, resolution};
+use super::shade_sort::SHADE_GROUP;
+use super::{Scene, world_of_clip};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::layout::{LightData, read};
+use crate::sim::{Ctx, Words};
+use glam::Vec3;
+use karis::{Lobes, hair_shading};
+use strandgraph_graph::AccessMode::{Read, Write};
+
+pub struct Shade;
+
+const KIND: &str = "kulikov.shade";
+
+/// How lights are shadowed by the hair itself.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SelfShadow {
+    None,
+    VoxelMarch,
+    Baked,
+}
+
+impl SelfShadow {
+    /// The WGSL parameter block's encoding.
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadeParams {
+    pub lobes: Lobes,
+    pub self_shadow: SelfShadow,
+    pub absorption: f32,
+    pub resolution: u32,
+    pub march_steps: u32,
+    /// Fraction of the base colour added as ambient light.
+    pub ambient: f32,
+}
+
+impl ShadeParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new(KIND, v)?;
+        let err = |param: &str, message: String| ParamError {
+            kind: KIND,
+            param: param.into(),
+            message,
+        };
+        let self_shadow = match p.string("self_shadow", "VoxelMarch")?.as_str() {
+            "None" => SelfShadow::None,
+            "VoxelMarch" => SelfShadow::VoxelMarch,
+            "Baked" => {
+                return Err(err(
+                    "self_shadow",
+                    "\"Baked\" reads the offline self-shadowing bake `groom.shadow_sh` \
+                     (ray-traced clamped L1 SH per vertex), which is not built yet; \
+                     use \"VoxelMarch\" or \"None\""
+                        .into(),
+                ));
+            }
+            other => {
+                return Err(err(
+                    "self_shadow",
+                    format!("expected \"None\", \"VoxelMarch\" or \"Baked\", got {other:?}"),
+                ));
+            }
+        };
+        let march_steps = p.u32("march_steps", 12)?;
+        if march_steps == 0 || march_steps > 256 {
+            return Err(err(
+                "march_steps",
+                format!("expected 1..=256, got {march_steps}"),
+            ));
+        }
+        let multiple = p.bool("multiple_scattering", true)?;
+        Ok(Self {
+            lobes: Lobes {
+                r: p.f32("r_scale", 1.0)?,
+                tt: p.f32("tt_scale", 1.0)?,
+                trt: p.f32("trt_scale", 1.0)?,
+                scatter: if multiple {
+                    p.f32("scatter", 1.0)?
+                } else {
+                    0.0
+                },
+                shift: p.f32("shift", 0.035)?,
+            },
+            self_shadow,
+            absorption: p.f32("absorption", 1.0)?,
+            resolution: resolution(KIND, v)?,
+            march_steps,
+            ambient: p.f32("ambient", 0.05)?,
+        })
+    }
+}
+
+impl ShadeParams {
+    /// The WGSL `ShadeParams` block (binding 0, 48 bytes).
+    pub fn uniform(&self) -> Vec<u32> {
+        let l = &self.lobes;
+        vec![
+            l.r.to_bits(),
+            l.tt.to_bits(),
+            l.trt.to_bits(),
+            l.scatter.to_bits(),
+            l.shift.to_bits(),
+            self.self_shadow.code(),
+            self.absorption.to_bits(),
+            self.resolution,
+            self.march_steps,
+            self.ambient.to_bits(),
+            0,
+            0,
+        ]
+    }
+}
+
+impl PassDef for Shade {
+    fn kind(&self) -> &'static str {
+        KIND
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "shade_args",
+                mode: Read,
+            },
+            Binding {
+                name: "frame",
+                mode: Read,
+            },
+            Binding {
+                name: "models",
+                mode: Read,
+            },
+            Binding {
+                name: "lod_models",
+                mode: Read,
+            },
+            Binding {
+                name: "lights",
+                mode: Read,
+            },
+            Binding {
+                name: "shading_segments",
+                mode: Read,
+            },
+            Binding {
+                name: "segment_visibility",
+                mode: Read,
+            },
+            Binding {
+                name: "clip_positions",
+                mode: Read,
+            },
+            Binding {
+                name: "density_grid",
+                mode: Read,
+            },
+            Binding {
+                name: "vertex_lighting",
+                mode: Write,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        SHADE_GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::Indirect {
+            binding: "shade_args",
+            word: 0,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/shade.wgsl",
+            entry: "shade",
+            fragment: None,
+        }
+    }
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        _: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(ShadeParams::from_ron(params)?.uniform())
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(ShadeKernel(ShadeParams::from_ron(params)?)))
+    }
+}
+
+struct ShadeKernel(ShadeParams);
+
+/// Distance along `dir` from `p` to where it leaves the box (0 if outside).
+fn exit_distance(g: &Grid, p: Vec3, dir: Vec3) -> f32 {
+    let mut t_exit = f32::MAX;
+    for a in 0..3 {
+        let (lo, hi) = (g.min[a], g.min[a] + g.size[a]);
+        if dir[a] > 1e-8 {
+            t_exit = t_exit.min((hi - p[a]) / dir[a]);
+        } else if dir[a] < -1e-8 {
+            t_exit = t_exit.min((lo - p[a]) / dir[a]);
+        }
+    }
+    t_exit.max(0.0)
+}
+
+/// Kulikov: "Density volume raymarching for each light": strands crossed
+/// from `p` towards the light, sampled at `steps` voxel centres, skipping
+/// the voxel `p` sits in (its own strand is not a shadow caster).
+pub fn march(
+    grid: &Words<'_>,
+    base: u32,
+    g: &Grid,
+    p: Vec3,
+    dir: Vec3,
+    max_t: f32,
+    steps: u32,
+) -> f32 {
+    let voxel = g.size.iter().fold(f32::MAX, |a, &b| a.min(b)) / g.resolution as f32;
+    let t0 = voxel;
+    let t1 = exit_distance(g, p, dir).min(max_t);
+    if t1 <= t0 {
+        return 0.0;
+    }
+    let dt = (t1 - t0) / steps as f32;
+    let mut crossed = 0.0;
+    for i in 0..steps {
+        let q = p + dir * (t0 + (i as f32 + 0.5) * dt);
+        if let Some(v) = g.voxel(q.to_array()) {
+            crossed += g.sigma(grid.load((base + v) as usize)) * dt;
+        }
+    }
+    crossed
+}
+
+impl ShadeKernel {
+    fn shade_vertex(
+        &self,
+        scene: &Scene,
+        lights: &[LightData],
+        grid: &Words<'_>,
+        model: usize,
+        p: Vec3,
+        t: Vec3,
+    ) -> Vec3 {
+        let k = &self.0;
+        let md = &scene.models[model];
+        let cam = Vec3::from_slice(&scene.frame.camera_pos[..3]);
+        let v = (cam - p).normalize_or(Vec3::Z);
+        let color = Vec3::from_slice(&md.color[..3]);
+        let g = Grid::of(md, k.resolution);
+        let mut out = color * k.ambient;
+        for l in lights {
+            let [x, y, z, kind] = l.position_or_direction;
+            let (to_light, dist, falloff) = if kind == 0.0 {
+                (-Vec3::new(x, y, z).normalize_or_zero(), f32::MAX, 1.0)
+            } else {
+                let d = Vec3::new(x, y, z) - p;
+                let d2 = d.length_squared().max(1e-4);
+                (d / d2.sqrt(), d2.sqrt(), 1.0 / d2)
+            };
+            let visibility = match k.self_shadow {
+                SelfShadow::VoxelMarch => {
+                    let base = model as u32 * GRID_WORDS;
+                    let n = march(grid, base, &g, p, to_light, dist, k.march_steps);
+                    (-k.absorption * n).exp()
+                }
+                SelfShadow::None | SelfShadow::Baked => 1.0,
+            };
+            let radiance = Vec3::from_slice(&l.radiance[..3]) * falloff;
+            out +=
+                radiance * hair_shading(t, v, to_light, color, md.color[3], visibility, &k.lobes);
+        }
+        out
+    }
+}
+
+impl CpuKernel for ShadeKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let lods = scene.lods(ctx);
+        let (list, bits, clip, grid, out) = (
+            ctx.words("shading_segments"),
+            ctx.words("segment_visibility"),
+            ctx.words("clip_positions"),
+            ctx.words("density_grid"),
+            ctx.words("vertex_lighting"),
+        );
+        let lw = ctx.words("lights");
+        let lights: Vec<LightData> = (0..(scene.frame.light_count as usize).min(lw.len() / 16))
+            .map(|i| read(&lw, i))
+            .collect();
+        let count = ctx.words("shade_args").load(3);
+        let inv = scene.frame.inv_view_proj;
+        let world = |v: u32| Vec3::from(world_of_clip(&inv, clip.load_vec4(v as usize)));
+        for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(count) {
+            let id = list.load(i as usize);
+            let Some(seg) = drawn_segment(&scene, &lods, id) else {
+                continue;
+            };
+            let (p0, p1) = (world(seg.v0), world(seg.v1));
+            // Towards the root (Karis's convention).
+            let t = (p0 - p1).normalize_or(Vec3::Y);
+            let c0 = self.shade_vertex(&scene, &lights, &grid, seg.model, p0, t);
+            store_rgba16f(&out, seg.v0 as usize, [c0.x, c0.y, c0.z, 1.0]);
+            let per = scene.models[seg.model].points_per_strand - 1;
+            let last = seg.local % per + 1 >= lods[seg.model].segments_per_strand;
+            let next = id + 1;
+            if last || bits.load((next / 32) as usize) & (1 << (next % 32)) == 0 {
+                let c1 = self.shade_vertex(&scene, &lights, &grid, seg.model, p1, t);
+                store_rgba16f(&out, seg.v1 as usize, [c1.x, c1.y, c1.z, 1.0]);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,199 @@
+//! `kulikov.shade_sort`: visible segments back to their natural order for
+//! strand-space shading.
+//!
+//! Kulikov, "Strand-space shading needs different segment order": "Sort again
+//! with 'natural' segment order. No need for buckets, let GPU scheduler do
+//! your work for you": each subgroup counts its visible lanes
+//! (`subgroupAdd`), one lane appends them with one `atomicAdd`, every lane
+//! writes at the returned base plus its `subgroupExclusiveAdd`. Waves launch
+//! roughly in order, so the list comes out nearly in segment order.
+//!
+//! `shade_args` (cleared to 0 before) ends as the shade pass's indirect
+//! dispatch: `[groups, 1, 1, count]`; word 3 is the append counter and word
+//! 0 is raised with `atomicMax` by every subgroup, so no scan pass is needed.
+//! `wave_aggregated_atomics: false` appends one lane at a time (the ablation).
+
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::sim::{CounterValues, Ctx, subgroup};
+use strandgraph_graph::AccessMode::{Atomic, Read, Write};
+use strandgraph_graph::schema::Quantity;
+
+pub struct ShadeSort;
+
+pub const GROUP: u32 = 256;
+/// Segments per workgroup of `kulikov.shade` (the indirect count's divisor).
+pub const SHADE_GROUP: u32 = 64;
+
+impl PassDef for ShadeSort {
+    fn kind(&self) -> &'static str {
+        "kulikov.shade_sort"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(&[
+            Binding {
+                name: "segment_visibility",
+                mode: Read,
+            },
+            Binding {
+                name: "shade_args",
+                mode: Atomic,
+            },
+            Binding {
+                name: "shading_segments",
+                mode: Write,
+            },
+        ])
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Segments,
+            per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/shade_sort.wgsl",
+            entry: "shade_sort",
+            fragment: None,
+        }
+    }
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Self::uniform(params, q)
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        let p = Params::new(self.kind(), params)?;
+        Ok(Box::new(ShadeSortKernel {
+            aggregated: p.bool("wave_aggregated_atomics", true)?,
+        }))
+    }
+}
+
+impl ShadeSort {
+    /// The WGSL `ShadeSortParams` block (binding 0): switch, segments.
+    pub fn uniform(
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = Params::new("kulikov.shade_sort", params)?;
+        Ok(vec![
+            u32::from(p.bool("wave_aggregated_atomics", true)?),
+            u32::try_from(q.segments).unwrap_or(u32::MAX),
+        ])
+    }
+}
+
+struct ShadeSortKernel {
+    aggregated: bool,
+}
+
+impl CpuKernel for ShadeSortKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let (bits, args, out) = (
+            ctx.words("segment_visibility"),
+            ctx.words("shade_args"),
+            ctx.words("shading_segments"),
+        );
+        let width = ctx.subgroup_width.max(1);
+        let mut tally = CounterValues::default();
+        for sub in (0..GROUP).step_by(width as usize) {
+            let ids: Vec<u32> = (sub..(sub + width).min(GROUP))
+                .map(|l| group * GROUP + l)
+                .collect();
+            let active: Vec<bool> = ids
+                .iter()
+                .map(|&id| {
+                    u64::from(id) < ctx.quantities.segments
+                        && bits.load((id / 32) as usize) & (1 << (id % 32)) != 0
+                })
+                .collect();
+            let n = subgroup::count(&active);
+            if n == 0 {
+                continue;
+            }
+            let (slots, end) = if self.aggregated {
+                let ones = vec![1; ids.len()];
+                let base = args.fetch_add(3, n);
+                tally.atomics += 1;
+                let offs = subgroup::exclusive_add(&ones, &active);
+                (offs.iter().map(|o| base + o).collect::<Vec<_>>(), base + n)
+            } else {
+                let slots: Vec<u32> = active
+                    .iter()
+                    .map(|&a| if a { args.fetch_add(3, 1) } else { 0 })
+                    .collect();
+                tally.atomics += u64::from(n);
+                let end = slots
+                    .iter()
+                    .zip(&active)
+                    .filter(|(_, a)| **a)
+                    .map(|(s, _)| s + 1);
+                (slots.clone(), end.max().unwrap_or(0))
+            };
+            for ((id, slot), a) in ids.iter().zip(&slots).zip(&active) {
+                if *a {
+                    out.store(*slot as usize, *id);
+                }
+            }
+            args.fetch_max(0, end.div_ceil(SHADE_GROUP));
+            args.store(1, 1);
+            args.store(2, 1);
+            tally.atomics += 1;
+            tally.active_lanes += u64::from(n);
+            tally.total_lanes += u64::from(width);
+        }
+        if ctx.instrument {
+            ctx.counters.add(&tally);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::harness::Harness;
+    use strandgraph_graph::Quantities;
+
+    fn run(aggregated: bool, width: u32) -> (Vec<u32>, Vec<u32>, u64) {
+        let segments = 1000u32;
+        let visible: Vec<u32> = (0..segments).filter(|i| (i * 7919) % 3 != 0).collect();
+        let mut bits = vec![0u32; segments.div_ceil(32) as usize];
+        for &v in &visible {
+            bits[(v / 32) as usize] |= 1 << (v % 32);
+        }
+        let mut hs = Harness::new(Quantities {
+            segments: u64::from(segments),
+            ..Default::default()
+        });
+        hs.subgroup_width = width;
+        hs.buffer("segment_visibility", bits)
+            .buffer("shade_args", vec![0; 4])
+            .buffer("shading_segments", vec![u32::MAX; segments as usize + 4]);
+        let params: ron::Value =
+            ron::from_str(&format!("{{\"wave_aggregated_atomics\": {aggregated}}}")).unwrap();
+        let k = ShadeSort.cpu_kernel(&params).unwrap();
+        let c = hs.run(k.as_ref(), segments.div_ceil(GROUP), GROUP);
+        let args = hs.read("shade_args");
+        let mut list = hs.read("shading_segments")[..args[3] as usize].to_vec();
+        list.sort_unstable();
+        assert_eq!(list, visible);
+        (args, visible, c.atomics)
+    }
+
+    #[test]
+    fn appends_every_visible_segment_once() {
+        let (args, visible, aggregated) = run(true, 32);
+        let n = visible.len() as u32;
+        assert_eq!(args, vec![n.div_ceil(SHADE_GROUP), 1, 1, n]);
+        let (args8, _, per_lane) = run(false, 8);
+        assert_eq!(args8, args);
+        // One append per subgroup instead of one per visible lane.
+        assert!(aggregated * 8 < per_lane, "{aggregated} vs {per_lane}");
+    }
+}

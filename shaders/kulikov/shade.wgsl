@@ -1,0 +1,267 @@
+// kulikov.shade: per-vertex hair lighting in strand space, one lane per
+// visible segment of shading_segments. Marschner R, TT, TRT after Karis 2016
+// ("Physically Based Hair Shading in Unreal"; Tafuri 2019's TT/TRT forms are
+// not reproduced, Karis's are used for all three lobes), Karis's multiple
+// scattering fake, per-lobe artist scalars, self-shadowing None (0) or
+// VoxelMarch (1) through density_grid.
+// Port of passes/src/kulikov/shade/{mod,karis}.rs.
+
+#import strandgraph::layout::{FrameData, ModelData, ModelLod, LightData}
+#import strandgraph::kulikov::{transform, load_lod, segment_in_model, drawn_in_model, DrawnSegment}
+
+struct ShadeParams {
+    // r, tt, trt scales; scatter (0 = no multiple scattering).
+    lobes: vec4<f32>,
+    shift: f32,
+    // 0 None, 1 VoxelMarch (Baked is refused before a pipeline is built).
+    self_shadow: u32,
+    absorption: f32,
+    resolution: u32,
+    march_steps: u32,
+    ambient: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: ShadeParams;
+@group(0) @binding(1) var<storage, read> shade_args: array<u32>;
+@group(0) @binding(2) var<storage, read> frame: FrameData;
+@group(0) @binding(3) var<storage, read> models: array<ModelData>;
+@group(0) @binding(4) var<storage, read> lod_models: array<ModelLod>;
+@group(0) @binding(5) var<storage, read> lights: array<LightData>;
+@group(0) @binding(6) var<storage, read> shading_segments: array<u32>;
+@group(0) @binding(7) var<storage, read> segment_visibility: array<u32>;
+@group(0) @binding(8) var<storage, read> clip_positions: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> density_grid: array<u32>;
+// rgba16f per vertex: r | g << 16, b | a << 16.
+@group(0) @binding(10) var<storage, read_write> vertex_lighting: array<vec2<u32>>;
+
+const GROUP: u32 = 64u;
+const GRID_WORDS: u32 = 110592u;
+const AREA_UNIT: f32 = 1e-9;
+const PI: f32 = 3.14159265;
+const F32_MAX: f32 = 3.40282347e38;
+
+fn drawn_segment(id: u32) -> DrawnSegment {
+    for (var m = 0u; m < frame.model_count; m++) {
+        let md = models[m];
+        if segment_in_model(md, id) {
+            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
+        }
+    }
+    return DrawnSegment(false, 0u, 0u, 0u, 0u);
+}
+
+fn world_of_clip(c: vec4<f32>) -> vec3<f32> {
+    let p = transform(frame.inv_view_proj, c);
+    let iw = 1.0 / p.w;
+    return vec3<f32>(p.x * iw, p.y * iw, p.z * iw);
+}
+
+// Karis 2016: longitudinal Gaussian and Schlick Fresnel (n = 1.55).
+fn hair_g(b: f32, theta: f32) -> f32 {
+    return exp(-0.5 * theta * theta / (b * b)) / (sqrt(2.0 * PI) * b);
+}
+
+fn hair_f(cos_theta: f32) -> f32 {
+    let r = (1.0 - 1.55) / (1.0 + 1.55);
+    let f0 = r * r;
+    return f0 + (1.0 - f0) * pow(1.0 - cos_theta, 5.0);
+}
+
+// karis::hair_shading.
+fn hair_shading(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, color: vec3<f32>, roughness: f32, shadow: f32) -> vec3<f32> {
+    let rough = clamp(roughness, 1.0 / 255.0, 1.0);
+    let vol = dot(v, l);
+    let sin_l = clamp(dot(t, l), -1.0, 1.0);
+    let sin_v = clamp(dot(t, v), -1.0, 1.0);
+    let cos_d = cos(0.5 * abs(asin(sin_v) - asin(sin_l)));
+    let lp = l - sin_l * t;
+    let vp = v - sin_v * t;
+    let cos_phi = dot(lp, vp) / sqrt(dot(lp, lp) * dot(vp, vp) + 1e-4);
+    let cos_half_phi = sqrt(clamp(0.5 + 0.5 * cos_phi, 0.0, 1.0));
+    let n_prime = 1.19 / cos_d + 0.36 * cos_d;
+    let shift = params.shift;
+    let r2 = rough * rough;
+    var s = vec3<f32>(0.0);
+    // Karis 2016, R lobe.
+    {
+        let sa = sin(-shift * 2.0);
+        let ca = cos(-shift * 2.0);
+        let sh = 2.0 * sa * (ca * cos_half_phi * sqrt(1.0 - sin_v * sin_v) + sa * sin_v);
+        let mp = hair_g(r2 * sqrt(2.0) * cos_half_phi, sin_l + sin_v - sh);
+        let np = 0.25 * cos_half_phi;
+        let fp = hair_f(sqrt(clamp(0.5 + 0.5 * vol, 0.0, 1.0)));
+        s += vec3<f32>(params.lobes.x * mp * np * fp);
+    }
+    // Karis 2016, TT lobe.
+    {
+        let mp = hair_g(r2 / 2.0, sin_l + sin_v - shift);
+        let a = 1.0 / n_prime;
+        let h = cos_half_phi * (1.0 + a * (0.6 - 0.8 * cos_phi));
+        let f = hair_f(cos_d * sqrt(clamp(1.0 - h * h, 0.0, 1.0)));
+        let fp = (1.0 - f) * (1.0 - f);
+        let tp = pow(color, vec3<f32>(0.5 * sqrt(max(1.0 - (h * a) * (h * a), 0.0)) / cos_d));
+        let np = exp(-3.65 * cos_phi - 3.98);
+        s += tp * (params.lobes.y * mp * np * fp);
+    }
+    // Karis 2016, TRT lobe.
+    {
+        let mp = hair_g(r2 * 2.0, sin_l + sin_v - shift * 4.0);
+        let f = hair_f(cos_d * 0.5);
+        let fp = (1.0 - f) * (1.0 - f) * f;
+        let tp = pow(color, vec3<f32>(0.8 / cos_d));
+        let np = exp(17.0 * cos_phi - 16.78);
+        s += tp * (params.lobes.z * mp * np * fp);
+    }
+    s *= shadow;
+    // Karis 2016, multiple scattering (KajiyaKayDiffuseAttenuation).
+    if params.lobes.w > 0.0 {
+        let kajiya = 1.0 - abs(sin_l);
+        var fake_n = v - t * sin_v;
+        let len = length(fake_n);
+        fake_n = select(v, fake_n / len, len > 0.0);
+        let nol = clamp((dot(fake_n, l) + 1.0) / 4.0, 0.0, 1.0);
+        let diffuse = (1.0 / PI) * (nol + (kajiya - nol) * 0.33) * params.lobes.w;
+        let luma = max(dot(color, vec3<f32>(0.3, 0.59, 0.11)), 1e-4);
+        let tint = pow(color / luma, vec3<f32>(1.0 - shadow));
+        s += sqrt(color) * diffuse * tint * shadow;
+    }
+    return max(s, vec3<f32>(0.0));
+}
+
+// shade::march: strands crossed from p towards the light through the model's grid.
+fn march(model: u32, md: ModelData, p: vec3<f32>, dir: vec3<f32>, max_t: f32) -> f32 {
+    let res = params.resolution;
+    let r = f32(res);
+    var size = vec3<f32>(0.0);
+    var t_exit = F32_MAX;
+    for (var a = 0u; a < 3u; a++) {
+        size[a] = max(md.bounds_max[a] - md.bounds_min[a], 1e-6);
+        let lo = md.bounds_min[a];
+        let hi = lo + size[a];
+        if dir[a] > 1e-8 {
+            t_exit = min(t_exit, (hi - p[a]) / dir[a]);
+        } else if dir[a] < -1e-8 {
+            t_exit = min(t_exit, (lo - p[a]) / dir[a]);
+        }
+    }
+    let voxel = min(size.x, min(size.y, size.z)) / r;
+    let volume = size.x * size.y * size.z / (r * r * r);
+    let t0 = voxel;
+    let t1 = min(max(t_exit, 0.0), max_t);
+    if t1 <= t0 {
+        return 0.0;
+    }
+    let dt = (t1 - t0) / f32(params.march_steps);
+    var crossed = 0.0;
+    for (var i = 0u; i < params.march_steps; i++) {
+        let q = p + dir * (t0 + (f32(i) + 0.5) * dt);
+        var idx = vec3<u32>(0u);
+        var inside = true;
+        for (var a = 0u; a < 3u; a++) {
+            let f = (q[a] - md.bounds_min[a]) / size[a] * r;
+            inside = inside && f >= 0.0 && f < r;
+            idx[a] = u32(max(f, 0.0));
+        }
+        if inside {
+            let units = density_grid[model * GRID_WORDS + (idx.z * res + idx.y) * res + idx.x];
+            crossed += f32(units) * AREA_UNIT / volume * dt;
+        }
+    }
+    return crossed;
+}
+
+fn shade_vertex(model: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32> {
+    let md = models[model];
+    let cam = frame.camera_pos.xyz;
+    let to_cam = cam - p;
+    let v = select(vec3<f32>(0.0, 0.0, 1.0), normalize(to_cam), length(to_cam) > 0.0);
+    let color = md.color.xyz;
+    var out = color * params.ambient;
+    for (var i = 0u; i < frame.light_count; i++) {
+        let light = lights[i];
+        var to_light: vec3<f32>;
+        var dist = F32_MAX;
+        var falloff = 1.0;
+        if light.position_or_direction.w == 0.0 {
+            let d = light.position_or_direction.xyz;
+            to_light = select(vec3<f32>(0.0), -normalize(d), length(d) > 0.0);
+        } else {
+            let d = light.position_or_direction.xyz - p;
+            let d2 = max(dot(d, d), 1e-4);
+            dist = sqrt(d2);
+            to_light = d / dist;
+            falloff = 1.0 / d2;
+        }
+        var visibility = 1.0;
+        if params.self_shadow == 1u {
+            visibility = exp(-params.absorption * march(model, md, p, to_light, dist));
+        }
+        out += light.radiance.xyz * falloff * hair_shading(t, v, to_light, color, md.color.w, visibility);
+    }
+    return out;
+}
+
+// half::f16::from_f32 (round to nearest even) without the f16 capability
+// pack2x16float needs.
+fn f16_bits(x: f32) -> u32 {
+    let b = bitcast<u32>(x);
+    let sign = (b >> 16u) & 0x8000u;
+    let e = i32((b >> 23u) & 0xFFu);
+    var m = b & 0x7FFFFFu;
+    if e == 255 {
+        return sign | 0x7C00u | select(0u, 0x200u | (m >> 13u), m != 0u);
+    }
+    let he = e - 112;
+    if he >= 31 {
+        return sign | 0x7C00u;
+    }
+    if he <= 0 {
+        if he < -10 {
+            return sign;
+        }
+        m = m | 0x800000u;
+        let shift = u32(14 - he);
+        var hm = m >> shift;
+        let rem = m & ((1u << shift) - 1u);
+        let half = 1u << (shift - 1u);
+        if rem > half || (rem == half && (hm & 1u) != 0u) {
+            hm += 1u;
+        }
+        return sign | hm;
+    }
+    var h = (u32(he) << 10u) | (m >> 13u);
+    let rem = m & 0x1FFFu;
+    if rem > 0x1000u || (rem == 0x1000u && (h & 1u) != 0u) {
+        h += 1u;
+    }
+    return sign | h;
+}
+
+fn store_lighting(v: u32, c: vec3<f32>) {
+    vertex_lighting[v] = vec2<u32>(f16_bits(c.x) | (f16_bits(c.y) << 16u), f16_bits(c.z) | (0x3C00u << 16u));
+}
+
+@compute @workgroup_size(64)
+fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let i = wg.x * GROUP + lane;
+    if i >= shade_args[3] {
+        return;
+    }
+    let id = shading_segments[i];
+    let seg = drawn_segment(id);
+    if !seg.valid {
+        return;
+    }
+    let p0 = world_of_clip(clip_positions[seg.va]);
+    let p1 = world_of_clip(clip_positions[seg.vb]);
+    let d = p0 - p1;
+    let t = select(vec3<f32>(0.0, 1.0, 0.0), normalize(d), length(d) > 0.0);
+    store_lighting(seg.va, shade_vertex(seg.model, p0, t));
+    let md = models[seg.model];
+    let per = md.points_per_strand - 1u;
+    let last = seg.local % per + 1u >= load_lod(lod_models[seg.model]).segments_per_strand;
+    let next = id + 1u;
+    if last || (segment_visibility[next / 32u] & (1u << (next % 32u))) == 0u {
+        store_lighting(seg.vb, shade_vertex(seg.model, p1, t));
+    }
+}
