@@ -1,12 +1,13 @@
 //! `strandgraph render`: run a scene's graph on a backend and write images.
 
 use miette::{IntoDiagnostic, Result, WrapErr};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandgraph::frame::{override_param, parse_size, prepare};
+use strandgraph::frame::{Prepared, override_param, parse_size, prepare};
 use strandgraph::images::to_picture;
 use strandgraph_cpu::{CpuBackend, PassTiming};
 use strandgraph_graph::Plan;
+use strandgraph_wgpu::WgpuBackend;
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Backend {
@@ -47,9 +48,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.backend != Backend::Cpu {
+    if args.backend == Backend::Ash {
         return Err(miette::miette!(
-            "only the cpu backend is built so far; wgpu and ash arrive with their issues"
+            "the ash backend is not built yet; use --backend cpu, wgpu or all"
         ));
     }
     let size = args.size.as_deref().map(parse_size).transpose()?;
@@ -70,6 +71,39 @@ pub fn run(args: Args) -> Result<()> {
         p.plan.graph.name,
         t0.elapsed().as_secs_f64() * 1e3
     );
+    let main = args.output.clone().unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "{}.png",
+            args.scene
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("render")
+        ))
+    });
+
+    let cpu = if matches!(args.backend, Backend::Cpu | Backend::All) {
+        Some(run_cpu(&args, &p, &main)?)
+    } else {
+        None
+    };
+    let gpu = if matches!(args.backend, Backend::Wgpu | Backend::All) {
+        // With --backend all the CPU images keep the main name.
+        let main = if cpu.is_some() {
+            main.with_extension("wgpu.png")
+        } else {
+            main.clone()
+        };
+        Some(run_wgpu(&p, &main)?)
+    } else {
+        None
+    };
+    if let (Some(cpu), Some(gpu)) = (&cpu, &gpu) {
+        print_side_by_side(&p.plan, cpu, gpu);
+    }
+    Ok(())
+}
+
+fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
     let backend = CpuBackend {
         subgroup_width: args.subgroup.clamp(1, 64),
         instrument: args.instrument,
@@ -100,20 +134,51 @@ pub fn run(args: Args) -> Result<()> {
     if oob > 0 {
         tracing::warn!(oob, "kernels accessed memory out of range");
     }
+    write_outputs(p, main, |name| Ok(frame.read(&p.plan, name)))?;
+    Ok(frame.timings)
+}
 
-    let main = args.output.clone().unwrap_or_else(|| {
-        PathBuf::from(format!(
-            "{}.png",
-            args.scene
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("render")
-        ))
-    });
+fn run_wgpu(p: &Prepared, main: &Path) -> Result<Vec<strandgraph_wgpu::PassTiming>> {
+    let t1 = Instant::now();
+    let frame = WgpuBackend::default()
+        .execute(&p.plan, &p.instance, &p.upload)
+        .into_diagnostic()?;
+    let wall = t1.elapsed().as_secs_f64() * 1e3;
+    print!(
+        "\n  {:<14} {:<16} {:<24} {:>9} {:>10}\n",
+        "queue", "pass", "kind", "groups", "GPU ms"
+    );
+    for t in &frame.timings {
+        println!(
+            "  {:<14} {:<16} {:<24} {:>9} {:>10.3}",
+            t.queue.to_string(),
+            t.name,
+            p.plan.graph.passes[t.pass].kind,
+            t.workgroups,
+            t.millis
+        );
+    }
+    let total: f64 = frame.timings.iter().map(|t| t.millis).sum();
+    println!("  one queue      total {total:.3} ms (per-pass GPU timestamps)");
+    println!("wgpu backend: frame {wall:.1} ms wall, including device and pipeline creation");
+    for note in &frame.notes {
+        println!("  {note}");
+    }
+    write_outputs(p, main, |name| frame.read(&p.plan, name).into_diagnostic())?;
+    Ok(frame.timings)
+}
+
+/// Writes every image output: the first to `main`, the others beside it.
+fn write_outputs(
+    p: &Prepared,
+    main: &Path,
+    read: impl Fn(&str) -> Result<Option<Vec<u32>>>,
+) -> Result<()> {
+    let q = p.upload.quantities;
     let mut wrote_main = false;
     for &(r, _) in &p.plan.graph.outputs {
         let name = p.plan.graph.resources[r].name.clone();
-        let Some(words) = frame.read(&p.plan, &name) else {
+        let Some(words) = read(&name)? else {
             continue;
         };
         let Some(img) = to_picture(&p.plan, r, &words, q.width, q.height) else {
@@ -122,7 +187,7 @@ pub fn run(args: Args) -> Result<()> {
         let path = if wrote_main {
             main.with_extension(format!("{}.png", name.replace('.', "_")))
         } else {
-            main.clone()
+            main.to_path_buf()
         };
         img.save(&path)
             .into_diagnostic()
@@ -137,6 +202,34 @@ pub fn run(args: Args) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// `--backend all`: per-pass times of both backends, in plan order.
+fn print_side_by_side(plan: &Plan, cpu: &[PassTiming], gpu: &[strandgraph_wgpu::PassTiming]) {
+    println!(
+        "\n  {:<16} {:<24} {:>14} {:>14}",
+        "pass", "kind", "cpu wall ms", "wgpu GPU ms"
+    );
+    for &pass in &plan.order {
+        let c = cpu.iter().find(|t| t.pass == pass).map(|t| t.millis);
+        let g = gpu.iter().find(|t| t.pass == pass).map(|t| t.millis);
+        let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+        println!(
+            "  {:<16} {:<24} {:>14} {:>14}",
+            plan.pass_name(pass),
+            plan.graph.passes[pass].kind,
+            show(c),
+            show(g)
+        );
+    }
+    let sum = |v: &mut dyn Iterator<Item = f64>| v.sum::<f64>();
+    println!(
+        "  {:<16} {:<24} {:>14.3} {:>14.3}",
+        "total",
+        "",
+        sum(&mut cpu.iter().map(|t| t.millis)),
+        sum(&mut gpu.iter().map(|t| t.millis))
+    );
 }
 
 fn print_timings(plan: &Plan, timings: &[PassTiming], instrument: bool) {

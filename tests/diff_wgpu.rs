@@ -163,3 +163,41 @@ fn showcase_visibility_matches_cpu_on_wgpu() {
         );
     }
 }
+
+/// `strandgraph render --backend all` runs both backends, prints their
+/// per-pass times side by side and says how the plan degraded on wgpu.
+#[test]
+fn render_backend_all_prints_both_timings() {
+    let out = out_dir().join("cli");
+    std::fs::create_dir_all(&out).unwrap();
+    let main = out.join("showcase.png");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+        .current_dir(root())
+        .args([
+            "render",
+            "scenes/showcase.ron",
+            "--graph",
+            "scenes/graphs/kulikov_visibility.ron",
+            "--size",
+            "128x72",
+            "--backend",
+            "all",
+            "-o",
+        ])
+        .arg(&main)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stdout}\n{stderr}");
+    for needle in [
+        "cpu wall ms",
+        "wgpu GPU ms",
+        "one queue",
+        "cannot alias",
+        "raster",
+    ] {
+        assert!(stdout.contains(needle), "no `{needle}` in:\n{stdout}");
+    }
+    assert!(main.exists() && main.with_extension("wgpu.png").exists());
+}
