@@ -168,3 +168,48 @@ fn render_rejects_a_bad_parameter_by_name() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("workgroup_size"));
 }
+
+/// Rgba16Float words to linear RGB.
+fn rgb16f(words: &[u32], i: usize) -> [f32; 3] {
+    let h = |w: u32| half::f16::from_bits(w as u16).to_f32();
+    [h(words[2 * i]), h(words[2 * i] >> 16), h(words[2 * i + 1])]
+}
+
+#[test]
+fn showcase_renders_lit_and_composited_with_its_own_graph() {
+    let p = prepare(&root().join("scenes/showcase.ron"), None, Some((320, 180)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(p.plan.graph.name, "kulikov");
+    let f = run(&p, &CpuBackend::default());
+    let out = f.read(&p.plan, "output.composed").unwrap();
+    let n = 320 * 180;
+    let bg = [0.02f32, 0.02, 0.025];
+    let mut hair = 0;
+    let mut bright = 0;
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        let c = rgb16f(&out, i);
+        assert!(
+            c.iter().all(|x| x.is_finite() && *x >= 0.0),
+            "pixel {i}: {c:?}"
+        );
+        if (0..3).any(|k| (c[k] - bg[k]).abs() > 0.01) {
+            hair += 1;
+            let luma = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            sum += f64::from(luma);
+            if luma > 0.15 {
+                bright += 1;
+            }
+        }
+    }
+    // Hair and head cover about a third of the frame; the hair is lit (a mean
+    // above the ambient floor, highlights) without blowing out.
+    let mean = sum / hair.max(1) as f64;
+    assert!(hair > n / 5 && hair < n * 3 / 4, "{hair} covered pixels");
+    assert!(mean > 0.03 && mean < 1.5, "mean luminance {mean}");
+    assert!(bright > n / 50, "{bright} bright pixels");
+    // Hair wrote depth where it is nearly opaque: far more than the head alone.
+    let depth = f.read(&p.plan, "scene.depth").unwrap();
+    let deep = depth.iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
+    assert!(deep > n / 6, "{deep} pixels with depth");
+}

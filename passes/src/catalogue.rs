@@ -98,7 +98,7 @@ pub static KINDS: &[PassKind] = &[
     ),
     kind(
         "kulikov.compose",
-        "per-model quad: coverage reconstruction, weighted lighting, depth and motion vectors",
+        "per-model quad, back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion vectors not yet)",
         "Kulikov 2025, 'Composition', 'Motion vectors'",
     ),
     kind(

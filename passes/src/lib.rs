@@ -38,6 +38,7 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::density::Density,
     &kulikov::shade_sort::ShadeSort,
     &kulikov::shade::Shade,
+    &kulikov::compose::Compose,
 ];
 
 /// The built-in pass kinds.

@@ -2,6 +2,7 @@
 //! Advances): LOD, skinning, culling, tile atlas, sort, software raster and
 //! a debug resolve. Each pass is one file: definition, CPU kernel, citation.
 
+pub mod compose;
 pub mod cull;
 pub mod debug_resolve;
 pub mod density;

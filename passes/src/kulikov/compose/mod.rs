@@ -1,0 +1,433 @@
+//! `kulikov.compose`: each hair model's visibility atlas, lit and blended
+//! over the opaque image, back to front.
+//!
+//! Kulikov, "Composition": "Sort back to front. Camera-facing quad for each
+//! hair piece ... Output lighting, depth and motion" and "Coverage
+//! reconstruction" ([`reconstruct`]). On the GPU this is a quad per model
+//! with premultiplied blending (`shaders/kulikov/compose.wgsl`); on the CPU
+//! it is one lane per screen pixel that visits the models in the same order
+//! and writes the `output` and `scene.depth` words directly, as
+//! `scene.opaque` does.
+//!
+//! Per pixel and model (parameters in brackets):
+//! - the atlas texel, jittered by a fixed Poisson-disk pattern hashed by
+//!   pixel where the model's tiles were downscaled ("Resolve stochastically
+//!   to avoid pixelation. Poisson disk distribution for samples")
+//!   [`poisson_samples`, 0 = off];
+//! - `C_total` from the additive layer [`coverage_fit`: `"Quadratic"`, the
+//!   shipped fit; `"Exponential"`, 1 − e^−x, the random-lines limit];
+//! - per layer: the segment from the payload, its coverage of this texel
+//!   [`layer_coverage`: `"Exact"`, the area of the segment's trapezoid in the
+//!   texel, exactly as `kulikov.raster` measured it; `"Width"`, the projected
+//!   strand width in texels, clamped to 1: a strand crossing the pixel covers
+//!   about its width of it], and its lighting interpolated along the segment
+//!   from `vertex_lighting` at the pixel centre's projection;
+//! - [`reconstruct`] [`reconstruct_missing`: false uses the 3 front layers only];
+//! - hair depth (the front layer's) where the result's coverage reaches
+//!   [`depth_threshold`] and is nearer than `scene.depth`.
+//!
+//! Models sort by the view depth of their bounds' centre; facial hair is
+//! pushed back by [`facial_hair_bias`] metres so it composes before the
+//! main hair piece ("Large bias for facial hair").
+
+pub mod reconstruct;
+#[cfg(test)]
+mod tests;
+
+use super::cull::drawn_segment;
+use super::debug_resolve::{load_rgba16f, store_rgba16f};
+use super::payload::{COVERAGE_SCALE, EMPTY, segment_of, total_coverage};
+use super::raster::LAYERS;
+use super::raster::geometry::Trapezoid;
+use super::tiles::ModelTiles;
+use super::{Scene, TILE, clip_to_screen};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::layout::MODEL_FACIAL_HAIR;
+use crate::sim::{CounterValues, Ctx, Words};
+use reconstruct::{Layer, reconstruct};
+use strandgraph_graph::AccessMode::{Read, Write};
+use strandgraph_graph::schema::Quantity;
+
+pub struct Compose;
+
+const KIND: &str = "kulikov.compose";
+pub const GROUP: u32 = 256;
+
+/// A fixed Poisson-disk pattern in the unit disk (minimum distance 0.5),
+/// scaled by half the downscale factor.
+pub const POISSON: [[f32; 2]; 8] = [
+    [0.0, 0.0],
+    [0.62, 0.18],
+    [-0.45, 0.55],
+    [0.12, -0.71],
+    [-0.66, -0.32],
+    [0.38, 0.78],
+    [0.85, -0.45],
+    [-0.1, 0.95],
+];
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ComposeParams {
+    pub poisson_samples: u32,
+    /// false: quadratic; true: 1 - exp(-x).
+    pub exponential_fit: bool,
+    /// false: exact trapezoid area; true: projected width.
+    pub width_coverage: bool,
+    pub reconstruct_missing: bool,
+    pub depth_threshold: f32,
+    pub facial_hair_bias: f32,
+}
+
+impl ComposeParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new(KIND, v)?;
+        let err = |param: &str, message: String| ParamError {
+            kind: KIND,
+            param: param.into(),
+            message,
+        };
+        let exponential_fit = match p.string("coverage_fit", "Quadratic")?.as_str() {
+            "Quadratic" => false,
+            "Exponential" => true,
+            o => {
+                return Err(err(
+                    "coverage_fit",
+                    format!("expected \"Quadratic\" or \"Exponential\", got {o:?}"),
+                ));
+            }
+        };
+        let width_coverage = match p.string("layer_coverage", "Exact")?.as_str() {
+            "Exact" => false,
+            "Width" => true,
+            o => {
+                return Err(err(
+                    "layer_coverage",
+                    format!("expected \"Exact\" or \"Width\", got {o:?}"),
+                ));
+            }
+        };
+        let poisson_samples = p.u32("poisson_samples", 8)?;
+        if poisson_samples as usize > POISSON.len() {
+            return Err(err(
+                "poisson_samples",
+                format!("expected 0..={}, got {poisson_samples}", POISSON.len()),
+            ));
+        }
+        Ok(Self {
+            poisson_samples,
+            exponential_fit,
+            width_coverage,
+            reconstruct_missing: p.bool("reconstruct_missing", true)?,
+            depth_threshold: p.f32("depth_threshold", 0.75)?,
+            facial_hair_bias: p.f32("facial_hair_bias", 0.5)?,
+        })
+    }
+
+    /// The WGSL `ComposeParams` block (binding 0, 32 bytes).
+    pub fn uniform(&self, q: &strandgraph_graph::Quantities) -> Vec<u32> {
+        vec![
+            self.poisson_samples,
+            u32::from(self.exponential_fit),
+            u32::from(self.width_coverage),
+            u32::from(self.reconstruct_missing),
+            self.depth_threshold.to_bits(),
+            self.facial_hair_bias.to_bits(),
+            q.width,
+            q.height,
+        ]
+    }
+}
+
+const BINDINGS: &[Binding] = &[
+    Binding {
+        name: "frame",
+        mode: Read,
+    },
+    Binding {
+        name: "models",
+        mode: Read,
+    },
+    Binding {
+        name: "lod_models",
+        mode: Read,
+    },
+    Binding {
+        name: "atlas_tiles",
+        mode: Read,
+    },
+    Binding {
+        name: "vis_atlas",
+        mode: Read,
+    },
+    Binding {
+        name: "coverage_atlas",
+        mode: Read,
+    },
+    Binding {
+        name: "vertex_lighting",
+        mode: Read,
+    },
+    Binding {
+        name: "clip_positions",
+        mode: Read,
+    },
+    Binding {
+        name: "groom.vertices",
+        mode: Read,
+    },
+    // Attachments (GPU): blended colour, hair depth.
+    Binding {
+        name: "output",
+        mode: Write,
+    },
+    Binding {
+        name: "scene.depth",
+        mode: Write,
+    },
+];
+
+impl PassDef for Compose {
+    fn kind(&self) -> &'static str {
+        KIND
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        Some(BINDINGS)
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Pixels,
+            per_group: GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader {
+            file: "kulikov/compose.wgsl",
+            entry: "vs_main",
+            fragment: Some("fs_main"),
+        }
+    }
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        Ok(ComposeParams::from_ron(params)?.uniform(q))
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(ComposeKernel(ComposeParams::from_ron(params)?)))
+    }
+}
+
+/// Back-to-front model order: farthest (bias included) first.
+pub fn model_order(scene: &Scene, facial_hair_bias: f32) -> Vec<usize> {
+    let cam = &scene.frame.camera_pos;
+    let mut keys: Vec<(f32, usize)> = scene
+        .models
+        .iter()
+        .enumerate()
+        .map(|(m, md)| {
+            let d: f32 = (0..3)
+                .map(|a| (0.5 * (md.bounds_min[a] + md.bounds_max[a]) - cam[a]).powi(2))
+                .sum::<f32>()
+                .sqrt();
+            let bias = if md.flags & MODEL_FACIAL_HAIR != 0 {
+                facial_hair_bias
+            } else {
+                0.0
+            };
+            (d + bias, m)
+        })
+        .collect();
+    keys.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    keys.into_iter().map(|(_, m)| m).collect()
+}
+
+/// A small integer hash (PCG-style) of a pixel.
+pub fn pixel_hash(x: u32, y: u32) -> u32 {
+    let mut h = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2c1b_3c6d);
+    h ^ (h >> 12)
+}
+
+/// NDC depth of view depth `w` under `perspective_rh` (inverse of `linear_depth`).
+pub fn ndc_depth(w: f32, near: f32, far: f32) -> f32 {
+    far * (w - near) / (w * (far - near))
+}
+
+struct ComposeKernel(ComposeParams);
+
+struct Model<'a> {
+    tiles: ModelTiles,
+    seg_first: u32,
+    lod: super::ModelLod,
+    _w: std::marker::PhantomData<&'a ()>,
+}
+
+impl ComposeKernel {
+    /// The layer's trapezoid in the model's raster grid, as `kulikov.raster` built it.
+    fn trapezoid(
+        &self,
+        scene: &Scene,
+        ctx: &Ctx<'_>,
+        md: &Model<'_>,
+        v0: u32,
+        v1: u32,
+    ) -> Option<Trapezoid> {
+        let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
+        let f = &scene.frame;
+        let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
+        let t = &md.tiles;
+        let d = t.downscale as f32;
+        let (ox, oy) = ((t.origin_x * TILE) as f32, (t.origin_y * TILE) as f32);
+        let to_raster = |c: [f32; 4]| {
+            let s = clip_to_screen(c, f.screen[0], f.screen[1]);
+            [s[0] / d - ox, s[1] / d - oy]
+        };
+        let half = |v: u32, w: f32| {
+            0.5 * verts.load_f32(4 * v as usize + 3) * md.lod.thickness_scale * f.pixels_per_unit
+                / w
+                / d
+        };
+        Trapezoid::new(
+            to_raster(c0),
+            to_raster(c1),
+            half(v0, c0[3]),
+            half(v1, c1[3]),
+            c0[3],
+            c1[3],
+        )
+    }
+
+    /// The up-to-3 layers of one texel: coverage, lighting and view depth.
+    #[allow(clippy::too_many_arguments)]
+    fn layers(
+        &self,
+        scene: &Scene,
+        lods: &[super::ModelLod],
+        ctx: &Ctx<'_>,
+        md: &Model<'_>,
+        texel: usize,
+        u: i32,
+        v: i32,
+    ) -> Vec<(Layer, f32)> {
+        let (vis, light) = (ctx.words("vis_atlas"), ctx.words("vertex_lighting"));
+        let stride = vis.len() / LAYERS;
+        let mut out = Vec::with_capacity(LAYERS);
+        for l in 0..LAYERS {
+            let p = vis.load(texel + l * stride);
+            if p == EMPTY {
+                break;
+            }
+            let id = md.seg_first + segment_of(p);
+            let Some(seg) = drawn_segment(scene, lods, id) else {
+                continue;
+            };
+            let Some(trap) = self.trapezoid(scene, ctx, md, seg.v0, seg.v1) else {
+                continue;
+            };
+            let c = [u as f32 + 0.5, v as f32 + 0.5];
+            let d = [trap.b[0] - trap.a[0], trap.b[1] - trap.a[1]];
+            let t = (((c[0] - trap.a[0]) * d[0] + (c[1] - trap.a[1]) * d[1])
+                / (d[0] * d[0] + d[1] * d[1]))
+                .clamp(0.0, 1.0);
+            let coverage = if self.0.width_coverage {
+                let pts = trap.quad.points();
+                let w0 = ((pts[0][0] - pts[3][0]).powi(2) + (pts[0][1] - pts[3][1]).powi(2)).sqrt();
+                let w1 = ((pts[1][0] - pts[2][0]).powi(2) + (pts[1][1] - pts[2][1]).powi(2)).sqrt();
+                (w0 + t * (w1 - w0)).clamp(0.0, 1.0)
+            } else {
+                Trapezoid::coverage(&trap.column(u), v)
+            };
+            let (l0, l1) = (
+                load_rgba16f(&light, seg.v0 as usize),
+                load_rgba16f(&light, seg.v1 as usize),
+            );
+            let lighting = [0, 1, 2].map(|k| l0[k] + t * (l1[k] - l0[k]));
+            out.push((Layer { coverage, lighting }, trap.depth_at(u, v)));
+        }
+        out
+    }
+}
+
+impl CpuKernel for ComposeKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let (width, height) = (ctx.quantities.width, ctx.quantities.height);
+        let pixels = ctx.quantities.count(Quantity::Pixels) as u32;
+        let lods = scene.lods(ctx);
+        let tiles = scene.tiles(ctx);
+        let models: Vec<Model<'_>> = model_order(&scene, self.0.facial_hair_bias)
+            .into_iter()
+            .filter(|&m| tiles[m].valid != 0)
+            .map(|m| Model {
+                tiles: tiles[m],
+                seg_first: scene.models[m].segment_first,
+                lod: lods[m],
+                _w: std::marker::PhantomData,
+            })
+            .collect();
+        let (cov, out, depth): (Words<'_>, Words<'_>, Words<'_>) = (
+            ctx.words("coverage_atlas"),
+            ctx.words("output"),
+            ctx.words("scene.depth"),
+        );
+        let (near, far) = (scene.frame.near, scene.frame.far);
+        let mut tally = CounterValues::default();
+        for i in group * GROUP..((group + 1) * GROUP).min(pixels) {
+            let (x, y) = (i % width, i / width);
+            let mut color = load_rgba16f(&out, i as usize);
+            let mut touched = false;
+            for md in &models {
+                let d = md.tiles.downscale;
+                let (mut sx, mut sy) = (x, y);
+                if d > 1 && self.0.poisson_samples > 0 {
+                    let k = pixel_hash(x, y) % self.0.poisson_samples;
+                    let r = 0.5 * d as f32;
+                    let [jx, jy] = POISSON[k as usize];
+                    sx = (x as f32 + 0.5 + jx * r).clamp(0.0, width as f32 - 1.0) as u32;
+                    sy = (y as f32 + 0.5 + jy * r).clamp(0.0, height as f32 - 1.0) as u32;
+                }
+                let Some(texel) = md.tiles.texel(sx, sy) else {
+                    continue;
+                };
+                let additive = cov.load(texel as usize);
+                if additive == 0 {
+                    continue;
+                }
+                let c_total = if self.0.exponential_fit {
+                    1.0 - (-(additive as f32) / COVERAGE_SCALE).exp()
+                } else {
+                    total_coverage(additive)
+                };
+                let u = (sx / d - md.tiles.origin_x * TILE) as i32;
+                let v = (sy / d - md.tiles.origin_y * TILE) as i32;
+                let layers = self.layers(&scene, &lods, ctx, md, texel as usize, u, v);
+                let ls: Vec<Layer> = layers.iter().map(|(l, _)| *l).collect();
+                let (hair, alpha) = reconstruct(&ls, c_total, self.0.reconstruct_missing);
+                for k in 0..3 {
+                    color[k] = hair[k] + (1.0 - alpha) * color[k];
+                }
+                touched = true;
+                if alpha >= self.0.depth_threshold
+                    && let Some((_, w)) = layers.first()
+                {
+                    let z = ndc_depth(*w, near, far);
+                    if z < depth.load_f32(i as usize) {
+                        depth.store_f32(i as usize, z);
+                    }
+                }
+            }
+            if touched {
+                store_rgba16f(&out, i as usize, color);
+                tally.pixels_written += 1;
+            }
+        }
+        if ctx.instrument {
+            ctx.counters.add(&tally);
+        }
+    }
+}

@@ -1,0 +1,239 @@
+// kulikov.compose: a camera-facing quad per hair model over its atlas
+// tiles, drawn back to front with premultiplied blending (src One, dst
+// OneMinusSrcAlpha) over the opaque image (Kulikov, "Composition").
+// fs_main reconstructs the pixel's hair radiance and coverage from the 3
+// layers and the additive coverage (Kulikov, "Coverage reconstruction");
+// fs_depth, drawn with the same quads into scene.depth, discards where the
+// coverage is below depth_threshold and writes the front layer's depth
+// ("We write hair to depth as we render it").
+// Port of passes/src/kulikov/compose/{mod,reconstruct}.rs; the CPU kernel
+// loops over pixels and models in the order vs_main draws the quads.
+
+#import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, trapezoid_new, trapezoid_column, column_coverage, trapezoid_depth_at, clip_to_screen, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+
+struct ComposeParams {
+    poisson_samples: u32,
+    // 0 Quadratic, 1 Exponential.
+    exponential_fit: u32,
+    // 0 Exact, 1 Width.
+    width_coverage: u32,
+    reconstruct_missing: u32,
+    depth_threshold: f32,
+    facial_hair_bias: f32,
+    width: u32,
+    height: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: ComposeParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> models: array<ModelData>;
+@group(0) @binding(3) var<storage, read> lod_models: array<ModelLod>;
+@group(0) @binding(4) var<storage, read> atlas_tiles: array<ModelTiles>;
+@group(0) @binding(5) var<storage, read> vis_atlas: array<u32>;
+@group(0) @binding(6) var<storage, read> coverage_atlas: array<u32>;
+@group(0) @binding(7) var<storage, read> vertex_lighting: array<vec2<u32>>;
+@group(0) @binding(8) var<storage, read> clip_positions: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> groom_vertices: array<vec4<f32>>;
+
+const POISSON = array<vec2<f32>, 8>(
+    vec2<f32>(0.0, 0.0), vec2<f32>(0.62, 0.18), vec2<f32>(-0.45, 0.55), vec2<f32>(0.12, -0.71),
+    vec2<f32>(-0.66, -0.32), vec2<f32>(0.38, 0.78), vec2<f32>(0.85, -0.45), vec2<f32>(-0.1, 0.95),
+);
+
+// compose::model_order: the sort key, view distance of the bounds' centre plus the facial bias.
+fn sort_key(m: u32) -> f32 {
+    let md = models[m];
+    let c = 0.5 * (md.bounds_min.xyz + md.bounds_max.xyz) - frame.camera_pos.xyz;
+    return sqrt(dot(c, c)) + select(0.0, params.facial_hair_bias, (md.flags & MODEL_FACIAL_HAIR) != 0u);
+}
+
+// The model drawn at back-to-front position `rank` (farthest first; ties by index).
+fn model_at(rank: u32) -> u32 {
+    for (var m = 0u; m < frame.model_count; m++) {
+        var r = 0u;
+        let k = sort_key(m);
+        for (var o = 0u; o < frame.model_count; o++) {
+            let ko = sort_key(o);
+            if ko > k || (ko == k && o < m) {
+                r += 1u;
+            }
+        }
+        if r == rank {
+            return m;
+        }
+    }
+    return 0u;
+}
+
+struct QuadOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) model: u32,
+}
+
+// Six vertices per model: the screen rectangle of its atlas tiles.
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> QuadOut {
+    var out: QuadOut;
+    let m = model_at(vi / 6u);
+    out.model = m;
+    let t = load_tiles(atlas_tiles[m]);
+    let span = f32(TILE * t.downscale);
+    let lo = vec2<f32>(f32(t.origin_x), f32(t.origin_y)) * span;
+    let hi = lo + vec2<f32>(f32(t.grid_w), f32(t.grid_h)) * span;
+    let corner = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0),
+        vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 1.0),
+    )[vi % 6u];
+    let p = mix(lo, hi, corner);
+    let ndc = vec2<f32>(p.x / frame.screen.x * 2.0 - 1.0, 1.0 - p.y / frame.screen.y * 2.0);
+    // Invalid models collapse to a degenerate quad.
+    out.position = vec4<f32>(select(vec2<f32>(2.0), ndc, t.valid != 0u), 0.0, 1.0);
+    return out;
+}
+
+fn f16_to_f32(h: u32) -> f32 {
+    let s = select(1.0, -1.0, (h & 0x8000u) != 0u);
+    let e = (h >> 10u) & 0x1Fu;
+    let m = f32(h & 0x3FFu);
+    if e == 0u {
+        return s * m * 5.9604645e-8;
+    }
+    if e == 31u {
+        return s * 65504.0;
+    }
+    return s * (1.0 + m / 1024.0) * exp2(f32(e) - 15.0);
+}
+
+fn lighting(v: u32) -> vec3<f32> {
+    let w = vertex_lighting[v];
+    return vec3<f32>(f16_to_f32(w.x & 0xFFFFu), f16_to_f32(w.x >> 16u), f16_to_f32(w.y & 0xFFFFu));
+}
+
+fn pixel_hash(x: u32, y: u32) -> u32 {
+    var h = (x * 0x8da6b343u) ^ (y * 0xd8163841u);
+    h ^= h >> 15u;
+    h = h * 0x2c1b3c6du;
+    return h ^ (h >> 12u);
+}
+
+struct Hair {
+    color: vec3<f32>,
+    alpha: f32,
+    // View depth of the front layer (0 when none).
+    front_w: f32,
+}
+
+// One pixel of one model: compose::ComposeKernel and reconstruct::reconstruct.
+fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
+    var out = Hair(vec3<f32>(0.0), 0.0, 0.0);
+    let t = load_tiles(atlas_tiles[m]);
+    let d = t.downscale;
+    var sx = x;
+    var sy = y;
+    if d > 1u && params.poisson_samples > 0u {
+        let j = POISSON[pixel_hash(x, y) % params.poisson_samples] * (0.5 * f32(d));
+        sx = u32(clamp(f32(x) + 0.5 + j.x, 0.0, f32(params.width) - 1.0));
+        sy = u32(clamp(f32(y) + 0.5 + j.y, 0.0, f32(params.height) - 1.0));
+    }
+    let texel = tile_texel(t, sx, sy);
+    if texel == EMPTY {
+        return out;
+    }
+    let additive = coverage_atlas[texel];
+    if additive == 0u {
+        return out;
+    }
+    var c_total = total_coverage(additive);
+    if params.exponential_fit != 0u {
+        c_total = 1.0 - exp(-f32(additive) / COVERAGE_SCALE);
+    }
+    let u = i32(sx / d - t.origin_x * TILE);
+    let v = i32(sy / d - t.origin_y * TILE);
+    let md = models[m];
+    let lod = load_lod(lod_models[m]);
+    let stride = arrayLength(&vis_atlas) / LAYERS;
+    let dd = f32(d);
+    let origin = vec2<f32>(f32(t.origin_x * TILE), f32(t.origin_y * TILE));
+    var cov = array<f32, 3>(0.0, 0.0, 0.0);
+    var lit = array<vec3<f32>, 3>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    var n = 0u;
+    for (var l = 0u; l < LAYERS; l++) {
+        let p = vis_atlas[texel + l * stride];
+        if p == EMPTY {
+            break;
+        }
+        let id = md.segment_first + (p & SEGMENT_MASK);
+        if !segment_in_model(md, id) {
+            continue;
+        }
+        let seg = drawn_in_model(md, lod, m, id);
+        if !seg.valid {
+            continue;
+        }
+        let c0 = clip_positions[seg.va];
+        let c1 = clip_positions[seg.vb];
+        let s0 = clip_to_screen(c0, frame.screen.x, frame.screen.y);
+        let s1 = clip_to_screen(c1, frame.screen.x, frame.screen.y);
+        let k = 0.5 * lod.thickness_scale * frame.pixels_per_unit;
+        let trap = trapezoid_new(s0.xy / dd - origin, s1.xy / dd - origin,
+            groom_vertices[seg.va].w * k / c0.w / dd, groom_vertices[seg.vb].w * k / c1.w / dd, c0.w, c1.w);
+        if !trap.valid {
+            continue;
+        }
+        let c = vec2<f32>(f32(u) + 0.5, f32(v) + 0.5);
+        let ab = trap.b - trap.a;
+        let tt = clamp(dot(c - trap.a, ab) / dot(ab, ab), 0.0, 1.0);
+        var coverage = 0.0;
+        if params.width_coverage != 0u {
+            let w0 = length(trap.quad.pts[0] - trap.quad.pts[3]);
+            let w1 = length(trap.quad.pts[1] - trap.quad.pts[2]);
+            coverage = clamp(w0 + tt * (w1 - w0), 0.0, 1.0);
+        } else {
+            coverage = column_coverage(trapezoid_column(trap.quad, u), v);
+        }
+        if n == 0u {
+            out.front_w = trapezoid_depth_at(trap.a, trap.b, trap.wa, trap.wb, u, v);
+        }
+        cov[n] = clamp(coverage, 0.0, 1.0);
+        lit[n] = mix(lighting(seg.va), lighting(seg.vb), tt);
+        n += 1u;
+    }
+    // Kulikov: C_front by alpha blending; missing lighting as the weighted
+    // average with w_i = C_i * 0.25^(3 - i).
+    var front = vec3<f32>(0.0);
+    var transmit = 1.0;
+    var wsum = 0.0;
+    var wl = vec3<f32>(0.0);
+    for (var i = 0u; i < n; i++) {
+        front += transmit * cov[i] * lit[i];
+        transmit *= 1.0 - cov[i];
+        let w = cov[i] * pow(0.25, f32(n - 1u - i));
+        wsum += w;
+        wl += w * lit[i];
+    }
+    out.color = front;
+    out.alpha = 1.0 - transmit;
+    if params.reconstruct_missing != 0u && wsum > 0.0 {
+        let c_missing = max(clamp(c_total, 0.0, 1.0) - out.alpha, 0.0);
+        out.color = front + c_missing * wl / wsum;
+        out.alpha += c_missing;
+    }
+    return out;
+}
+
+@fragment
+fn fs_main(in: QuadOut) -> @location(0) vec4<f32> {
+    let h = compose_pixel(in.model, u32(in.position.x), u32(in.position.y));
+    return vec4<f32>(h.color, h.alpha);
+}
+
+// compose::ndc_depth of the front layer where coverage reaches the threshold.
+@fragment
+fn fs_depth(in: QuadOut) -> @builtin(frag_depth) f32 {
+    let h = compose_pixel(in.model, u32(in.position.x), u32(in.position.y));
+    if h.alpha < params.depth_threshold || h.front_w <= 0.0 {
+        discard;
+    }
+    return frame.far * (h.front_w - frame.near) / (h.front_w * (frame.far - frame.near));
+}
