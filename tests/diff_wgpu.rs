@@ -241,3 +241,21 @@ fn render_backend_all_prints_both_timings() {
     }
     assert!(main.exists() && main.with_extension("wgpu.png").exists());
 }
+
+/// A raster pass whose pipeline state the backend does not know is refused
+/// by name, not drawn with the wrong state.
+#[test]
+fn wgpu_refuses_raster_passes_it_cannot_draw() {
+    let graph = root().join("scenes/graphs/kulikov.ron");
+    let p = prepare(
+        &root().join("scenes/showcase.ron"),
+        Some(&graph),
+        Some((64, 36)),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let Err(e) = WgpuBackend::default().execute(&p.plan, &p.instance, &p.upload) else {
+        panic!("kulikov.compose ran on wgpu without its blend and depth pipeline state");
+    };
+    let message = e.to_string();
+    assert!(message.contains("kulikov.compose"), "{message}");
+}

@@ -364,6 +364,17 @@ fn prepare<'d>(
             .into_iter()
             .map(|(n, r, _)| (n, g.physical(r)))
             .collect();
+        if def.shader().fragment.is_some() && !RASTER_KINDS.contains(&def.kind()) {
+            return Err(WgpuError::Pass {
+                pass: pass.name.clone(),
+                message: format!(
+                    "`{}` is a raster pass whose pipeline state (blending, draw count, \
+                     extra pipelines) the wgpu backend does not know yet; it runs \
+                     {RASTER_KINDS:?}",
+                    def.kind()
+                ),
+            });
+        }
         let params = def.gpu_params(&pass.params, &instance.quantities)?;
         let file = def.shader().file;
         let composed = shaders
@@ -493,6 +504,12 @@ fn create_memory(
     }
     Ok(memory)
 }
+
+/// The raster passes whose pipeline state [`color_load`] and
+/// `record_and_run` know. Any other pass with a fragment entry is refused
+/// rather than drawn with the wrong state: `kulikov.compose` blends
+/// premultiplied, draws a quad per model and has a second depth pipeline.
+const RASTER_KINDS: [&str; 2] = ["scene.depth_prepass", "scene.opaque"];
 
 /// The raster state a render-pipeline pass needs, from its shader's header
 /// (shaders/scene/depth_prepass.wgsl, shaders/scene/opaque.wgsl): triangle
