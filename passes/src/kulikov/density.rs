@@ -206,6 +206,80 @@ impl CpuKernel for DensityKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kulikov::ModelLod;
+    use crate::layout::{FrameData, words_of};
+    use crate::sim::harness::Harness;
+    use bytemuck::Zeroable;
+    use strandgraph_graph::Quantities;
+
+    /// Two strands of 3 points, 1 cm segments, 100 µm thick, one LOD-dropped:
+    /// the grid holds the drawn segments' projected area, at their midpoints.
+    #[test]
+    fn splats_drawn_segments_projected_area() {
+        let mut f = FrameData::zeroed();
+        let id = glam::Mat4::IDENTITY.to_cols_array();
+        (f.view_proj, f.inv_view_proj, f.model_count) = (id, id, 1);
+        let mut m = ModelData::zeroed();
+        (m.strand_count, m.points_per_strand) = (2, 3);
+        m.bounds_min = [0.0, 0.0, 0.0, 0.0];
+        m.bounds_max = [0.048, 0.048, 0.048, 0.0];
+        let lod = ModelLod {
+            strands: 1,
+            vertex_step: 1,
+            thickness_scale: 2.0,
+            segments_per_strand: 2,
+            ..Default::default()
+        };
+        let mut lod_words = vec![0u32; 8];
+        {
+            let atoms: Vec<_> = lod_words
+                .iter()
+                .map(|&w| std::sync::atomic::AtomicU32::new(w))
+                .collect();
+            let oob = std::sync::atomic::AtomicU64::new(0);
+            lod.store(&crate::sim::Words::new(&atoms, &oob), 0);
+            lod_words = atoms
+                .iter()
+                .map(|a| a.load(std::sync::atomic::Ordering::Relaxed))
+                .collect();
+        }
+        let (mut clip, mut verts) = (Vec::new(), Vec::new());
+        for s in 0..2 {
+            for k in 0..3 {
+                let p = [0.0105 + 0.02 * s as f32, 0.0105 + 0.01 * k as f32, 0.0105];
+                clip.extend([p[0], p[1], p[2], 1.0].map(f32::to_bits));
+                verts.extend([p[0], p[1], p[2], 1e-4].map(f32::to_bits));
+            }
+        }
+        let mut hs = Harness::new(Quantities {
+            segments: 4,
+            vertices: 6,
+            models: 1,
+            ..Default::default()
+        });
+        hs.buffer("frame", words_of(&[f]))
+            .buffer("models", words_of(&[m]))
+            .buffer("lod_models", lod_words)
+            .buffer("clip_positions", clip)
+            .buffer("groom.vertices", verts)
+            .buffer("density_grid", vec![0; GRID_WORDS as usize]);
+        let k = Density.cpu_kernel(&ron::Value::Unit).unwrap();
+        hs.run(k.as_ref(), 1, GROUP);
+        assert_eq!(hs.out_of_bounds(), 0);
+        let grid = hs.read("density_grid");
+        // 2e-4 m (thickness × LOD scale) × 0.01 m = 2e-6 m² = 2000 units per segment.
+        let filled: Vec<(usize, u32)> = grid
+            .iter()
+            .copied()
+            .enumerate()
+            .filter(|(_, u)| *u > 0)
+            .collect();
+        let g = Grid::of(&m, MAX_RESOLUTION);
+        let at = |y: f32| g.voxel([0.0105, y, 0.0105]).unwrap() as usize;
+        assert_eq!(filled, vec![(at(0.0155), 2000), (at(0.0255), 2000)]);
+        // One voxel is 1 mm³: 2000 units there are 2 strands crossed per mm.
+        assert!((g.sigma(2000) - 2000.0).abs() < 1.0, "{}", g.sigma(2000));
+    }
 
     #[test]
     fn voxels_cover_the_bounds() {
