@@ -507,9 +507,15 @@ fn create_memory(
 
 /// The raster passes whose pipeline state [`color_load`] and
 /// `record_and_run` know. Any other pass with a fragment entry is refused
-/// rather than drawn with the wrong state: `kulikov.compose` blends
-/// premultiplied, draws a quad per model and has a second depth pipeline.
-const RASTER_KINDS: [&str; 2] = ["scene.depth_prepass", "scene.opaque"];
+/// rather than drawn with the wrong state.
+const RASTER_KINDS: [&str; 3] = ["scene.depth_prepass", "scene.opaque", COMPOSE];
+
+/// shaders/kulikov/compose.wgsl (header): six vertices per model, drawn back
+/// to front with premultiplied blending (src One, dst OneMinusSrcAlpha) over
+/// the loaded colour; then `fs_depth` with the same quads writes hair depth
+/// into the loaded `scene.depth` where nearer (the CPU kernel's `z < depth`).
+const COMPOSE: &str = "kulikov.compose";
+const COMPOSE_DEPTH_ENTRY: &str = "fs_depth";
 
 /// The raster state a render-pipeline pass needs, from its shader's header
 /// (shaders/scene/depth_prepass.wgsl, shaders/scene/opaque.wgsl): triangle
@@ -634,6 +640,7 @@ fn record_and_run(
                 .filter(|(_, u)| *u == Usage::Color)
                 .map(|(b, _)| *b)
                 .collect();
+            let compose = prep.def.kind() == COMPOSE;
             let depth_writes = depth.is_some_and(|b| {
                 pass.accesses
                     .iter()
@@ -652,7 +659,19 @@ fn record_and_run(
                     format_of(b).map(|format| {
                         Some(wgpu::ColorTargetState {
                             format,
-                            blend: None,
+                            blend: compose.then_some(wgpu::BlendState {
+                                color: wgpu::BlendComponent {
+                                    src_factor: wgpu::BlendFactor::One,
+                                    dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+                                    operation: wgpu::BlendOperation::Add,
+                                },
+                                // The opaque image's alpha stays.
+                                alpha: wgpu::BlendComponent {
+                                    src_factor: wgpu::BlendFactor::Zero,
+                                    dst_factor: wgpu::BlendFactor::One,
+                                    operation: wgpu::BlendOperation::Add,
+                                },
+                            }),
                             write_mask: wgpu::ColorWrites::ALL,
                         })
                     })
@@ -661,8 +680,10 @@ fn record_and_run(
             let depth_stencil = match depth {
                 Some(b) => Some(wgpu::DepthStencilState {
                     format: format_of(b)?,
-                    depth_write_enabled: Some(depth_writes),
-                    depth_compare: Some(if depth_writes {
+                    depth_write_enabled: Some(depth_writes && !compose),
+                    depth_compare: Some(if compose {
+                        wgpu::CompareFunction::Always
+                    } else if depth_writes {
                         wgpu::CompareFunction::Less
                     } else {
                         wgpu::CompareFunction::Equal
@@ -684,10 +705,10 @@ fn record_and_run(
                 primitive: wgpu::PrimitiveState {
                     topology: wgpu::PrimitiveTopology::TriangleList,
                     front_face: wgpu::FrontFace::Ccw,
-                    cull_mode: Some(wgpu::Face::Back),
+                    cull_mode: (!compose).then_some(wgpu::Face::Back),
                     ..Default::default()
                 },
-                depth_stencil,
+                depth_stencil: depth_stencil.clone(),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
@@ -734,7 +755,7 @@ fn record_and_run(
                         .as_ref()
                         .ok_or_else(|| pass_error("depth attachment has no view".into()))?,
                     depth_ops: Some(wgpu::Operations {
-                        load: if depth_writes {
+                        load: if depth_writes && !compose {
                             wgpu::LoadOp::Clear(1.0)
                         } else {
                             wgpu::LoadOp::Load
@@ -745,8 +766,64 @@ fn record_and_run(
                 }),
                 None => None,
             };
-            let vertices = u32::try_from(q.triangles * 3)
-                .map_err(|_| pass_error(format!("{} triangles are too many", q.triangles)))?;
+            let drawn = if compose {
+                q.models * 6
+            } else {
+                q.triangles * 3
+            };
+            let vertices = u32::try_from(drawn)
+                .map_err(|_| pass_error(format!("{drawn} vertices are too many")))?;
+            // compose's second pipeline: hair depth, no colour writes.
+            let depth_pass = if compose {
+                let targets: Vec<Option<wgpu::ColorTargetState>> = targets
+                    .iter()
+                    .map(|t| {
+                        t.as_ref().map(|t| wgpu::ColorTargetState {
+                            format: t.format,
+                            blend: None,
+                            write_mask: wgpu::ColorWrites::empty(),
+                        })
+                    })
+                    .collect();
+                let depth_stencil = depth_stencil.map(|d| wgpu::DepthStencilState {
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    ..d
+                });
+                let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(&pass.name),
+                    layout: None,
+                    vertex: wgpu::VertexState {
+                        module: &module,
+                        entry_point: Some(shader.entry),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        ..Default::default()
+                    },
+                    depth_stencil,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &module,
+                        entry_point: Some(COMPOSE_DEPTH_ENTRY),
+                        compilation_options: Default::default(),
+                        targets: &targets,
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                });
+                // Automatic layouts are per pipeline: its own bind group.
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&pass.name),
+                    layout: &pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                });
+                Some((pipeline, bind_group))
+            } else {
+                None
+            };
             let mut rp = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(&pass.name),
                 color_attachments: &color_attachments,
@@ -763,6 +840,11 @@ fn record_and_run(
             rp.set_bind_group(0, &bind_group, &[]);
             // Draw 3 × triangles vertices, no vertex buffers (the shader headers).
             rp.draw(0..vertices, 0..1);
+            if let Some((pipeline, bind_group)) = &depth_pass {
+                rp.set_pipeline(pipeline);
+                rp.set_bind_group(0, bind_group, &[]);
+                rp.draw(0..vertices, 0..1);
+            }
             workgroups.push(vertices);
             continue;
         }
