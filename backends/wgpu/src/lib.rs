@@ -282,7 +282,7 @@ impl WgpuBackend {
         };
 
         let mut notes = vec![
-            format!("adapter: {adapter_name}"),
+            format!("adapter: {adapter_name}; requested features: {features:?}"),
             "wgpu has one queue: AsyncCompute passes run on it in plan order; the plan's sync points hold trivially".into(),
         ];
         let memory = create_memory(&device, &queue, plan, instance, inputs, &prepared)?;
