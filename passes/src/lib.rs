@@ -7,6 +7,7 @@
 //! Each entry says which pipeline it belongs to and which section of which
 //! paper specifies it, so `strandgraph graph` can show where a pass comes from.
 
+pub mod bind;
 mod catalogue;
 pub mod common;
 pub mod contract;

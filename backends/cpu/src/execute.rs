@@ -17,12 +17,8 @@ use strandgraph_passes::{CpuKernel, Definitions, Dispatch, PassDef, Registry};
 pub enum CpuError {
     #[error("pass `{pass}`: kind `{kind}` has no CPU kernel yet")]
     NoKernel { pass: String, kind: String },
-    #[error("pass `{pass}`: kind `{kind}` binds `{binding}`, which the graph does not give it")]
-    MissingBinding {
-        pass: String,
-        kind: String,
-        binding: String,
-    },
+    #[error(transparent)]
+    MissingBinding(#[from] strandgraph_passes::bind::MissingBinding),
     #[error(transparent)]
     Param(#[from] strandgraph_passes::ParamError),
     #[error("input `{resource}`: {message}")]
@@ -174,33 +170,10 @@ impl CpuBackend {
                     pass: pass.name.clone(),
                     kind: pass.kind.clone(),
                 })?;
-            let given: Vec<(String, usize)> = pass
-                .accesses
-                .iter()
-                .map(|a| (g.resources[a.resource].name.clone(), a.resource))
+            let bindings = strandgraph_passes::bind::bind(def, g, p)?
+                .into_iter()
+                .map(|b| (b.name, b.access.resource))
                 .collect();
-            let bindings = match def.bindings() {
-                None => pass
-                    .accesses
-                    .iter()
-                    .filter(|a| a.mode.writes())
-                    .map(|a| (g.resources[a.resource].name.clone(), a.resource))
-                    .collect(),
-                Some(wanted) => wanted
-                    .iter()
-                    .map(|b| {
-                        given
-                            .iter()
-                            .find(|(n, _)| n == b.name)
-                            .cloned()
-                            .ok_or_else(|| CpuError::MissingBinding {
-                                pass: pass.name.clone(),
-                                kind: pass.kind.clone(),
-                                binding: b.name.to_string(),
-                            })
-                    })
-                    .collect::<Result<_, _>>()?,
-            };
             let kernel = def.cpu_kernel(&pass.params)?;
             out.insert(
                 p,

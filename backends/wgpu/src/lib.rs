@@ -43,12 +43,8 @@ pub enum WgpuError {
     Device(String),
     #[error("pass `{pass}`: kind `{kind}` has no definition")]
     NoDefinition { pass: String, kind: String },
-    #[error("pass `{pass}`: kind `{kind}` binds `{binding}`, which the graph does not give it")]
-    MissingBinding {
-        pass: String,
-        kind: String,
-        binding: String,
-    },
+    #[error(transparent)]
+    MissingBinding(#[from] strandgraph_passes::bind::MissingBinding),
     #[error(transparent)]
     Param(#[from] strandgraph_passes::ParamError),
     #[error("shader: {0}")]
@@ -326,34 +322,10 @@ fn prepare<'d>(
                 pass: pass.name.clone(),
                 kind: pass.kind.clone(),
             })?;
-        // As the CPU backend binds (backends/cpu/src/execute.rs, `prepare`).
-        let given: Vec<(String, usize, Usage)> = pass
-            .accesses
-            .iter()
-            .map(|a| (g.resources[a.resource].name.clone(), a.resource, a.usage))
+        let chosen: Vec<(String, usize, Usage)> = strandgraph_passes::bind::bind(def, g, p)?
+            .into_iter()
+            .map(|b| (b.name, b.access.resource, b.access.usage))
             .collect();
-        let chosen: Vec<(String, usize, Usage)> = match def.bindings() {
-            None => pass
-                .accesses
-                .iter()
-                .filter(|a| a.mode.writes())
-                .map(|a| (g.resources[a.resource].name.clone(), a.resource, a.usage))
-                .collect(),
-            Some(wanted) => wanted
-                .iter()
-                .map(|b| {
-                    given
-                        .iter()
-                        .find(|(n, _, _)| n == b.name)
-                        .cloned()
-                        .ok_or_else(|| WgpuError::MissingBinding {
-                            pass: pass.name.clone(),
-                            kind: pass.kind.clone(),
-                            binding: b.name.to_string(),
-                        })
-                })
-                .collect::<Result<_, _>>()?,
-        };
         let attachments = chosen
             .iter()
             .enumerate()

@@ -1,0 +1,53 @@
+//! Matching a graph pass's accesses to its kind's bindings, the same way on
+//! every backend: by resource name, in the order the definition lists them.
+
+use crate::contract::PassDef;
+use strandgraph_graph::resolve::{Access, Graph, PassId};
+
+/// A binding the graph gave: the name the kernel asks for and the access behind it.
+#[derive(Debug, Clone)]
+pub struct Bound {
+    pub name: String,
+    pub access: Access,
+}
+
+/// A binding the definition declares that the graph pass does not provide.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("pass `{pass}`: kind `{kind}` binds `{binding}`, which the graph does not give it")]
+pub struct MissingBinding {
+    pub pass: String,
+    pub kind: String,
+    pub binding: String,
+}
+
+/// The bindings of pass `p`, in the definition's order. A definition without
+/// a fixed interface (`common.clear`) binds every resource the pass writes.
+pub fn bind(def: &dyn PassDef, g: &Graph, p: PassId) -> Result<Vec<Bound>, MissingBinding> {
+    let pass = &g.passes[p];
+    let named = |a: &Access| Bound {
+        name: g.resources[a.resource].name.clone(),
+        access: *a,
+    };
+    match def.bindings() {
+        None => Ok(pass
+            .accesses
+            .iter()
+            .filter(|a| a.mode.writes())
+            .map(named)
+            .collect()),
+        Some(wanted) => wanted
+            .iter()
+            .map(|b| {
+                pass.accesses
+                    .iter()
+                    .find(|a| g.resources[a.resource].name == b.name)
+                    .map(named)
+                    .ok_or_else(|| MissingBinding {
+                        pass: pass.name.clone(),
+                        kind: pass.kind.clone(),
+                        binding: b.name.to_string(),
+                    })
+            })
+            .collect(),
+    }
+}
