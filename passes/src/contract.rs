@@ -16,6 +16,27 @@ pub struct Binding {
     pub mode: AccessMode,
 }
 
+impl Binding {
+    pub const fn read(name: &'static str) -> Self {
+        Self {
+            name,
+            mode: AccessMode::Read,
+        }
+    }
+    pub const fn write(name: &'static str) -> Self {
+        Self {
+            name,
+            mode: AccessMode::Write,
+        }
+    }
+    pub const fn atomic(name: &'static str) -> Self {
+        Self {
+            name,
+            mode: AccessMode::Atomic,
+        }
+    }
+}
+
 /// How many workgroups a dispatch launches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Dispatch {
@@ -38,6 +59,17 @@ pub struct Shader {
     pub entry: &'static str,
     /// The fragment entry point of a raster pass (one with colour or depth attachments).
     pub fragment: Option<&'static str>,
+}
+
+impl Shader {
+    /// A compute entry point.
+    pub const fn compute(file: &'static str, entry: &'static str) -> Self {
+        Self {
+            file,
+            entry,
+            fragment: None,
+        }
+    }
 }
 
 /// A pass parameter that is missing, mistyped or out of range.

@@ -27,11 +27,7 @@ impl PassDef for Clear {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "common/clear.wgsl",
-            entry: "clear",
-            fragment: None,
-        }
+        Shader::compute("common/clear.wgsl", "clear")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         let p = Params::new(self.kind(), params)?;

@@ -12,7 +12,6 @@ use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef,
 use crate::layout::ModelData;
 use crate::sim::{CounterValues, Ctx, Words};
 use std::collections::BTreeMap;
-use strandgraph_graph::AccessMode::{Atomic, Read};
 use strandgraph_graph::schema::Quantity;
 
 pub struct Cull;
@@ -33,40 +32,17 @@ impl PassDef for Cull {
         "kulikov.cull"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Read,
-            },
-            Binding {
-                name: "hiz",
-                mode: Read,
-            },
-            Binding {
-                name: "segment_visibility",
-                mode: Atomic,
-            },
-            Binding {
-                name: "screen_bounds",
-                mode: Atomic,
-            },
-            Binding {
-                name: "sort_bins",
-                mode: Atomic,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("clip_positions"),
+            Binding::read("hiz"),
+            Binding::atomic("segment_visibility"),
+            Binding::atomic("screen_bounds"),
+            Binding::atomic("sort_bins"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -78,11 +54,7 @@ impl PassDef for Cull {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/cull.wgsl",
-            entry: "cull",
-            fragment: None,
-        }
+        Shader::compute("kulikov/cull.wgsl", "cull")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         let p = Params::new(self.kind(), params)?;

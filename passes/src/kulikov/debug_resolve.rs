@@ -12,7 +12,6 @@ use super::{Scene, TILE_TEXELS};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
 use crate::sim::{Ctx, Words};
 use half::f16;
-use strandgraph_graph::AccessMode::{Read, Write};
 use strandgraph_graph::schema::Quantity;
 
 pub struct DebugResolve;
@@ -24,36 +23,16 @@ impl PassDef for DebugResolve {
         "kulikov.debug_resolve"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "atlas_tiles",
-                mode: Read,
-            },
-            Binding {
-                name: "vis_atlas",
-                mode: Read,
-            },
-            Binding {
-                name: "coverage_atlas",
-                mode: Read,
-            },
-            Binding {
-                name: "output",
-                mode: Write,
-            },
-            Binding {
-                name: "debug_layers",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("atlas_tiles"),
+            Binding::read("vis_atlas"),
+            Binding::read("coverage_atlas"),
+            Binding::write("output"),
+            Binding::write("debug_layers"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -65,11 +44,7 @@ impl PassDef for DebugResolve {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/debug_resolve.wgsl",
-            entry: "resolve",
-            fragment: None,
-        }
+        Shader::compute("kulikov/debug_resolve.wgsl", "resolve")
     }
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(ResolveKernel))

@@ -16,7 +16,6 @@ use super::{Scene, world_of_clip};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::layout::ModelData;
 use crate::sim::Ctx;
-use strandgraph_graph::AccessMode::{Atomic, Read};
 use strandgraph_graph::schema::Quantity;
 
 pub struct Density;
@@ -33,32 +32,15 @@ impl PassDef for Density {
         "kulikov.density"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Read,
-            },
-            Binding {
-                name: "groom.vertices",
-                mode: Read,
-            },
-            Binding {
-                name: "density_grid",
-                mode: Atomic,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("clip_positions"),
+            Binding::read("groom.vertices"),
+            Binding::atomic("density_grid"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -70,11 +52,7 @@ impl PassDef for Density {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/density.wgsl",
-            entry: "density",
-            fragment: None,
-        }
+        Shader::compute("kulikov/density.wgsl", "density")
     }
     fn gpu_params(
         &self,

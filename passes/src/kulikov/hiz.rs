@@ -6,7 +6,6 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
 use crate::sim::Ctx;
-use strandgraph_graph::AccessMode::{Read, Write};
 use strandgraph_graph::schema::Quantity;
 
 pub struct DepthDownsample;
@@ -20,16 +19,8 @@ impl PassDef for DepthDownsample {
         "kulikov.depth_downsample"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "scene.depth",
-                mode: Read,
-            },
-            Binding {
-                name: "hiz",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[Binding::read("scene.depth"), Binding::write("hiz")];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -41,11 +32,7 @@ impl PassDef for DepthDownsample {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/hiz.wgsl",
-            entry: "downsample",
-            fragment: None,
-        }
+        Shader::compute("kulikov/hiz.wgsl", "downsample")
     }
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(DownsampleKernel))

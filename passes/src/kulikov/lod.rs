@@ -16,7 +16,6 @@ use super::{ModelLod, Scene, drawn_segments, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::layout::{MODEL_LOD_ENABLED, ModelData};
 use crate::sim::Ctx;
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct Lod;
 
@@ -58,24 +57,13 @@ impl PassDef for Lod {
         "kulikov.lod"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Write,
-            },
-            Binding {
-                name: "skin_args",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::write("lod_models"),
+            Binding::write("skin_args"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         1
@@ -84,11 +72,7 @@ impl PassDef for Lod {
         Dispatch::Fixed(1)
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/lod.wgsl",
-            entry: "lod",
-            fragment: None,
-        }
+        Shader::compute("kulikov/lod.wgsl", "lod")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(LodKernel(LodParams::from_ron(params)?)))

@@ -15,7 +15,6 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::{CounterValues, Ctx, subgroup};
-use strandgraph_graph::AccessMode::{Atomic, Read, Write};
 use strandgraph_graph::schema::Quantity;
 
 pub struct ShadeSort;
@@ -29,20 +28,12 @@ impl PassDef for ShadeSort {
         "kulikov.shade_sort"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "segment_visibility",
-                mode: Read,
-            },
-            Binding {
-                name: "shade_args",
-                mode: Atomic,
-            },
-            Binding {
-                name: "shading_segments",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("segment_visibility"),
+            Binding::atomic("shade_args"),
+            Binding::write("shading_segments"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -54,11 +45,7 @@ impl PassDef for ShadeSort {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/shade_sort.wgsl",
-            entry: "shade_sort",
-            fragment: None,
-        }
+        Shader::compute("kulikov/shade_sort.wgsl", "shade_sort")
     }
     fn gpu_params(
         &self,

@@ -14,7 +14,6 @@ use crate::layout::{ModelData, TriangleData, read};
 use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3};
 use strandgraph_assets::octahedral::{unpack_barycentrics, unpack_unit_vector};
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct Skin;
 
@@ -23,44 +22,18 @@ impl PassDef for Skin {
         "kulikov.skin"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "skin_args",
-                mode: Read,
-            },
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "groom.vertices",
-                mode: Read,
-            },
-            Binding {
-                name: "groom.strands",
-                mode: Read,
-            },
-            Binding {
-                name: "groom.skinning",
-                mode: Read,
-            },
-            Binding {
-                name: "mesh.triangles",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("skin_args"),
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("groom.vertices"),
+            Binding::read("groom.strands"),
+            Binding::read("groom.skinning"),
+            Binding::read("mesh.triangles"),
+            Binding::write("clip_positions"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         SKIN_GROUP
@@ -72,11 +45,7 @@ impl PassDef for Skin {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/skin.wgsl",
-            entry: "skin",
-            fragment: None,
-        }
+        Shader::compute("kulikov/skin.wgsl", "skin")
     }
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(SkinKernel))

@@ -11,7 +11,6 @@ use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
 use super::{Scene, clip_to_screen};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::Ctx;
-use strandgraph_graph::AccessMode::{Atomic, Read, Write};
 use strandgraph_graph::schema::Quantity;
 
 pub struct SortScan;
@@ -22,20 +21,12 @@ impl PassDef for SortScan {
         "kulikov.sort_scan"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "sort_bins",
-                mode: Read,
-            },
-            Binding {
-                name: "sort_offsets",
-                mode: Write,
-            },
-            Binding {
-                name: "raster_args",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("sort_bins"),
+            Binding::write("sort_offsets"),
+            Binding::write("raster_args"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         1
@@ -44,11 +35,7 @@ impl PassDef for SortScan {
         Dispatch::Fixed(1)
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/sort.wgsl",
-            entry: "scan",
-            fragment: None,
-        }
+        Shader::compute("kulikov/sort.wgsl", "scan")
     }
     fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(ScanKernel))
@@ -92,36 +79,16 @@ impl PassDef for Sort {
         "kulikov.sort"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Read,
-            },
-            Binding {
-                name: "segment_visibility",
-                mode: Read,
-            },
-            Binding {
-                name: "sort_offsets",
-                mode: Atomic,
-            },
-            Binding {
-                name: "sorted_segments",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("clip_positions"),
+            Binding::read("segment_visibility"),
+            Binding::atomic("sort_offsets"),
+            Binding::write("sorted_segments"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         CULL_GROUP
@@ -133,11 +100,7 @@ impl PassDef for Sort {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/sort.wgsl",
-            entry: "scatter",
-            fragment: None,
-        }
+        Shader::compute("kulikov/sort.wgsl", "scatter")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         let p = Params::new(self.kind(), params)?;

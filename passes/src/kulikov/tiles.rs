@@ -8,7 +8,6 @@
 use super::TILE;
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::{Ctx, Words};
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct TileAlloc;
 
@@ -151,20 +150,12 @@ impl PassDef for TileAlloc {
         "kulikov.tile_alloc"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "screen_bounds",
-                mode: Read,
-            },
-            Binding {
-                name: "atlas_tiles",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("screen_bounds"),
+            Binding::write("atlas_tiles"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         1
@@ -173,11 +164,7 @@ impl PassDef for TileAlloc {
         Dispatch::Fixed(1)
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/tiles.wgsl",
-            entry: "allocate",
-            fragment: None,
-        }
+        Shader::compute("kulikov/tiles.wgsl", "allocate")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         let p = Params::new(self.kind(), params)?;

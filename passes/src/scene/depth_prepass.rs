@@ -15,7 +15,6 @@
 use super::{GROUP, View, clear, dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::{CounterValues, Ctx};
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct DepthPrepass;
 
@@ -24,20 +23,12 @@ impl PassDef for DepthPrepass {
         "scene.depth_prepass"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "mesh.triangles",
-                mode: Read,
-            },
-            Binding {
-                name: "scene.depth",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("mesh.triangles"),
+            Binding::write("scene.depth"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP

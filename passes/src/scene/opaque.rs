@@ -29,7 +29,6 @@ use crate::layout::{LightData, read};
 use crate::sim::{CounterValues, Ctx, Words};
 use glam::Vec3;
 use half::f16;
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct Opaque;
 
@@ -40,28 +39,14 @@ impl PassDef for Opaque {
         KIND
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "mesh.triangles",
-                mode: Read,
-            },
-            Binding {
-                name: "lights",
-                mode: Read,
-            },
-            Binding {
-                name: "scene.depth",
-                mode: Read,
-            },
-            Binding {
-                name: "output",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("mesh.triangles"),
+            Binding::read("lights"),
+            Binding::read("scene.depth"),
+            Binding::write("output"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP

@@ -45,7 +45,6 @@ use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef,
 use crate::layout::MODEL_FACIAL_HAIR;
 use crate::sim::{CounterValues, Ctx, Words};
 use reconstruct::{Layer, reconstruct};
-use strandgraph_graph::AccessMode::{Read, Write};
 use strandgraph_graph::schema::Quantity;
 
 pub struct Compose;
@@ -139,51 +138,18 @@ impl ComposeParams {
 }
 
 const BINDINGS: &[Binding] = &[
-    Binding {
-        name: "frame",
-        mode: Read,
-    },
-    Binding {
-        name: "models",
-        mode: Read,
-    },
-    Binding {
-        name: "lod_models",
-        mode: Read,
-    },
-    Binding {
-        name: "atlas_tiles",
-        mode: Read,
-    },
-    Binding {
-        name: "vis_atlas",
-        mode: Read,
-    },
-    Binding {
-        name: "coverage_atlas",
-        mode: Read,
-    },
-    Binding {
-        name: "vertex_lighting",
-        mode: Read,
-    },
-    Binding {
-        name: "clip_positions",
-        mode: Read,
-    },
-    Binding {
-        name: "groom.vertices",
-        mode: Read,
-    },
+    Binding::read("frame"),
+    Binding::read("models"),
+    Binding::read("lod_models"),
+    Binding::read("atlas_tiles"),
+    Binding::read("vis_atlas"),
+    Binding::read("coverage_atlas"),
+    Binding::read("vertex_lighting"),
+    Binding::read("clip_positions"),
+    Binding::read("groom.vertices"),
     // Attachments (GPU): blended colour, hair depth.
-    Binding {
-        name: "output",
-        mode: Write,
-    },
-    Binding {
-        name: "scene.depth",
-        mode: Write,
-    },
+    Binding::write("output"),
+    Binding::write("scene.depth"),
 ];
 
 impl PassDef for Compose {

@@ -26,7 +26,6 @@ use super::{ModelLod, Scene, TILE, TILE_TEXELS};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::sim::{CounterValues, Ctx, Words};
 use geometry::Trapezoid;
-use strandgraph_graph::AccessMode::{Atomic, Read};
 
 pub struct Raster;
 
@@ -79,52 +78,20 @@ impl PassDef for Raster {
         "kulikov.raster"
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "raster_args",
-                mode: Read,
-            },
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "sorted_segments",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Read,
-            },
-            Binding {
-                name: "groom.vertices",
-                mode: Read,
-            },
-            Binding {
-                name: "atlas_tiles",
-                mode: Read,
-            },
-            Binding {
-                name: "scene.depth",
-                mode: Read,
-            },
-            Binding {
-                name: "vis_atlas",
-                mode: Atomic,
-            },
-            Binding {
-                name: "coverage_atlas",
-                mode: Atomic,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("raster_args"),
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("sorted_segments"),
+            Binding::read("clip_positions"),
+            Binding::read("groom.vertices"),
+            Binding::read("atlas_tiles"),
+            Binding::read("scene.depth"),
+            Binding::atomic("vis_atlas"),
+            Binding::atomic("coverage_atlas"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -136,11 +103,7 @@ impl PassDef for Raster {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/raster.wgsl",
-            entry: "raster",
-            fragment: None,
-        }
+        Shader::compute("kulikov/raster.wgsl", "raster")
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))

@@ -31,7 +31,6 @@ use crate::layout::{LightData, read};
 use crate::sim::{Ctx, Words};
 use glam::Vec3;
 use karis::{Lobes, hair_shading};
-use strandgraph_graph::AccessMode::{Read, Write};
 
 pub struct Shade;
 
@@ -145,48 +144,19 @@ impl PassDef for Shade {
         KIND
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(&[
-            Binding {
-                name: "shade_args",
-                mode: Read,
-            },
-            Binding {
-                name: "frame",
-                mode: Read,
-            },
-            Binding {
-                name: "models",
-                mode: Read,
-            },
-            Binding {
-                name: "lod_models",
-                mode: Read,
-            },
-            Binding {
-                name: "lights",
-                mode: Read,
-            },
-            Binding {
-                name: "shading_segments",
-                mode: Read,
-            },
-            Binding {
-                name: "segment_visibility",
-                mode: Read,
-            },
-            Binding {
-                name: "clip_positions",
-                mode: Read,
-            },
-            Binding {
-                name: "density_grid",
-                mode: Read,
-            },
-            Binding {
-                name: "vertex_lighting",
-                mode: Write,
-            },
-        ])
+        const BINDINGS: &[Binding] = &[
+            Binding::read("shade_args"),
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("lights"),
+            Binding::read("shading_segments"),
+            Binding::read("segment_visibility"),
+            Binding::read("clip_positions"),
+            Binding::read("density_grid"),
+            Binding::write("vertex_lighting"),
+        ];
+        Some(BINDINGS)
     }
     fn workgroup_size(&self) -> u32 {
         SHADE_GROUP
@@ -198,11 +168,7 @@ impl PassDef for Shade {
         }
     }
     fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/shade.wgsl",
-            entry: "shade",
-            fragment: None,
-        }
+        Shader::compute("kulikov/shade.wgsl", "shade")
     }
     fn gpu_params(
         &self,
