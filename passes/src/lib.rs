@@ -16,6 +16,7 @@ pub mod layout;
 pub mod scene;
 pub mod sim;
 pub mod upload;
+pub mod wgsl;
 
 pub use catalogue::{KINDS, PassKind};
 pub use contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};

@@ -30,15 +30,14 @@
 //! and so does every struct of that name in a pass's module (imported, or a
 //! copy in a shader that does not compose).
 
-use naga::valid::{Capabilities, ModuleInfo, ShaderStages, ValidationFlags, Validator};
+use naga::valid::{Capabilities, ModuleInfo};
 use naga::{AddressSpace, ImageClass, Module, ShaderStage, StorageAccess, TypeInner};
-use naga_oil::compose::{
-    ComposableModuleDescriptor, Composer, NagaModuleDescriptor, ShaderLanguage, ShaderType,
-};
+use naga_oil::compose::Composer;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use strandgraph_graph::AccessMode;
 use strandgraph_passes::layout::{FrameData, LightData, ModelData, TriangleData};
+use strandgraph_passes::wgsl::{Shaders, validate};
 use strandgraph_passes::{Definitions, KINDS, PassDef, Registry};
 
 /// What every shader may use: subgroup operations and subgroup barriers
@@ -57,95 +56,30 @@ fn capabilities_of(file: &str) -> Capabilities {
     }
 }
 
-/// Everything any module may use; the composer validates with this.
+/// Everything any module may use.
 fn all_capabilities() -> Capabilities {
-    BASE | Capabilities::FLOAT64
+    strandgraph_passes::wgsl::all_capabilities()
 }
 
 fn shaders_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders")
 }
 
-fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            wgsl_files(&path, out);
-        } else if path.extension().is_some_and(|e| e == "wgsl") {
-            out.push(path);
-        }
-    }
-}
-
-fn relative(path: &Path) -> String {
-    path.strip_prefix(shaders_dir())
-        .unwrap_or(path)
-        .to_string_lossy()
-        .replace('\\', "/")
-}
-
-/// A composer holding every composable module under `shaders/`, added in
-/// dependency order.
-fn composer() -> Composer {
-    let mut composer = Composer::default().with_capabilities(all_capabilities());
-    let mut files = Vec::new();
-    wgsl_files(&shaders_dir(), &mut files);
-    let mut pending: Vec<(String, String, Vec<String>, String)> = files
-        .iter()
-        .filter_map(|path| {
-            let source = std::fs::read_to_string(path).unwrap();
-            let (name, imports, _) = naga_oil::compose::get_preprocessor_data(&source);
-            let name = name?;
-            let imports = imports.into_iter().map(|i| i.import).collect();
-            Some((name, relative(path), imports, source))
-        })
-        .collect();
-    while !pending.is_empty() {
-        let ready = pending.iter().position(|(_, _, imports, _)| {
-            imports
-                .iter()
-                .all(|i| composer.contains_module(i) || !pending.iter().any(|p| &p.0 == i))
-        });
-        let Some(ready) = ready else {
-            let names: Vec<&str> = pending.iter().map(|p| p.1.as_str()).collect();
-            panic!("composable modules import each other in a cycle: {names:?}");
-        };
-        let (name, file, _, source) = pending.remove(ready);
-        let added = composer.add_composable_module(ComposableModuleDescriptor {
-            source: &source,
-            file_path: &file,
-            language: ShaderLanguage::Wgsl,
-            ..Default::default()
-        });
-        if let Err(e) = added {
-            panic!("{file} ({name}): {}", e.emit_to_string(&composer));
-        }
-    }
-    composer
+/// Every composable module under `shaders/`, loaded by the composition the
+/// backends use ([`strandgraph_passes::wgsl::Shaders`]).
+fn composer() -> Shaders {
+    Shaders::load(&shaders_dir()).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Composes and validates one top-level shader with the given capabilities.
 fn compose(
-    composer: &mut Composer,
+    composer: &mut Shaders,
     file: &str,
     source: &str,
     caps: Capabilities,
 ) -> Result<(Module, ModuleInfo), String> {
-    let made = composer.make_naga_module(NagaModuleDescriptor {
-        source,
-        file_path: file,
-        shader_type: ShaderType::Wgsl,
-        ..Default::default()
-    });
-    let module = made.map_err(|e| e.emit_to_string(composer))?;
-    let info = Validator::new(ValidationFlags::all(), caps)
-        .subgroup_stages(ShaderStages::COMPUTE | ShaderStages::FRAGMENT)
-        .validate(&module)
-        .map_err(|e| format!("{file}: validation with {caps:?}: {e:?}"))?;
+    let module = composer.module_from_source(file, source)?;
+    let info = validate(&module, caps).map_err(|e| format!("{file}: {e}"))?;
     Ok((module, info))
 }
 
@@ -285,7 +219,7 @@ fn record_size_errors(module: &Module) -> Vec<String> {
 }
 
 /// Checks one definition's shader; returns what is wrong with it.
-fn check_definition(composer: &mut Composer, def: &dyn PassDef) -> Result<(), String> {
+fn check_definition(composer: &mut Shaders, def: &dyn PassDef) -> Result<(), String> {
     let shader = def.shader();
     let path = shaders_dir().join(shader.file);
     let source = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -441,7 +375,7 @@ fn every_definition_has_a_valid_shader_matching_its_interface() {
 }
 
 /// Composes a probe that binds every shared record, so their layouts can be read.
-fn layout_probe(composer: &mut Composer) -> Module {
+fn layout_probe(composer: &mut Shaders) -> Module {
     let source = "
 #import strandgraph::layout::{FrameData, ModelData, LightData, TriangleData, ModelLod, ModelTiles}
 @group(0) @binding(0) var<storage> frame: FrameData;

@@ -9,7 +9,7 @@
 //!   barriers itself.
 //!
 //! Shaders are the WGSL under `shaders/`, composed with naga_oil
-//! ([`shaders`]) and handed to wgpu as naga modules. Binding 0 is the pass's
+//! (`strandgraph_passes::wgsl`) and handed to wgpu as naga modules. Binding 0 is the pass's
 //! parameter block ([`PassDef::gpu_params`]), then the pass's `bindings()`
 //! in order; raster passes (`Shader.fragment`) are render pipelines whose
 //! colour and depth attachments are not bound. Each pass is one compute or
@@ -19,7 +19,7 @@ mod memory;
 mod prepare;
 mod readback;
 mod record;
-pub mod shaders;
+mod shaders;
 
 use memory::create_memory;
 use prepare::prepare;
@@ -27,7 +27,7 @@ use readback::read_buffer;
 use record::{RASTER_KINDS, record_and_run};
 
 use naga::{AddressSpace, ImageClass, StorageAccess, TypeInner};
-use shaders::{CAPABILITY_FEATURES, Composed, Shaders};
+use shaders::CAPABILITY_FEATURES;
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -35,6 +35,7 @@ use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl, Usage};
 use strandgraph_graph::{Instance, LifetimeClass, Plan, Queue};
 use strandgraph_passes::upload::Upload;
+use strandgraph_passes::wgsl::{Composed, Shaders};
 use strandgraph_passes::{Definitions, Dispatch, PassDef, Registry};
 
 #[derive(Debug, thiserror::Error)]
@@ -71,7 +72,7 @@ pub enum WgpuError {
 /// How the wgpu backend runs.
 #[derive(Debug, Clone)]
 pub struct WgpuBackend {
-    /// The WGSL directory ([`shaders::default_dir`]).
+    /// The WGSL directory ([`strandgraph_passes::wgsl::default_dir`]).
     pub shader_dir: PathBuf,
     /// Which wgpu backends to look for an adapter on (Vulkan by default).
     pub backends: wgpu::Backends,
@@ -80,7 +81,7 @@ pub struct WgpuBackend {
 impl Default for WgpuBackend {
     fn default() -> Self {
         Self {
-            shader_dir: shaders::default_dir(),
+            shader_dir: strandgraph_passes::wgsl::default_dir(),
             backends: wgpu::Backends::VULKAN,
         }
     }
