@@ -5,6 +5,7 @@
 //! rule, a WGSL entry point for the GPU backends and a CPU kernel written per
 //! workgroup for the CPU simulator.
 
+use crate::draw::RasterState;
 use crate::sim::Ctx;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::{AccessMode, Quantity};
@@ -110,6 +111,16 @@ pub trait PassDef: Send + Sync {
             param: "params".into(),
             message: "the pass has no GPU parameter block yet (PassDef::gpu_params)".into(),
         })
+    }
+    /// The draw state of a raster pass (`shader().fragment` is `Some`);
+    /// `None` for compute passes.
+    fn raster(
+        &self,
+        params: &ron::Value,
+        q: &Quantities,
+    ) -> Result<Option<RasterState>, ParamError> {
+        let _ = (params, q);
+        Ok(None)
     }
 }
 

@@ -11,6 +11,7 @@ pub mod bind;
 mod catalogue;
 pub mod common;
 pub mod contract;
+pub mod draw;
 pub mod kulikov;
 pub mod layout;
 pub mod scene;
@@ -20,6 +21,7 @@ pub mod wgsl;
 
 pub use catalogue::{KINDS, PassKind};
 pub use contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+pub use draw::RasterState;
 use strandgraph_graph::PassRegistry;
 
 /// Pass kinds that have kernels so far. A kind listed in [`KINDS`] but not

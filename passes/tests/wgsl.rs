@@ -261,6 +261,32 @@ fn check_definition(composer: &mut Shaders, def: &dyn PassDef) -> Result<(), Str
             entries.push(fragment);
         }
     }
+    // The draw state names the fragment entries it draws with, the first
+    // one being `Shader::fragment`; compute passes have none.
+    let defaults = ron::Value::Map(Default::default());
+    let raster = def
+        .raster(&defaults, &strandgraph_graph::Quantities::example())
+        .map_err(|e| e.to_string())?;
+    match (&raster, shader.fragment) {
+        (None, None) => {}
+        (Some(r), Some(fragment)) => {
+            if r.draws.first().map(|d| d.fragment) != Some(fragment) {
+                return Err(format!("raster() draws do not start with `{fragment}`"));
+            }
+            for d in &r.draws[1..] {
+                let ep = find(d.fragment)
+                    .ok_or_else(|| format!("draw entry `{}` is missing", d.fragment))?;
+                if ep.stage != ShaderStage::Fragment {
+                    return Err(format!(
+                        "draw entry `{}` is not a fragment entry",
+                        d.fragment
+                    ));
+                }
+            }
+        }
+        (Some(_), None) => return Err("raster() is Some for a compute pass".into()),
+        (None, Some(_)) => return Err("a raster pass without raster() draw state".into()),
+    }
 
     let used = reflect(&module, &info, &entries)?;
     let mut errors = record_size_errors(&module);

@@ -16,15 +16,15 @@
 //! render pass with begin/end `TIMESTAMP_QUERY` writes.
 
 mod memory;
+mod pipelines;
 mod prepare;
 mod readback;
 mod record;
+mod session;
 mod shaders;
 
-use memory::create_memory;
-use prepare::prepare;
 use readback::read_buffer;
-use record::{RASTER_KINDS, record_and_run};
+pub use session::{Frame, Session};
 
 use naga::{AddressSpace, ImageClass, StorageAccess, TypeInner};
 use shaders::CAPABILITY_FEATURES;
@@ -109,18 +109,6 @@ enum Memory {
     },
 }
 
-/// A finished frame: the device and its resources, to read back, and
-/// per-pass GPU times in plan order.
-pub struct Frame {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
-    memory: Vec<Option<Memory>>,
-    pub timings: Vec<PassTiming>,
-    /// What the adapter is, and how the plan degraded on wgpu.
-    pub notes: Vec<String>,
-    pub adapter: String,
-}
-
 fn texture_format(f: ImageFormat) -> wgpu::TextureFormat {
     use wgpu::TextureFormat as T;
     match f {
@@ -156,6 +144,8 @@ struct Prepared<'d> {
     attachments: Vec<(usize, Usage)>,
     params: Vec<u32>,
     composed: Composed,
+    /// The draw state, for raster passes.
+    raster: Option<strandgraph_passes::RasterState>,
 }
 
 fn read_only_storage_texture_needs(module: &naga::Module) -> Option<naga::StorageFormat> {
@@ -183,133 +173,4 @@ fn read_only_storage_texture_needs(module: &naga::Module) -> Option<naga::Storag
             _ => None,
         }
     })
-}
-
-impl WgpuBackend {
-    /// Runs one frame with the built-in pass definitions.
-    pub fn execute(
-        &self,
-        plan: &Plan,
-        instance: &Instance,
-        inputs: &Upload,
-    ) -> Result<Frame, WgpuError> {
-        self.execute_with(&Registry, plan, instance, inputs)
-    }
-
-    /// Runs one frame, looking pass kinds up in `defs`.
-    pub fn execute_with(
-        &self,
-        defs: &dyn Definitions,
-        plan: &Plan,
-        instance: &Instance,
-        inputs: &Upload,
-    ) -> Result<Frame, WgpuError> {
-        let mut shaders = Shaders::load(&self.shader_dir).map_err(WgpuError::Shader)?;
-        let prepared = prepare(defs, plan, instance, &mut shaders)?;
-
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = self.backends;
-        let wgpu_instance = wgpu::Instance::new(desc);
-        let adapter = pollster::block_on(wgpu_instance.request_adapter(&Default::default()))
-            .map_err(|e| WgpuError::NoAdapter(e.to_string()))?;
-        let info = adapter.get_info();
-        let adapter_name = format!("{} ({:?}, {})", info.name, info.backend, info.driver);
-
-        // Only the features the plan's passes need, each named with its pass.
-        let available = adapter.features();
-        let mut features = wgpu::Features::TIMESTAMP_QUERY;
-        let mut missing = |feature: wgpu::Features, name: &'static str, pass: &str, why: String| {
-            if available.contains(feature) {
-                features |= feature;
-                Ok(())
-            } else {
-                Err(WgpuError::MissingFeature {
-                    adapter: adapter_name.clone(),
-                    feature: name,
-                    pass: pass.to_string(),
-                    why,
-                })
-            }
-        };
-        if let Some(first) = prepared.first() {
-            missing(
-                wgpu::Features::TIMESTAMP_QUERY,
-                "TIMESTAMP_QUERY",
-                plan.pass_name(first.p),
-                "per-pass GPU times".into(),
-            )?;
-        }
-        for prep in &prepared {
-            let name = plan.pass_name(prep.p);
-            for (cap, feature, feature_name) in CAPABILITY_FEATURES {
-                if prep.composed.needs.contains(cap) {
-                    missing(
-                        feature,
-                        feature_name,
-                        name,
-                        format!("{} uses {cap:?}", prep.def.shader().file),
-                    )?;
-                }
-            }
-            if let Some(format) = read_only_storage_texture_needs(&prep.composed.module) {
-                missing(
-                    wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,
-                    "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES",
-                    name,
-                    format!("read_write storage texture of {format:?}"),
-                )?;
-            }
-        }
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("strandgraph"),
-            required_features: features,
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|e| WgpuError::Device(e.to_string()))?;
-        let errors: Arc<Mutex<Vec<String>>> = Arc::default();
-        {
-            let errors = errors.clone();
-            device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
-                errors
-                    .lock()
-                    .unwrap_or_else(|e| e.into_inner())
-                    .push(e.to_string());
-            }));
-        }
-        let check = |what: &str| -> Result<(), WgpuError> {
-            let mut errs = errors.lock().unwrap_or_else(|e| e.into_inner());
-            if errs.is_empty() {
-                Ok(())
-            } else {
-                let all = std::mem::take(&mut *errs).join("\n");
-                Err(WgpuError::Validation(format!("{what}: {all}")))
-            }
-        };
-
-        let mut notes = vec![
-            format!("adapter: {adapter_name}; requested features: {features:?}"),
-            "wgpu has one queue: AsyncCompute passes run on it in plan order; the plan's sync points hold trivially".into(),
-        ];
-        let memory = create_memory(&device, &queue, plan, instance, inputs, &prepared)?;
-        let transient: u64 = instance.memory.placements.iter().map(|p| p.size).sum();
-        notes.push(format!(
-            "wgpu cannot alias memory: {} transients take {:.2} MiB in separate allocations (the plan's aliased heaps: {:.2} MiB)",
-            instance.memory.placements.len(),
-            transient as f64 / (1 << 20) as f64,
-            instance.memory.bytes_with_aliasing as f64 / (1 << 20) as f64,
-        ));
-        check("creating resources")?;
-
-        let timings = record_and_run(&device, &queue, plan, instance, &prepared, &memory)?;
-        check("running the frame")?;
-        Ok(Frame {
-            device,
-            queue,
-            memory,
-            timings,
-            notes,
-            adapter: adapter_name,
-        })
-    }
 }

@@ -2,12 +2,12 @@
 
 use super::*;
 
+/// Creates every resource a live pass uses, and every imported or history
+/// resource, zeroed.
 pub(crate) fn create_memory(
     device: &wgpu::Device,
-    queue: &wgpu::Queue,
     plan: &Plan,
     instance: &Instance,
-    inputs: &Upload,
     prepared: &[Prepared<'_>],
 ) -> Result<Vec<Option<Memory>>, WgpuError> {
     let g = &plan.graph;
@@ -34,19 +34,6 @@ pub(crate) fn create_memory(
             continue;
         }
         let size = instance.sizes[r];
-        let init = inputs.resources.get(&res.name);
-        if let Some(w) = init
-            && w.len() as u64 * 4 > size.bytes
-        {
-            return Err(WgpuError::Input {
-                resource: res.name.clone(),
-                message: format!(
-                    "{} words given, the plan sizes it at {} bytes",
-                    w.len(),
-                    size.bytes
-                ),
-            });
-        }
         let made = match &res.decl {
             ResourceDecl::Buffer { .. } => {
                 let buffer = device.create_buffer(&wgpu::BufferDescriptor {
@@ -58,9 +45,6 @@ pub(crate) fn create_memory(
                         | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
-                if let Some(w) = init {
-                    queue.write_buffer(&buffer, 0, bytemuck::cast_slice(w));
-                }
                 Memory::Buffer(buffer, size.bytes.div_ceil(4) as usize)
             }
             ResourceDecl::Image { format, .. } => {
@@ -85,23 +69,6 @@ pub(crate) fn create_memory(
                     view_formats: &[],
                 });
                 let texel_bytes = format.texel_bytes() as u32;
-                if let Some(w) = init {
-                    let bytes: &[u8] = bytemuck::cast_slice(w);
-                    let row = extent[0] * texel_bytes;
-                    let rows = extent[1] * extent[2].max(1);
-                    let mut full = bytes.to_vec();
-                    full.resize((row * rows) as usize, 0);
-                    queue.write_texture(
-                        texture.as_image_copy(),
-                        &full,
-                        wgpu::TexelCopyBufferLayout {
-                            offset: 0,
-                            bytes_per_row: Some(row),
-                            rows_per_image: Some(extent[1]),
-                        },
-                        texture.size(),
-                    );
-                }
                 Memory::Texture {
                     texture,
                     format: wformat,
@@ -113,4 +80,64 @@ pub(crate) fn create_memory(
         memory.push(Some(made));
     }
     Ok(memory)
+}
+
+/// Writes a frame's inputs into the imported resources they name. Inputs for
+/// transients are ignored, as on the CPU backend; history resources named by
+/// no input keep what the previous frame wrote.
+pub(crate) fn upload(
+    queue: &wgpu::Queue,
+    plan: &Plan,
+    instance: &Instance,
+    memory: &[Option<Memory>],
+    inputs: &Upload,
+) -> Result<(), WgpuError> {
+    let g = &plan.graph;
+    for (name, words) in &inputs.resources {
+        let Some(r) = g.resource_id(name) else {
+            continue; // packed for another graph
+        };
+        if g.resources[r].decl.lifetime() == LifetimeClass::Transient {
+            continue;
+        }
+        let input_error = |message: String| WgpuError::Input {
+            resource: name.clone(),
+            message,
+        };
+        let bytes = instance.sizes[r].bytes;
+        if words.len() as u64 * 4 > bytes {
+            return Err(input_error(format!(
+                "{} words given, the plan sizes it at {bytes} bytes",
+                words.len()
+            )));
+        }
+        match &memory[g.physical(r)] {
+            None => {}
+            Some(Memory::Buffer(buffer, _)) => {
+                queue.write_buffer(buffer, 0, bytemuck::cast_slice(words));
+            }
+            Some(Memory::Texture {
+                texture,
+                extent,
+                texel_bytes,
+                ..
+            }) => {
+                let row = extent[0] * texel_bytes;
+                let rows = extent[1] * extent[2].max(1);
+                let mut full: Vec<u8> = bytemuck::cast_slice(words).to_vec();
+                full.resize((row * rows) as usize, 0);
+                queue.write_texture(
+                    texture.as_image_copy(),
+                    &full,
+                    wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(row),
+                        rows_per_image: Some(extent[1]),
+                    },
+                    texture.size(),
+                );
+            }
+        }
+    }
+    Ok(())
 }

@@ -34,13 +34,12 @@ pub(crate) fn prepare<'d>(
             .into_iter()
             .map(|(n, r, _)| (n, g.physical(r)))
             .collect();
-        if def.shader().fragment.is_some() && !RASTER_KINDS.contains(&def.kind()) {
+        let raster = def.raster(&pass.params, &instance.quantities)?;
+        if def.shader().fragment.is_some() != raster.is_some() {
             return Err(WgpuError::Pass {
                 pass: pass.name.clone(),
                 message: format!(
-                    "`{}` is a raster pass whose pipeline state (blending, draw count, \
-                     extra pipelines) the wgpu backend does not know yet; it runs \
-                     {RASTER_KINDS:?}",
+                    "`{}` has a fragment entry but no draw state (PassDef::raster), or the reverse",
                     def.kind()
                 ),
             });
@@ -57,6 +56,7 @@ pub(crate) fn prepare<'d>(
             attachments,
             params,
             composed,
+            raster,
         });
     }
     Ok(out)

@@ -50,7 +50,7 @@ pub(crate) fn map_and_read(
     Ok(data)
 }
 
-impl Frame {
+impl Session {
     /// A copy of resource `name`'s words, laid out as the CPU backend lays
     /// them out (images: rows of texels, no padding). `None` when the
     /// resource does not exist or has no memory (used by no live pass).

@@ -14,6 +14,7 @@
 
 use super::{GROUP, View, clear, dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::sim::{CounterValues, Ctx};
 
 pub struct DepthPrepass;
@@ -56,6 +57,27 @@ impl PassDef for DepthPrepass {
     ) -> Result<Vec<u32>, ParamError> {
         Params::new(self.kind(), params)?;
         Ok(vec![0])
+    }
+    /// The prologue's clear to 1.0, then `fetch_min` of depth: Less, written.
+    fn raster(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Option<RasterState>, ParamError> {
+        Params::new(self.kind(), params)?;
+        Ok(Some(RasterState {
+            vertices: q.triangles * 3,
+            cull_back_faces: true,
+            color_load: ColorLoad::Load,
+            depth_load: DepthLoad::Clear(1.0),
+            draws: vec![Draw {
+                fragment: "fs_main",
+                blend: Blend::Replace,
+                color_writes: true,
+                depth_compare: Compare::Less,
+                depth_write: true,
+            }],
+        }))
     }
 }
 

@@ -25,6 +25,7 @@
 
 use super::{GROUP, View, corner_normals, corners, dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::layout::{LightData, read};
 use crate::sim::{CounterValues, Ctx, Words};
 use glam::Vec3;
@@ -76,6 +77,28 @@ impl PassDef for Opaque {
             .uniform()
             .map(f32::to_bits)
             .to_vec())
+    }
+    /// Shades where the prepass's depth is equal (the kernel's `==` test),
+    /// over the background the prologue clears to.
+    fn raster(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Option<RasterState>, ParamError> {
+        let [r, g, b] = OpaqueParams::from_ron(params)?.background;
+        Ok(Some(RasterState {
+            vertices: q.triangles * 3,
+            cull_back_faces: true,
+            color_load: ColorLoad::Clear([r, g, b, 1.0]),
+            depth_load: DepthLoad::Load,
+            draws: vec![Draw {
+                fragment: "fs_main",
+                blend: Blend::Replace,
+                color_writes: true,
+                depth_compare: Compare::Equal,
+                depth_write: false,
+            }],
+        }))
     }
 }
 

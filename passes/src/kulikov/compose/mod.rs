@@ -42,6 +42,7 @@ use super::raster::geometry::Trapezoid;
 use super::tiles::ModelTiles;
 use super::{Scene, TILE, clip_to_screen};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::layout::MODEL_FACIAL_HAIR;
 use crate::sim::{CounterValues, Ctx, Words};
 use reconstruct::{Layer, reconstruct};
@@ -181,6 +182,39 @@ impl PassDef for Compose {
         q: &strandgraph_graph::Quantities,
     ) -> Result<Vec<u32>, ParamError> {
         Ok(ComposeParams::from_ron(params)?.uniform(q))
+    }
+    /// shaders/kulikov/compose.wgsl (header): six vertices per model, drawn
+    /// back to front with premultiplied blending over the loaded colour;
+    /// then `fs_depth` with the same quads writes hair depth into the
+    /// loaded `scene.depth` where nearer (the CPU kernel's `z < depth`).
+    fn raster(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Option<RasterState>, ParamError> {
+        ComposeParams::from_ron(params)?;
+        Ok(Some(RasterState {
+            vertices: q.models * 6,
+            cull_back_faces: false,
+            color_load: ColorLoad::Load,
+            depth_load: DepthLoad::Load,
+            draws: vec![
+                Draw {
+                    fragment: "fs_main",
+                    blend: Blend::PremultipliedOverKeepAlpha,
+                    color_writes: true,
+                    depth_compare: Compare::Always,
+                    depth_write: false,
+                },
+                Draw {
+                    fragment: "fs_depth",
+                    blend: Blend::Replace,
+                    color_writes: false,
+                    depth_compare: Compare::Less,
+                    depth_write: true,
+                },
+            ],
+        }))
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok(Box::new(ComposeKernel(ComposeParams::from_ron(params)?)))

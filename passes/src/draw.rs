@@ -1,0 +1,60 @@
+//! The fixed-function state of raster passes: what a GPU backend needs
+//! beyond the shader to draw a pass that has colour or depth attachments.
+//!
+//! Raster passes draw non-indexed triangle lists with no vertex buffers
+//! (vertex shaders fetch from storage buffers), counter-clockwise front
+//! faces. One pass may issue several draws over the same attachments with
+//! different fragment entries and state: `kulikov.compose` blends colour,
+//! then writes hair depth. The CPU kernels implement the same state in
+//! software; each definition's `raster()` documents the pairing.
+
+/// A raster pass's draws and attachment load operations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RasterState {
+    /// Vertices per draw (3 per triangle).
+    pub vertices: u64,
+    pub cull_back_faces: bool,
+    pub color_load: ColorLoad,
+    pub depth_load: DepthLoad,
+    /// In order; the first one's fragment entry is `Shader::fragment`.
+    pub draws: Vec<Draw>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ColorLoad {
+    Load,
+    /// Clear to linear RGBA.
+    Clear([f32; 4]),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DepthLoad {
+    Load,
+    Clear(f32),
+}
+
+/// One draw over the pass's attachments.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Draw {
+    pub fragment: &'static str,
+    pub blend: Blend,
+    pub color_writes: bool,
+    pub depth_compare: Compare,
+    pub depth_write: bool,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blend {
+    /// The fragment replaces the attachment.
+    Replace,
+    /// Premultiplied "over": colour = src + (1 − src.a) · dst; the
+    /// attachment's alpha stays (the opaque image's alpha is its coverage).
+    PremultipliedOverKeepAlpha,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Compare {
+    Always,
+    Less,
+    Equal,
+}
