@@ -68,15 +68,34 @@ pub struct PassTiming {
     pub counters: CounterValues,
 }
 
-/// A finished frame: its memory, to read back, and per-pass timings in plan order.
-pub struct Frame {
+/// A plan opened on the simulator: memory laid out and kernels built once;
+/// each [`Session::run`] uploads a frame's inputs and runs every pass.
+/// History resources keep their contents between runs.
+pub struct Session<'d> {
+    backend: CpuBackend,
+    plan: Plan,
+    instance: Instance,
+    prepared: HashMap<PassId, Prepared<'d>>,
     pub memory: Memory,
+    /// The last frame's per-pass timings, in plan order.
     pub timings: Vec<PassTiming>,
 }
 
-impl Frame {
+/// A session after one frame ([`CpuBackend::execute`]).
+pub type Frame<'d> = Session<'d>;
+
+impl Session<'_> {
     pub fn read(&self, plan: &Plan, resource: &str) -> Option<Vec<u32>> {
         self.memory.read(plan, resource)
+    }
+
+    /// Uploads `inputs` and runs one frame; returns its per-pass timings.
+    pub fn run(&mut self, inputs: &Inputs) -> Result<&[PassTiming], CpuError> {
+        self.memory.upload(&self.plan, inputs)?;
+        self.timings =
+            self.backend
+                .run_frame(&self.plan, &self.instance, &self.prepared, &self.memory)?;
+        Ok(&self.timings)
     }
 }
 
@@ -94,20 +113,48 @@ impl CpuBackend {
         plan: &Plan,
         instance: &Instance,
         inputs: &Inputs,
-    ) -> Result<Frame, CpuError> {
+    ) -> Result<Frame<'static>, CpuError> {
         self.execute_with(&Registry, plan, instance, inputs)
     }
 
     /// Runs one frame, looking pass kinds up in `defs`.
-    pub fn execute_with(
+    pub fn execute_with<'d>(
         &self,
-        defs: &dyn Definitions,
+        defs: &'d dyn Definitions,
         plan: &Plan,
         instance: &Instance,
         inputs: &Inputs,
-    ) -> Result<Frame, CpuError> {
-        let prepared = self.prepare(defs, plan)?;
-        let memory = Memory::new(plan, instance, inputs, self.alias)?;
+    ) -> Result<Frame<'d>, CpuError> {
+        let mut session = self.open(defs, plan, instance)?;
+        session.run(inputs)?;
+        Ok(session)
+    }
+
+    /// Opens a session: builds every live pass's kernel and lays out memory.
+    pub fn open<'d>(
+        &self,
+        defs: &'d dyn Definitions,
+        plan: &Plan,
+        instance: &Instance,
+    ) -> Result<Session<'d>, CpuError> {
+        Ok(Session {
+            backend: self.clone(),
+            prepared: self.prepare(defs, plan)?,
+            memory: Memory::new(plan, instance, self.alias),
+            plan: plan.clone(),
+            instance: instance.clone(),
+            timings: Vec::new(),
+        })
+    }
+
+    /// One frame: a thread per queue lane, waiting at the plan's sync points.
+    fn run_frame(
+        &self,
+        plan: &Plan,
+        instance: &Instance,
+        prepared: &HashMap<PassId, Prepared<'_>>,
+        memory: &Memory,
+    ) -> Result<Vec<PassTiming>, CpuError> {
         let timelines: HashMap<Queue, Timeline> = plan
             .lanes
             .iter()
@@ -119,8 +166,7 @@ impl CpuBackend {
 
         std::thread::scope(|scope| {
             for lane in &plan.lanes {
-                let (memory, prepared, timelines, abort, failure, timings) =
-                    (&memory, &prepared, &timelines, &abort, &failure, &timings);
+                let (timelines, abort, failure, timings) = (&timelines, &abort, &failure, &timings);
                 scope.spawn(move || {
                     for (i, &p) in lane.passes.iter().enumerate() {
                         if abort.load(Ordering::Relaxed) {
@@ -151,7 +197,7 @@ impl CpuBackend {
         }
         let mut timings = timings.into_inner().unwrap_or_else(|e| e.into_inner());
         timings.sort_by_key(|t| plan.position(t.pass));
-        Ok(Frame { memory, timings })
+        Ok(timings)
     }
 
     /// Looks up every live pass's definition, binds it and builds its kernel.

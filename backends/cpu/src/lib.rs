@@ -14,5 +14,5 @@ pub mod execute;
 pub mod memory;
 pub mod timeline;
 
-pub use execute::{CpuBackend, CpuError, Frame, PassTiming};
+pub use execute::{CpuBackend, CpuError, Frame, PassTiming, Session};
 pub use memory::Inputs;

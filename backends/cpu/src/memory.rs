@@ -3,7 +3,7 @@
 
 use crate::execute::CpuError;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU32, AtomicU64};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use strandgraph_graph::alias::HeapKind;
 use strandgraph_graph::{Instance, LifetimeClass, Plan};
 
@@ -40,12 +40,7 @@ fn words_of(bytes: u64) -> usize {
 impl Memory {
     /// Lays out memory for `instance`. With `alias` false every transient
     /// gets its own range, the reference the aliased layout is diffed against.
-    pub fn new(
-        plan: &Plan,
-        instance: &Instance,
-        inputs: &Inputs,
-        alias: bool,
-    ) -> Result<Memory, CpuError> {
+    pub fn new(plan: &Plan, instance: &Instance, alias: bool) -> Memory {
         let g = &plan.graph;
         let mut homes = vec![Home::Unused; g.resources.len()];
         // Heaps sit back to back in one arena: buffers, then images.
@@ -85,28 +80,45 @@ impl Memory {
                 continue;
             }
             let len = words_of(instance.sizes[r].bytes);
-            let init = inputs.resources.get(&res.name);
-            if let Some(w) = init
-                && w.len() > len
-            {
-                return Err(CpuError::Input {
-                    resource: res.name.clone(),
-                    message: format!("{} words given, the plan sizes it at {len}", w.len()),
-                });
-            }
-            let mut words: Vec<AtomicU32> =
-                init.map_or_else(Vec::new, |w| w.iter().map(|&x| AtomicU32::new(x)).collect());
-            words.resize_with(len, || AtomicU32::new(0));
             homes[r] = Home::Owned(owned.len());
-            owned.push(words);
+            owned.push((0..len).map(|_| AtomicU32::new(0)).collect());
         }
-        Ok(Memory {
+        Memory {
             arena,
             owned,
             homes,
             out_of_bounds: AtomicU64::new(0),
             arena_bytes,
-        })
+        }
+    }
+
+    /// Writes a frame's inputs into the imported and history resources they
+    /// name (from word 0; the rest keeps its contents). Inputs for
+    /// transients or for resources the graph lacks are ignored.
+    pub fn upload(&self, plan: &Plan, inputs: &Inputs) -> Result<(), CpuError> {
+        for (name, words) in &inputs.resources {
+            let Some(r) = plan.graph.resource_id(name) else {
+                continue;
+            };
+            let Home::Owned(i) = self.homes[plan.graph.physical(r)] else {
+                continue;
+            };
+            let dst = &self.owned[i];
+            if words.len() > dst.len() {
+                return Err(CpuError::Input {
+                    resource: name.clone(),
+                    message: format!(
+                        "{} words given, the plan sizes it at {}",
+                        words.len(),
+                        dst.len()
+                    ),
+                });
+            }
+            for (d, &w) in dst.iter().zip(words) {
+                d.store(w, Ordering::Relaxed);
+            }
+        }
+        Ok(())
     }
 
     /// The words of resource `r` (a version resolves to its resource's memory).
