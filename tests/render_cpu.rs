@@ -14,7 +14,7 @@ fn visibility(scene: &str, w: u32, h: u32) -> Prepared {
     prepare(&root().join(scene), Some(&graph), Some((w, h))).unwrap_or_else(|e| panic!("{e:?}"))
 }
 
-fn run(p: &Prepared, backend: &CpuBackend) -> Frame {
+fn run(p: &Prepared, backend: &CpuBackend) -> Frame<'static> {
     let f = backend
         .execute(&p.plan, &p.instance, &p.upload)
         .unwrap_or_else(|e| panic!("{e}"));
