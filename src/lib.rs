@@ -2,5 +2,6 @@
 //! benches share — preparing a scene's frame for a graph, and turning
 //! rendered images into pictures.
 
+pub mod compare;
 pub mod frame;
 pub mod images;

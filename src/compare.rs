@@ -1,0 +1,87 @@
+//! Comparing rendered images across backends with NVIDIA's FLIP (Andersson
+//! et al. 2020, through the `nv-flip` crate): a perceptual per-pixel error
+//! in [0, 1], pooled to a mean. The differential tests and
+//! `render --backend all` use it on the sRGB pictures they write.
+
+use image::{RgbImage, RgbaImage};
+
+/// How two pictures of the same size differ.
+#[derive(Debug, Clone)]
+pub struct ImageDiff {
+    /// Mean FLIP error over all pixels (0: identical).
+    pub mean: f32,
+    /// The largest per-pixel FLIP error, and where.
+    pub max: f32,
+    pub max_at: (u32, u32),
+    /// The FLIP error map in the magma colour map, to look at.
+    pub error_map: RgbImage,
+    errors: Vec<f32>,
+}
+
+impl ImageDiff {
+    /// Pixels whose FLIP error exceeds `bound`.
+    pub fn pixels_over(&self, bound: f32) -> usize {
+        self.errors.iter().filter(|&&e| e > bound).count()
+    }
+}
+
+fn rgb(img: &RgbaImage) -> nv_flip::FlipImageRgb8 {
+    let data: Vec<u8> = img.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
+    nv_flip::FlipImageRgb8::with_data(img.width(), img.height(), &data)
+}
+
+/// FLIP of `test` against `reference` at the default 67 pixels per degree
+/// (a 0.7 m viewing distance from a 24" 4K screen, FLIP's default).
+/// `None` when the sizes differ.
+pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> Option<ImageDiff> {
+    if reference.dimensions() != test.dimensions() || reference.width() == 0 {
+        return None;
+    }
+    let map = nv_flip::flip(
+        rgb(reference),
+        rgb(test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let errors = map.to_vec();
+    let w = reference.width();
+    let (i, max) = errors
+        .iter()
+        .copied()
+        .enumerate()
+        .fold(
+            (0, 0.0f32),
+            |(bi, bm), (i, e)| if e > bm { (i, e) } else { (bi, bm) },
+        );
+    let mean = nv_flip::FlipPool::from_image(&map).mean();
+    let colours = map.apply_color_lut(&nv_flip::magma_lut());
+    let error_map = RgbImage::from_raw(colours.width(), colours.height(), colours.to_vec())?;
+    Some(ImageDiff {
+        mean,
+        max,
+        max_at: (i as u32 % w, i as u32 / w),
+        error_map,
+        errors,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identical_images_have_no_error_and_changes_are_found() {
+        let mut a = RgbaImage::new(32, 32);
+        for (x, y, p) in a.enumerate_pixels_mut() {
+            *p = image::Rgba([(x * 8) as u8, (y * 8) as u8, 128, 255]);
+        }
+        let same = flip(&a, &a.clone()).unwrap();
+        assert_eq!(same.mean, 0.0);
+        assert_eq!(same.pixels_over(0.0), 0);
+        let mut b = a.clone();
+        b.put_pixel(20, 10, image::Rgba([255, 255, 255, 255]));
+        let d = flip(&a, &b).unwrap();
+        assert!(d.mean > 0.0 && d.max > 0.3, "mean {} max {}", d.mean, d.max);
+        assert_eq!(d.max_at, (20, 10));
+        assert!(flip(&a, &RgbaImage::new(8, 8)).is_none());
+    }
+}
