@@ -1,0 +1,128 @@
+//! # strandgraph-ash
+//!
+//! Runs a compiled `Plan` on raw Vulkan 1.3 through ash 0.38, a thin runner
+//! like the CPU and wgpu backends that does what wgpu cannot:
+//! - **aliased transients**: each heap of the plan's memory plan
+//!   (`graph/src/alias.rs`) is one `VkDeviceMemory`, and transients are bound
+//!   at the plan's offsets ([`memory`]);
+//! - **the plan's barriers**: every same-queue dependency of the plan's sync
+//!   section (`graph/src/sync.rs`) becomes a `vkCmdPipelineBarrier2` with its
+//!   stage and access masks and image layouts, and nothing else ([`barriers`]);
+//! - **async compute**: when the device has a compute-only queue family,
+//!   AsyncCompute lanes run there, ordered by timeline semaphores at the plan's
+//!   sync points ([`record`], [`submit`]); with one queue (lavapipe) the lanes
+//!   are serialised in plan order and the frame notes say so;
+//! - **per-pass timestamps per queue** ([`timing`]).
+//!
+//! Shaders are the WGSL under `shaders/`, composed by
+//! [`strandgraph_passes::wgsl`] and translated by naga to SPIR-V 1.3 with the
+//! capabilities each pass needs ([`spirv`]). Binding 0 is the pass's parameter
+//! block ([`PassDef::gpu_params`]), then its `bindings()` in order.
+//!
+//! A [`Session`] creates the device, pipelines, memory and command buffers
+//! once ([`AshBackend::open`]); [`Session::run`] uploads a frame's inputs and
+//! runs it; [`Session::read`] reads any resource back. Validation
+//! ([`Validation::Sync`]) collects every message of the Khronos layer,
+//! synchronization validation included, and fails the run with them.
+
+mod barriers;
+mod device;
+mod error;
+mod memory;
+mod pipelines;
+mod prepare;
+mod readback;
+mod record;
+mod session;
+mod spirv;
+mod submit;
+mod timing;
+
+pub use error::AshError;
+pub use session::{Frame, Session};
+pub use timing::PassTiming;
+
+use std::path::PathBuf;
+use std::time::Duration;
+use strandgraph_graph::{Instance, Plan};
+use strandgraph_passes::upload::Upload;
+use strandgraph_passes::{Definitions, Registry};
+
+/// Whether to load the Khronos validation layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Validation {
+    Off,
+    /// `VK_LAYER_KHRONOS_validation` with synchronization validation; any
+    /// warning or error fails the run. A missing layer is an error.
+    Sync,
+}
+
+impl Validation {
+    /// `Sync` when `STRANDGRAPH_VK_VALIDATION` is set to anything but `0`.
+    pub fn from_env() -> Self {
+        match std::env::var("STRANDGRAPH_VK_VALIDATION") {
+            Ok(v) if v != "0" && !v.is_empty() => Validation::Sync,
+            _ => Validation::Off,
+        }
+    }
+}
+
+/// How the ash backend runs.
+#[derive(Debug, Clone)]
+pub struct AshBackend {
+    /// The WGSL directory ([`strandgraph_passes::wgsl::default_dir`]).
+    pub shader_dir: PathBuf,
+    pub validation: Validation,
+    /// Place transients at the plan's aliasing offsets; `false` gives each
+    /// its own memory, so every transient can be read back after a frame.
+    pub alias: bool,
+    /// Use a compute-only queue family for AsyncCompute passes when there is one.
+    pub async_compute: bool,
+    /// The longest any fence or semaphore wait may take before the run fails.
+    pub timeout: Duration,
+    /// Pick the first device whose name contains this (else the first discrete GPU).
+    pub device_name: Option<String>,
+}
+
+impl Default for AshBackend {
+    fn default() -> Self {
+        Self {
+            shader_dir: strandgraph_passes::wgsl::default_dir(),
+            validation: Validation::from_env(),
+            alias: true,
+            async_compute: true,
+            timeout: Duration::from_secs(60),
+            device_name: std::env::var("STRANDGRAPH_VK_DEVICE").ok(),
+        }
+    }
+}
+
+impl AshBackend {
+    /// Creates the device, memory, pipelines and command buffers for `plan`
+    /// with the built-in pass definitions.
+    pub fn open(&self, plan: &Plan, instance: &Instance) -> Result<Session, AshError> {
+        self.open_with(&Registry, plan, instance)
+    }
+
+    /// Like [`AshBackend::open`], looking pass kinds up in `defs`.
+    pub fn open_with(
+        &self,
+        defs: &dyn Definitions,
+        plan: &Plan,
+        instance: &Instance,
+    ) -> Result<Session, AshError> {
+        Session::open(self, defs, plan, instance)
+    }
+
+    /// One frame: open, upload `inputs`, run.
+    pub fn execute(
+        &self,
+        plan: &Plan,
+        instance: &Instance,
+        inputs: &Upload,
+    ) -> Result<(Session, Frame), AshError> {
+        let mut session = self.open(plan, instance)?;
+        let frame = session.run(inputs)?;
+        Ok((session, frame))
+    }
+}

@@ -1,0 +1,468 @@
+//! Lanes, batches and their command buffers, recorded once per session.
+//!
+//! Each plan lane (`graph/src/schedule.rs`) runs on a backend queue:
+//! Graphics and Transfer on the graphics family, AsyncCompute on the
+//! compute-only family when there is one. Lanes that land on one queue are
+//! merged in plan order, and their sync points become the plain barriers of
+//! their dependencies (barriers.rs). A lane is cut into *batches* at its sync
+//! points: a batch ends after a pass another queue waits for (it signals the
+//! lane's timeline semaphore with the pass's 1-based lane position, the
+//! plan's `SyncPoint::value`) and starts before a pass that waits. The
+//! command buffers do not change between frames; only the timeline values
+//! (offset per frame) do, so frames resubmit them.
+
+use crate::barriers::{Barrier, SyncPlan, Target};
+use crate::device::Gpu;
+use crate::error::{AshError, VkContext};
+use crate::memory::{Memory, Res, full_range};
+use crate::pipelines::{Launch, Pipelines, Work};
+use crate::timing::Timestamps;
+use ash::vk;
+use strandgraph_graph::resolve::PassId;
+use strandgraph_graph::{Plan, Queue};
+use strandgraph_passes::draw::{ColorLoad, DepthLoad};
+
+/// Which backend queue a plan queue runs on.
+pub(crate) fn backend_queue(q: Queue, has_compute: bool) -> usize {
+    match q {
+        Queue::AsyncCompute if has_compute => 1,
+        _ => 0,
+    }
+}
+
+pub(crate) struct Batch {
+    pub cmd: vk::CommandBuffer,
+    /// Range of lane positions (0-based, inclusive).
+    pub first: usize,
+    pub last: usize,
+    /// `(lane, 1-based position)` this batch waits for.
+    pub waits: Vec<(usize, u64)>,
+}
+
+pub(crate) struct Lane {
+    /// Backend queue index.
+    pub queue: usize,
+    pub passes: Vec<PassId>,
+    pub batches: Vec<Batch>,
+    pub semaphore: vk::Semaphore,
+    pool: vk::CommandPool,
+}
+
+impl Lane {
+    pub fn position(&self, p: PassId) -> Option<usize> {
+        self.passes.iter().position(|&x| x == p)
+    }
+}
+
+pub(crate) struct Lanes {
+    pub lanes: Vec<Lane>,
+    /// Lane index of every pass (by pass id).
+    pub lane_of: Vec<usize>,
+}
+
+impl Lanes {
+    pub fn destroy(&mut self, d: &ash::Device) {
+        for lane in self.lanes.drain(..) {
+            // SAFETY: the device is idle; command buffers go with their pool.
+            unsafe {
+                d.destroy_command_pool(lane.pool, None);
+                d.destroy_semaphore(lane.semaphore, None);
+            }
+        }
+    }
+}
+
+pub(crate) fn timeline(d: &ash::Device, what: &str) -> Result<vk::Semaphore, AshError> {
+    let mut ty = vk::SemaphoreTypeCreateInfo::default()
+        .semaphore_type(vk::SemaphoreType::TIMELINE)
+        .initial_value(0);
+    let info = vk::SemaphoreCreateInfo::default().push_next(&mut ty);
+    // SAFETY: valid device and info.
+    unsafe { d.create_semaphore(&info, None) }.ctx(what)
+}
+
+/// Splits the plan's passes into lanes per backend queue and batches.
+pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
+    let has_compute = gpu.queues.len() > 1;
+    let g = &plan.graph;
+    let mut lane_of = vec![usize::MAX; g.passes.len()];
+    let mut lanes: Vec<Lane> = Vec::new();
+    let mut out = Lanes {
+        lanes: Vec::new(),
+        lane_of: Vec::new(),
+    };
+    for &p in &plan.order {
+        let q = backend_queue(g.passes[p].queue, has_compute);
+        let l = match lanes.iter().position(|l| l.queue == q) {
+            Some(l) => l,
+            None => {
+                let info =
+                    vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queues[q].family);
+                // SAFETY: valid device and info.
+                let pool = unsafe { gpu.device.create_command_pool(&info, None) };
+                let pool = match pool {
+                    Ok(pool) => pool,
+                    Err(e) => {
+                        out.lanes = lanes;
+                        out.destroy(&gpu.device);
+                        return Err(AshError::vk("vkCreateCommandPool", e));
+                    }
+                };
+                let semaphore = match timeline(&gpu.device, "timeline semaphore") {
+                    Ok(s) => s,
+                    Err(e) => {
+                        // SAFETY: unused pool.
+                        unsafe { gpu.device.destroy_command_pool(pool, None) };
+                        out.lanes = lanes;
+                        out.destroy(&gpu.device);
+                        return Err(e);
+                    }
+                };
+                lanes.push(Lane {
+                    queue: q,
+                    passes: Vec::new(),
+                    batches: Vec::new(),
+                    semaphore,
+                    pool,
+                });
+                lanes.len() - 1
+            }
+        };
+        lanes[l].passes.push(p);
+        lane_of[p] = l;
+    }
+    // Cross-queue sync points of the plan, in backend lanes.
+    let points: Vec<(usize, usize, usize, usize)> = plan
+        .sync_points
+        .iter()
+        .filter(|s| lane_of[s.after] != lane_of[s.before])
+        .map(|s| {
+            let (la, lb) = (lane_of[s.after], lane_of[s.before]);
+            (
+                la,
+                lanes[la].position(s.after).unwrap_or(0),
+                lb,
+                lanes[lb].position(s.before).unwrap_or(0),
+            )
+        })
+        .collect();
+    for (l, lane) in lanes.iter_mut().enumerate() {
+        let n = lane.passes.len();
+        let mut start = 0;
+        for i in 0..n {
+            let signals = points.iter().any(|&(la, pa, _, _)| la == l && pa == i);
+            let next_waits = points.iter().any(|&(_, _, lb, pb)| lb == l && pb == i + 1);
+            if signals || next_waits || i + 1 == n {
+                let mut waits: Vec<(usize, u64)> = Vec::new();
+                for &(la, pa, _, _) in points
+                    .iter()
+                    .filter(|&&(_, _, lb, pb)| lb == l && pb == start)
+                {
+                    match waits.iter_mut().find(|w| w.0 == la) {
+                        Some(w) => w.1 = w.1.max(pa as u64 + 1),
+                        None => waits.push((la, pa as u64 + 1)),
+                    }
+                }
+                lane.batches.push(Batch {
+                    cmd: vk::CommandBuffer::null(),
+                    first: start,
+                    last: i,
+                    waits,
+                });
+                start = i + 1;
+            }
+        }
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(lane.pool)
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(lane.batches.len() as u32);
+        // SAFETY: valid pool.
+        let cmds = unsafe { gpu.device.allocate_command_buffers(&info) };
+        let cmds = match cmds {
+            Ok(c) => c,
+            Err(e) => {
+                out.lanes = std::mem::take(&mut lanes);
+                out.destroy(&gpu.device);
+                return Err(AshError::vk("vkAllocateCommandBuffers", e));
+            }
+        };
+        for (b, cmd) in lane.batches.iter_mut().zip(cmds) {
+            b.cmd = cmd;
+        }
+    }
+    out.lanes = lanes;
+    out.lane_of = lane_of;
+    Ok(out)
+}
+
+/// Converts barriers to Vulkan and records them in one `vkCmdPipelineBarrier2`.
+pub(crate) fn record_barriers(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    barriers: &[Barrier],
+    memory: &Memory,
+) {
+    if barriers.is_empty() {
+        return;
+    }
+    let mut global = Vec::new();
+    let mut buffers = Vec::new();
+    let mut images = Vec::new();
+    for b in barriers {
+        match b.target {
+            Target::Global => global.push(
+                vk::MemoryBarrier2::default()
+                    .src_stage_mask(b.src.stages)
+                    .src_access_mask(b.src.access)
+                    .dst_stage_mask(b.dst.stages)
+                    .dst_access_mask(b.dst.access),
+            ),
+            Target::Buffer(r) => {
+                if let Some(Res::Buffer { buffer, .. }) = &memory.res[r] {
+                    buffers.push(
+                        vk::BufferMemoryBarrier2::default()
+                            .src_stage_mask(b.src.stages)
+                            .src_access_mask(b.src.access)
+                            .dst_stage_mask(b.dst.stages)
+                            .dst_access_mask(b.dst.access)
+                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .buffer(*buffer)
+                            .offset(0)
+                            .size(vk::WHOLE_SIZE),
+                    );
+                }
+            }
+            Target::Image { resource, old, new } => {
+                if let Some(res @ Res::Image { image, extent, .. }) = &memory.res[resource] {
+                    images.push(
+                        vk::ImageMemoryBarrier2::default()
+                            .src_stage_mask(b.src.stages)
+                            .src_access_mask(b.src.access)
+                            .dst_stage_mask(b.dst.stages)
+                            .dst_access_mask(b.dst.access)
+                            .old_layout(old)
+                            .new_layout(new)
+                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                            .image(*image)
+                            .subresource_range(full_range(res.aspect(), extent[2])),
+                    );
+                }
+            }
+        }
+    }
+    let info = vk::DependencyInfo::default()
+        .memory_barriers(&global)
+        .buffer_memory_barriers(&buffers)
+        .image_memory_barriers(&images);
+    // SAFETY: recording state; every handle is live.
+    unsafe { d.cmd_pipeline_barrier2(cmd, &info) };
+}
+
+/// Records every batch of every lane.
+pub(crate) fn record_all(
+    gpu: &Gpu,
+    plan: &Plan,
+    lanes: &Lanes,
+    pipelines: &Pipelines,
+    memory: &Memory,
+    sync: &SyncPlan,
+    timestamps: &Timestamps,
+) -> Result<(), AshError> {
+    let d = &gpu.device;
+    for lane in &lanes.lanes {
+        let pool = timestamps.pools[lane.queue];
+        for batch in &lane.batches {
+            let cmd = batch.cmd;
+            let begin = vk::CommandBufferBeginInfo::default();
+            // SAFETY: a fresh command buffer from this lane's pool.
+            unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
+            if let Some((qp, _)) = pool {
+                let first = 2 * batch.first as u32;
+                let count = 2 * (batch.last - batch.first + 1) as u32;
+                // SAFETY: outside any render pass.
+                unsafe { d.cmd_reset_query_pool(cmd, qp, first, count) };
+            }
+            for i in batch.first..=batch.last {
+                let p = lane.passes[i];
+                let built =
+                    pipelines
+                        .built
+                        .iter()
+                        .find(|b| b.p == p)
+                        .ok_or_else(|| AshError::Pass {
+                            pass: plan.pass_name(p).to_string(),
+                            message: "no pipeline was built".into(),
+                        })?;
+                record_barriers(d, cmd, &sync.before[p], memory);
+                // SAFETY: recording; handles live for the session.
+                unsafe {
+                    if let Some((qp, _)) = pool {
+                        d.cmd_write_timestamp2(
+                            cmd,
+                            vk::PipelineStageFlags2::TOP_OF_PIPE,
+                            qp,
+                            2 * i as u32,
+                        );
+                    }
+                    record_work(d, cmd, built.layout, &built.work, memory, sync, p)?;
+                    if let Some((qp, _)) = pool {
+                        d.cmd_write_timestamp2(
+                            cmd,
+                            vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
+                            qp,
+                            2 * i as u32 + 1,
+                        );
+                    }
+                }
+                record_barriers(d, cmd, &sync.after[p], memory);
+            }
+            // SAFETY: recording state.
+            unsafe { d.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
+        }
+    }
+    Ok(())
+}
+
+/// # Safety
+/// `cmd` is recording and every handle is live.
+unsafe fn record_work(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    layout: vk::PipelineLayout,
+    work: &Work,
+    memory: &Memory,
+    sync: &SyncPlan,
+    p: PassId,
+) -> Result<(), AshError> {
+    let layout_of = |r: usize| {
+        sync.layout_in
+            .get(&(p, r))
+            .copied()
+            .unwrap_or(vk::ImageLayout::GENERAL)
+    };
+    // SAFETY: per the function's contract.
+    unsafe {
+        match work {
+            Work::Compute {
+                pipeline,
+                dispatches,
+            } => {
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
+                for (set, launch) in dispatches {
+                    d.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::COMPUTE,
+                        layout,
+                        0,
+                        &[*set],
+                        &[],
+                    );
+                    match *launch {
+                        Launch::Direct(n) => d.cmd_dispatch(cmd, n, 1, 1),
+                        Launch::Indirect(r, offset) => {
+                            if let Some(Res::Buffer { buffer, .. }) = &memory.res[r] {
+                                d.cmd_dispatch_indirect(cmd, *buffer, offset);
+                            }
+                        }
+                    }
+                }
+            }
+            Work::Raster {
+                pipelines,
+                set,
+                color,
+                depth,
+                state,
+                vertices,
+                extent,
+            } => {
+                let view = |r: usize| match &memory.res[r] {
+                    Some(Res::Image { view, .. }) => *view,
+                    _ => vk::ImageView::null(),
+                };
+                let colors: Vec<vk::RenderingAttachmentInfo<'_>> = color
+                    .iter()
+                    .map(|&r| {
+                        let (op, clear) = match state.color_load {
+                            ColorLoad::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                            ColorLoad::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
+                        };
+                        vk::RenderingAttachmentInfo::default()
+                            .image_view(view(r))
+                            .image_layout(layout_of(r))
+                            .load_op(op)
+                            .store_op(vk::AttachmentStoreOp::STORE)
+                            .clear_value(vk::ClearValue {
+                                color: vk::ClearColorValue { float32: clear },
+                            })
+                    })
+                    .collect();
+                let depth_info = depth.map(|r| {
+                    let (op, clear) = match state.depth_load {
+                        DepthLoad::Load => (vk::AttachmentLoadOp::LOAD, 1.0),
+                        DepthLoad::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
+                    };
+                    vk::RenderingAttachmentInfo::default()
+                        .image_view(view(r))
+                        .image_layout(layout_of(r))
+                        .load_op(op)
+                        .store_op(vk::AttachmentStoreOp::STORE)
+                        .clear_value(vk::ClearValue {
+                            depth_stencil: vk::ClearDepthStencilValue {
+                                depth: clear,
+                                stencil: 0,
+                            },
+                        })
+                });
+                let area = vk::Rect2D {
+                    offset: vk::Offset2D { x: 0, y: 0 },
+                    extent: vk::Extent2D {
+                        width: extent[0],
+                        height: extent[1],
+                    },
+                };
+                let mut info = vk::RenderingInfo::default()
+                    .render_area(area)
+                    .layer_count(1)
+                    .color_attachments(&colors);
+                if let Some(di) = depth_info.as_ref() {
+                    info = info.depth_attachment(di);
+                }
+                d.cmd_begin_rendering(cmd, &info);
+                // WGSL's clip space has y up: a negative-height viewport
+                // (Vulkan 1.1) flips it, as wgpu-hal does.
+                d.cmd_set_viewport(
+                    cmd,
+                    0,
+                    &[vk::Viewport {
+                        x: 0.0,
+                        y: extent[1] as f32,
+                        width: extent[0] as f32,
+                        height: -(extent[1] as f32),
+                        min_depth: 0.0,
+                        max_depth: 1.0,
+                    }],
+                );
+                d.cmd_set_scissor(cmd, 0, &[area]);
+                for pipeline in pipelines {
+                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, *pipeline);
+                    d.cmd_bind_descriptor_sets(
+                        cmd,
+                        vk::PipelineBindPoint::GRAPHICS,
+                        layout,
+                        0,
+                        &[*set],
+                        &[],
+                    );
+                    if *vertices > 0 {
+                        d.cmd_draw(cmd, *vertices, 1, 0, 0);
+                    }
+                }
+                d.cmd_end_rendering(cmd);
+            }
+        }
+    }
+    Ok(())
+}

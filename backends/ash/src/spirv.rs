@@ -1,0 +1,205 @@
+//! WGSL (composed by `strandgraph_passes::wgsl`) to SPIR-V with naga's
+//! `spv-out`, and the descriptor layout the module declares.
+//!
+//! DESIGN.md, "Shaders": SPIR-V 1.3 or later with an explicit capability
+//! set (the device's [`crate::device::Gpu::spirv_caps`]: Int64,
+//! Int64Atomics, GroupNonUniform* only where the features were enabled) and
+//! `fake_missing_bindings: true`, so `@group(0) @binding(n)` becomes
+//! descriptor set 0, binding n as written.
+
+use crate::error::AshError;
+use ash::vk;
+use naga::back::spv;
+use naga::{AddressSpace, ImageClass, TypeInner};
+use strandgraph_passes::wgsl::{Composed, all_capabilities, validate};
+
+/// A translated module and the descriptors its entry points use.
+pub(crate) struct Spirv {
+    pub words: Vec<u32>,
+    /// `(binding, type)` in set 0, sorted by binding.
+    pub descriptors: Vec<(u32, vk::DescriptorType)>,
+}
+
+/// Translates `composed` for the entry points `entries` (compute, or vertex
+/// and fragments); `pass` names the pass in errors.
+pub(crate) fn translate(
+    composed: &Composed,
+    entries: &[&str],
+    caps: &[spv::Capability],
+    pass: &str,
+    device: &str,
+) -> Result<Spirv, AshError> {
+    let module = &composed.module;
+    let info = validate(module, all_capabilities())
+        .map_err(|e| AshError::Shader(format!("pass `{pass}`: {e}")))?;
+    let mut descriptors: Vec<(u32, vk::DescriptorType)> = Vec::new();
+    for want in entries {
+        let Some(index) = module.entry_points.iter().position(|e| e.name == *want) else {
+            return Err(AshError::Shader(format!(
+                "pass `{pass}`: no entry point `{want}` in the composed module"
+            )));
+        };
+        let uses = info.get_entry_point(index);
+        for (handle, var) in module.global_variables.iter() {
+            let Some(binding) = &var.binding else {
+                continue;
+            };
+            if uses[handle].is_empty() {
+                continue;
+            }
+            if binding.group != 0 {
+                return Err(AshError::Shader(format!(
+                    "pass `{pass}`: binding group {} (only group 0 is bound)",
+                    binding.group
+                )));
+            }
+            let ty = match (var.space, &module.types[var.ty].inner) {
+                (AddressSpace::Uniform, _) => vk::DescriptorType::UNIFORM_BUFFER,
+                (AddressSpace::Storage { .. }, _) => vk::DescriptorType::STORAGE_BUFFER,
+                (AddressSpace::Handle, TypeInner::Image { class, .. }) => match class {
+                    ImageClass::Storage { .. } => vk::DescriptorType::STORAGE_IMAGE,
+                    _ => vk::DescriptorType::SAMPLED_IMAGE,
+                },
+                (AddressSpace::Handle, TypeInner::Sampler { .. }) => vk::DescriptorType::SAMPLER,
+                (space, _) => {
+                    return Err(AshError::Shader(format!(
+                        "pass `{pass}`: binding {} in {space:?} is not a descriptor",
+                        binding.binding
+                    )));
+                }
+            };
+            if !descriptors.iter().any(|(b, _)| *b == binding.binding) {
+                descriptors.push((binding.binding, ty));
+            }
+        }
+    }
+    descriptors.sort_by_key(|(b, _)| *b);
+
+    let options = spv::Options {
+        lang_version: (1, 3),
+        flags: spv::WriterFlags::LABEL_VARYINGS,
+        fake_missing_bindings: true,
+        capabilities: Some(caps.iter().copied().collect()),
+        // The same robustness wgpu-hal asks naga for on Vulkan, so
+        // out-of-range accesses behave as on the wgpu backend.
+        bounds_check_policies: naga::proc::BoundsCheckPolicies {
+            index: naga::proc::BoundsCheckPolicy::Restrict,
+            buffer: naga::proc::BoundsCheckPolicy::Restrict,
+            image_load: naga::proc::BoundsCheckPolicy::Restrict,
+            binding_array: naga::proc::BoundsCheckPolicy::Unchecked,
+        },
+        // WGSL zero-initialises workgroup memory.
+        zero_initialize_workgroup_memory: spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
+        ..Default::default()
+    };
+    let words = spv::write_vec(module, &info, &options, None).map_err(|e| match e {
+        spv::Error::MissingCapabilities(what, missing) => AshError::MissingFeature {
+            device: device.to_string(),
+            feature: format!("SPIR-V capability {missing:?}"),
+            pass: pass.to_string(),
+            why: format!("the shader uses {what}"),
+        },
+        e => AshError::Shader(format!("pass `{pass}`: SPIR-V: {e}")),
+    })?;
+    // naga checks some capabilities against the given set and adds others
+    // (Float64, Int64) unchecked: check every declared one here.
+    for cap in declared_capabilities(&words) {
+        if !caps.iter().any(|c| *c as u32 == cap) {
+            return Err(AshError::MissingFeature {
+                device: device.to_string(),
+                feature: format!("SPIR-V capability {}", capability_name(caps, cap)),
+                pass: pass.to_string(),
+                why: "the translated shader declares it and the device's enabled features do not allow it".into(),
+            });
+        }
+    }
+    Ok(Spirv { words, descriptors })
+}
+
+/// The operands of every `OpCapability` (opcode 17) in a SPIR-V module.
+pub(crate) fn declared_capabilities(words: &[u32]) -> Vec<u32> {
+    let mut out = Vec::new();
+    let mut i = 5; // after the header
+    while i < words.len() {
+        let (count, opcode) = ((words[i] >> 16) as usize, words[i] & 0xFFFF);
+        if count == 0 {
+            break;
+        }
+        if opcode == 17 && i + 1 < words.len() {
+            out.push(words[i + 1]);
+        }
+        i += count;
+    }
+    out
+}
+
+fn capability_name(_known: &[spv::Capability], raw: u32) -> String {
+    use spv::Capability as C;
+    for c in [
+        C::Float64,
+        C::Int64,
+        C::Int64Atomics,
+        C::GroupNonUniform,
+        C::GroupNonUniformVote,
+        C::GroupNonUniformArithmetic,
+        C::GroupNonUniformBallot,
+        C::GroupNonUniformShuffle,
+        C::GroupNonUniformShuffleRelative,
+        C::GroupNonUniformQuad,
+        C::Int16,
+        C::Float16,
+    ] {
+        if c as u32 == raw {
+            return format!("{c:?}");
+        }
+    }
+    format!("#{raw}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use strandgraph_passes::wgsl::{Shaders, default_dir};
+
+    #[test]
+    fn clear_translates_with_a_uniform_and_a_storage_buffer() {
+        let mut shaders = Shaders::load(&default_dir()).unwrap();
+        let composed = shaders.compose("common/clear.wgsl").unwrap();
+        let entry = composed.module.entry_points[0].name.clone();
+        let s = translate(
+            &composed,
+            &[&entry],
+            &[spv::Capability::Shader],
+            "clear",
+            "test",
+        )
+        .unwrap();
+        assert_eq!(s.words[0], 0x0723_0203, "SPIR-V magic");
+        assert_eq!(
+            s.descriptors,
+            vec![
+                (0, vk::DescriptorType::UNIFORM_BUFFER),
+                (1, vk::DescriptorType::STORAGE_BUFFER)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_capability_the_device_lacks_names_the_pass() {
+        let mut shaders = Shaders::load(&default_dir()).unwrap();
+        let composed = shaders.compose("kulikov/lod.wgsl").unwrap();
+        let entry = composed.module.entry_points[0].name.clone();
+        // Float64 withheld.
+        let err = translate(
+            &composed,
+            &[&entry],
+            &[spv::Capability::Shader],
+            "lod",
+            "test",
+        )
+        .err()
+        .unwrap();
+        let text = err.to_string();
+        assert!(text.contains("`lod`") && text.contains("Float64"), "{text}");
+    }
+}

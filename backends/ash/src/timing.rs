@@ -1,0 +1,103 @@
+//! Per-pass GPU times: a timestamp query pool per queue, two queries per
+//! pass, reset at the start of each batch that writes them. Ticks are masked
+//! to the family's `timestampValidBits` and scaled by `timestampPeriod`.
+
+use crate::device::Gpu;
+use crate::error::{AshError, VkContext};
+use ash::vk;
+use strandgraph_graph::Queue;
+use strandgraph_graph::resolve::PassId;
+
+/// One pass's GPU time on the queue it ran on.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct PassTiming {
+    pub pass: PassId,
+    pub name: String,
+    /// The queue the plan gave it.
+    pub queue: Queue,
+    /// The Vulkan queue family it ran on.
+    pub family: u32,
+    pub workgroups: u32,
+    /// `None` where the family has no timestamps (`timestampValidBits` 0).
+    pub millis: Option<f64>,
+    /// Begin and end in milliseconds from the frame's first timestamp on any
+    /// queue (one device clock: overlap between queues shows here).
+    pub span: Option<(f64, f64)>,
+}
+
+/// Query pools of the backend's queues.
+pub(crate) struct Timestamps {
+    /// Per backend queue: the pool (if the family has timestamps) and its size.
+    pub pools: Vec<Option<(vk::QueryPool, u32)>>,
+    bits: Vec<u32>,
+}
+
+impl Timestamps {
+    /// `passes[q]`: how many passes backend queue `q` runs.
+    pub fn new(gpu: &Gpu, passes: &[usize]) -> Result<Self, AshError> {
+        let mut pools = Vec::new();
+        let mut bits = Vec::new();
+        for (q, &n) in passes.iter().enumerate() {
+            let valid = gpu.queues[q].timestamp_bits;
+            bits.push(valid);
+            if valid == 0 || n == 0 {
+                pools.push(None);
+                continue;
+            }
+            let count = (2 * n) as u32;
+            let info = vk::QueryPoolCreateInfo::default()
+                .query_type(vk::QueryType::TIMESTAMP)
+                .query_count(count);
+            // SAFETY: valid device and info.
+            match unsafe { gpu.device.create_query_pool(&info, None) } {
+                Ok(pool) => pools.push(Some((pool, count))),
+                Err(e) => {
+                    let mut made = Timestamps { pools, bits };
+                    made.destroy(&gpu.device);
+                    return Err(AshError::vk("vkCreateQueryPool", e));
+                }
+            }
+        }
+        Ok(Self { pools, bits })
+    }
+
+    /// Raw ticks of every query of queue `q`'s pool, masked to the valid bits.
+    pub fn read(&self, gpu: &Gpu, q: usize) -> Result<Option<Vec<u64>>, AshError> {
+        let Some((pool, count)) = self.pools[q] else {
+            return Ok(None);
+        };
+        let mut ticks = vec![0u64; count as usize];
+        // SAFETY: the frame that wrote these queries has completed (the host
+        // waited on every queue's timeline before reading).
+        unsafe {
+            gpu.device.get_query_pool_results(
+                pool,
+                0,
+                &mut ticks,
+                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+            )
+        }
+        .ctx("vkGetQueryPoolResults")?;
+        let mask = if self.bits[q] >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << self.bits[q]) - 1
+        };
+        Ok(Some(ticks.into_iter().map(|t| t & mask).collect()))
+    }
+
+    pub fn mask(&self, q: usize) -> u64 {
+        if self.bits[q] >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << self.bits[q]) - 1
+        }
+    }
+
+    pub fn destroy(&mut self, d: &ash::Device) {
+        for (pool, _) in self.pools.iter_mut().filter_map(Option::take) {
+            // SAFETY: the device is idle.
+            unsafe { d.destroy_query_pool(pool, None) };
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! The ash backend runs the showcase's Kulikov visibility graph under the
+//! Khronos validation layer with synchronization validation: any validation
+//! message fails the run (lavapipe in CI; `scripts/test.sh` installs the
+//! layer). Correctness against the CPU reference is `tests/diff_ash.rs` at
+//! the workspace root.
+
+use std::path::Path;
+use strandgraph_ash::{AshBackend, Validation};
+use strandgraph_assets::Scene;
+use strandgraph_graph::compile_file;
+use strandgraph_passes::Registry;
+use strandgraph_passes::upload::upload;
+
+fn root() -> &'static Path {
+    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+}
+
+fn validated() -> AshBackend {
+    AshBackend {
+        validation: Validation::Sync,
+        ..AshBackend::default()
+    }
+}
+
+#[test]
+fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
+    let scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
+    let plan = compile_file(
+        &root().join("scenes/graphs/kulikov_visibility.ron"),
+        &Registry,
+    )
+    .unwrap();
+    let up = upload(&scene, 96, 54);
+    let instance = plan.instantiate(&up.quantities).unwrap();
+    let mut session = validated()
+        .open(&plan, &instance)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for n in &session.notes {
+        eprintln!("ash: {n}");
+    }
+    for frame in 0..2 {
+        let f = session
+            .run(&up)
+            .unwrap_or_else(|e| panic!("frame {frame}: {e}"));
+        assert_eq!(f.timings.len(), plan.order.len());
+        for t in &f.timings {
+            eprintln!(
+                "{:<16} {:<12} family {} groups {:>8} {:?} ms",
+                t.name,
+                t.queue.to_string(),
+                t.family,
+                t.workgroups,
+                t.millis
+            );
+        }
+    }
+    let layers = session.read("debug_layers").unwrap().unwrap();
+    assert_eq!(layers.len(), 96 * 54);
+    assert!(
+        layers.iter().any(|&w| w >> 24 != 0),
+        "some hair coverage reaches the debug view"
+    );
+    assert!(session.transient_bytes <= session.unaliased_bytes);
+}
