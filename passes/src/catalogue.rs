@@ -132,6 +132,22 @@ pub static KINDS: &[PassKind] = &[
         "reconnection and opacity reconstruction filter over centre and conservative layers",
         "Lipp §3.3, Appendix B Code 2",
     ),
+    // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
+    kind(
+        "bench.atomic_min32",
+        "random-address 32-bit atomicMin into a visibility-atlas-sized buffer (roofline)",
+        "strandgraph bench; Kulikov 2025 'Rasterization' (the operation measured)",
+    ),
+    kind(
+        "bench.atomic_min64",
+        "random-address 64-bit atomicMin, result unused, into a screen-sized 64-bit buffer (roofline)",
+        "strandgraph bench; Lipp §3.1 (the operation measured)",
+    ),
+    kind(
+        "bench.copy",
+        "buffer-to-buffer copy in a compute shader (bandwidth roofline)",
+        "strandgraph bench",
+    ),
     // Scheuermann 2004, ATI: polygonal hair, the baseline.
     kind(
         "scheuermann.sort",

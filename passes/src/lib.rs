@@ -7,6 +7,7 @@
 //! Each entry says which pipeline it belongs to and which section of which
 //! paper specifies it, so `strandgraph graph` can show where a pass comes from.
 
+pub mod bench;
 pub mod bind;
 mod catalogue;
 pub mod common;
@@ -43,6 +44,9 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::shade_sort::ShadeSort,
     &kulikov::shade::Shade,
     &kulikov::compose::Compose,
+    &bench::AtomicMin32,
+    &bench::AtomicMin64,
+    &bench::Copy,
 ];
 
 /// The built-in pass kinds.

@@ -52,6 +52,10 @@ fn capabilities_of(file: &str) -> Capabilities {
         // The segment budget's proportional reduction is done in f64, as the
         // CPU kernel does (`budget as f64 / total as f64`).
         "kulikov/lod.wgsl" => BASE | Capabilities::FLOAT64,
+        // atomic<u64> with atomicMin whose result is unused (DESIGN.md, "Shaders").
+        "bench/atomic_min64.wgsl" => {
+            BASE | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
+        }
         _ => BASE,
     }
 }

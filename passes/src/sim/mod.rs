@@ -3,6 +3,7 @@
 
 pub mod harness;
 pub mod subgroup;
+mod wide;
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
