@@ -194,7 +194,7 @@ impl Session {
                 }
                 None => (None, None),
             };
-            let mut workgroups = self
+            let workgroups = self
                 .pipelines
                 .built
                 .iter()
@@ -209,9 +209,13 @@ impl Session {
                         .fold(0u32, u32::saturating_add),
                     crate::pipelines::Work::Raster { vertices, .. } => *vertices,
                 });
+            let mut workgroups = Some(workgroups);
             if let Some(&(_, r, word)) = self.indirect.iter().find(|x| x.0 == i) {
-                let words = self.read_words(r)?;
-                workgroups = words.get(word).copied().unwrap_or(0);
+                workgroups = if self.memory.aliases.iter().any(|&(a, b)| a == r || b == r) {
+                    None
+                } else {
+                    self.read_words(r)?.get(word).copied()
+                };
             }
             out.push(PassTiming {
                 pass: p,

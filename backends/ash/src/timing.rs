@@ -17,7 +17,9 @@ pub struct PassTiming {
     pub queue: Queue,
     /// The Vulkan queue family it ran on.
     pub family: u32,
-    pub workgroups: u32,
+    /// Workgroups (vertices for raster passes); `None` for an indirect
+    /// dispatch whose arguments' bytes were aliased by the frame's end.
+    pub workgroups: Option<u32>,
     /// `None` where the family has no timestamps (`timestampValidBits` 0).
     pub millis: Option<f64>,
     /// Begin and end in milliseconds from the frame's first timestamp on any

@@ -45,7 +45,7 @@ fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
         assert_eq!(f.timings.len(), plan.order.len());
         for t in &f.timings {
             eprintln!(
-                "{:<16} {:<12} family {} groups {:>8} {:?} ms",
+                "{:<16} {:<12} family {} groups {:>10?} {:?} ms",
                 t.name,
                 t.queue.to_string(),
                 t.family,
@@ -61,4 +61,34 @@ fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
         "some hair coverage reaches the debug view"
     );
     assert!(session.transient_bytes <= session.unaliased_bytes);
+}
+
+/// The smallest graph: one compute pass clearing an imported buffer,
+/// read back through the session, twice.
+#[test]
+fn a_clear_pass_writes_its_value() {
+    let plan = strandgraph_graph::compile_str(
+        "clear.ron",
+        r#"Graph(
+            name: "clear",
+            resources: [Buffer(name: "out", size: Bytes(1000), lifetime: Imported)],
+            passes: [Pass(name: "clear", kind: "common.clear", queue: AsyncCompute, params: {"value": 7}, writes: ["out"])],
+            outputs: ["out"],
+        )"#,
+        &Registry,
+    )
+    .unwrap();
+    let instance = plan.instantiate(&Default::default()).unwrap();
+    let mut session = validated()
+        .open(&plan, &instance)
+        .unwrap_or_else(|e| panic!("{e}"));
+    for _ in 0..2 {
+        let frame = session
+            .run(&Default::default())
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(frame.timings.len(), 1);
+        assert_eq!(frame.timings[0].workgroups, Some(1));
+        assert_eq!(session.read("out").unwrap().unwrap(), vec![7; 250]);
+    }
+    assert_eq!(session.read("no such resource").unwrap(), None);
 }
