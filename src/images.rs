@@ -1,7 +1,7 @@
 //! Rendered images (graph outputs read back as words) to 8-bit pictures.
 
 use half::f16;
-use image::RgbaImage;
+use image::{Rgb32FImage, Rgba32FImage, RgbaImage};
 use strandgraph_graph::Plan;
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl};
 
@@ -47,4 +47,76 @@ pub fn to_picture(
         _ => return None,
     }
     Some(img)
+}
+
+/// An `Rgba16Float` image resource as linear float RGBA, for EXR; `None`
+/// for other formats.
+pub fn to_linear(
+    plan: &Plan,
+    resource: usize,
+    words: &[u32],
+    width: u32,
+    height: u32,
+) -> Option<Rgba32FImage> {
+    let r = plan.graph.physical(resource);
+    let ResourceDecl::Image {
+        format: ImageFormat::Rgba16Float,
+        ..
+    } = plan.graph.resources[r].decl
+    else {
+        return None;
+    };
+    let texels = (width * height) as usize;
+    if words.len() < 2 * texels {
+        return None;
+    }
+    let data = words[..2 * texels]
+        .iter()
+        .flat_map(|w| [w & 0xFFFF, w >> 16])
+        .map(|h| f16::from_bits(h as u16).to_f32())
+        .collect();
+    Rgba32FImage::from_raw(width, height, data)
+}
+
+/// A `D32Float` depth image (NDC depth of `perspective_rh`, cleared to 1)
+/// as linear view depth in metres, in all three channels (the `image`
+/// crate writes EXR as RGB or RGBA); the far plane where nothing was drawn.
+pub fn depth_to_view(
+    words: &[u32],
+    near: f32,
+    far: f32,
+    width: u32,
+    height: u32,
+) -> Option<Rgb32FImage> {
+    let texels = (width * height) as usize;
+    let data = words
+        .get(..texels)?
+        .iter()
+        .flat_map(|&w| {
+            let z = f32::from_bits(w).clamp(0.0, 1.0);
+            let d = near * far / (far - z * (far - near));
+            [d, d, d]
+        })
+        .collect();
+    Rgb32FImage::from_raw(width, height, data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depth_converts_to_view_distance() {
+        let (n, f) = (0.02, 500.0);
+        let p = glam_free_projection_depth(3.0, n, f);
+        let img = depth_to_view(&[p.to_bits(), 1.0f32.to_bits()], n, f, 2, 1).unwrap();
+        assert!((img.get_pixel(0, 0)[0] - 3.0).abs() < 1e-3);
+        assert!((img.get_pixel(1, 0)[0] - f).abs() < 1e-2);
+        assert!(depth_to_view(&[0], n, f, 2, 1).is_none());
+    }
+
+    /// NDC depth of view distance `d` under `perspective_rh` (z in [0, 1]).
+    fn glam_free_projection_depth(d: f32, n: f32, f: f32) -> f32 {
+        (f / (n - f) * -d + n * f / (n - f)) / d
+    }
 }
