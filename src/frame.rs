@@ -4,9 +4,11 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::Path;
 use strandgraph_assets::Scene;
+use strandgraph_bake::BakeOutcome;
 use strandgraph_graph::{Instance, Plan, compile_file};
 use strandgraph_passes::Registry;
-use strandgraph_passes::upload::{Upload, upload};
+use strandgraph_passes::kulikov::shade::{SelfShadow, ShadeParams};
+use strandgraph_passes::upload::{SHADOW_SH, Upload, bake_shadow_sh, upload};
 
 pub struct Prepared {
     pub scene: Scene,
@@ -32,7 +34,8 @@ pub fn prepare(
     }
     let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
     let plan = compile_file(&graph_path, &Registry)?;
-    let upload = upload(&scene, w, h);
+    let mut upload = upload(&scene, w, h);
+    bake_shadows(&plan, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
     Ok(Prepared {
         scene,
@@ -40,6 +43,38 @@ pub fn prepare(
         plan,
         instance,
     })
+}
+
+/// Kulikov's precomputed self-shadowing: when a live `kulikov.shade` pass
+/// reads `groom.shadow_sh` with `self_shadow: "Baked"`, bakes the SH with
+/// that pass's bake settings, or loads it from the on-disk cache
+/// (`strandgraph_bake::cache_dir`), so it runs once per groom. Nothing
+/// reads it otherwise, and nothing is baked (the backends zero-fill it).
+/// Does nothing when the upload already holds it; call it again after
+/// [`override_param`] switches the shade pass to `"Baked"`.
+pub fn bake_shadows(plan: &Plan, up: &mut Upload) -> Result<Option<BakeOutcome>> {
+    let g = &plan.graph;
+    let Some(r) = g.resource_id(SHADOW_SH) else {
+        return Ok(None);
+    };
+    if up.resources.contains_key(SHADOW_SH) {
+        return Ok(None);
+    }
+    for (p, pass) in g.passes.iter().enumerate() {
+        let reads = pass.accesses.iter().any(|a| g.physical(a.resource) == r);
+        if !plan.live[p] || !reads || pass.kind != "kulikov.shade" {
+            continue;
+        }
+        let params = ShadeParams::from_ron(&pass.params).map_err(|e| miette::miette!("{e}"))?;
+        if params.self_shadow != SelfShadow::Baked {
+            continue;
+        }
+        let cache = strandgraph_bake::cache_dir();
+        let outcome = bake_shadow_sh(up, &params.bake, cache.as_deref())
+            .map_err(|e| miette::miette!("pass `{}`: {e}", pass.name))?;
+        return Ok(Some(outcome));
+    }
+    Ok(None)
 }
 
 /// Parses `WxH`.

@@ -258,3 +258,71 @@ pub fn melanin_color(melanin: f32) -> [f32; 3] {
     let black = [0.04, 0.03, 0.02];
     [0, 1, 2].map(|i| blond[i] + (black[i] - blond[i]) * m.powf(0.5))
 }
+
+/// The packed resource [`bake_shadow_sh`] fills: 4 × f32 per packed vertex.
+pub const SHADOW_SH: &str = "groom.shadow_sh";
+
+/// Kulikov, "Precomputed self-shadowing": the bake's geometry from a packed
+/// scene, in the packed vertex order (so the SH lines up with
+/// `groom.vertices` one to one, resampled strands included): world-space
+/// vertices (each model's rest pose through its world matrix), the strand
+/// table, and every scene triangle as an opaque occluder ("We trace against
+/// the parent mesh as well so hair is always shadowed by the head").
+pub fn shadow_bake_geometry(up: &Upload) -> ShadowBakeGeometry {
+    let words = |name: &str| up.resources.get(name).map_or(&[][..], Vec::as_slice);
+    let local: &[[f32; 4]] = bytemuck::cast_slice(words("groom.vertices"));
+    let mut vertices = local.to_vec();
+    for m in &up.models {
+        let world = Mat4::from_cols_array(&m.world);
+        let first = m.vertex_first as usize;
+        let n = m.strand_count as usize * m.points_per_strand as usize;
+        for v in vertices.iter_mut().skip(first).take(n) {
+            let p = world.transform_point3(Vec3::new(v[0], v[1], v[2]));
+            *v = [p.x, p.y, p.z, v[3]];
+        }
+    }
+    let strands = bytemuck::cast_slice(words("groom.strands")).to_vec();
+    let triangles = words("mesh.triangles")
+        .chunks_exact(16)
+        .map(|t| {
+            let corner = |k: usize| [0, 1, 2].map(|i| f32::from_bits(t[4 * k + i]));
+            [corner(0), corner(1), corner(2)]
+        })
+        .collect();
+    ShadowBakeGeometry {
+        vertices,
+        strands,
+        triangles,
+    }
+}
+
+/// What [`shadow_bake_geometry`] returns; [`Self::input`] borrows it for the bake.
+#[derive(Debug, Clone, Default)]
+pub struct ShadowBakeGeometry {
+    pub vertices: Vec<[f32; 4]>,
+    pub strands: Vec<[u32; 2]>,
+    pub triangles: Vec<[[f32; 3]; 3]>,
+}
+
+impl ShadowBakeGeometry {
+    pub fn input(&self) -> strandgraph_bake::BakeInput<'_> {
+        strandgraph_bake::BakeInput {
+            vertices: &self.vertices,
+            strands: &self.strands,
+            triangles: &self.triangles,
+        }
+    }
+}
+
+/// Bakes (or loads from the cache in `cache`) the self-shadowing SH of
+/// every packed vertex and stores it as [`SHADOW_SH`].
+pub fn bake_shadow_sh(
+    up: &mut Upload,
+    settings: &strandgraph_bake::BakeSettings,
+    cache: Option<&std::path::Path>,
+) -> Result<strandgraph_bake::BakeOutcome, strandgraph_bake::BakeError> {
+    let geometry = shadow_bake_geometry(up);
+    let (sh, outcome) = strandgraph_bake::bake_cached(&geometry.input(), settings, cache)?;
+    up.set(SHADOW_SH, bytemuck::cast_slice(&sh).to_vec());
+    Ok(outcome)
+}

@@ -2,8 +2,10 @@
 // visible segment of shading_segments. Marschner R, TT, TRT after Karis 2016
 // ("Physically Based Hair Shading in Unreal"; Tafuri 2019's TT/TRT forms are
 // not reproduced, Karis's are used for all three lobes), Karis's multiple
-// scattering fake, per-lobe artist scalars, self-shadowing None (0) or
-// VoxelMarch (1) through density_grid.
+// scattering fake, per-lobe artist scalars, self-shadowing None (0),
+// VoxelMarch (1) through density_grid, or Baked (2): Kulikov's precomputed
+// self-shadowing, clamped L1 SH of scattering events per vertex
+// (groom_shadow_sh, baked offline by strandgraph-bake).
 // Port of passes/src/kulikov/shade/{mod,karis}.rs.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, LightData}
@@ -13,7 +15,7 @@ struct ShadeParams {
     // r, tt, trt scales; scatter (0 = no multiple scattering).
     lobes: vec4<f32>,
     shift: f32,
-    // 0 None, 1 VoxelMarch (Baked is refused before a pipeline is built).
+    // 0 None, 1 VoxelMarch, 2 Baked.
     self_shadow: u32,
     absorption: f32,
     resolution: u32,
@@ -31,8 +33,11 @@ struct ShadeParams {
 @group(0) @binding(7) var<storage, read> segment_visibility: array<u32>;
 @group(0) @binding(8) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> density_grid: array<u32>;
+// Per vertex: L1 SH coefficients (Y00, Y1-1 (y), Y10 (z), Y11 (x)) of the
+// scattering-event count, biased by -HAIR_MAX_SCATTER_EVENTS where rays missed.
+@group(0) @binding(10) var<storage, read> groom_shadow_sh: array<vec4<f32>>;
 // rgba16f per vertex: r | g << 16, b | a << 16.
-@group(0) @binding(10) var<storage, read_write> vertex_lighting: array<vec2<u32>>;
+@group(0) @binding(11) var<storage, read_write> vertex_lighting: array<vec2<u32>>;
 
 const GROUP: u32 = 64u;
 const GRID_WORDS: u32 = 110592u;
@@ -170,7 +175,15 @@ fn march(model: u32, md: ModelData, p: vec3<f32>, dir: vec3<f32>, max_t: f32) ->
     return crossed;
 }
 
-fn shade_vertex(model: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32> {
+// strandgraph_bake::sh::visibility. Kulikov, "Visibility function":
+// numScatterEvents = max(0, ProjectL1SH(visSH, lightDirection));
+// visibility = exp(-absorption * numScatterEvents).
+fn baked_visibility(sh: vec4<f32>, l: vec3<f32>) -> f32 {
+    let events = sh.x * 0.2820948 + dot(sh.yzw, vec3<f32>(l.y, l.z, l.x)) * 0.4886025;
+    return exp(-params.absorption * max(events, 0.0));
+}
+
+fn shade_vertex(model: u32, vertex: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32> {
     let md = models[model];
     let cam = frame.camera_pos.xyz;
     let to_cam = cam - p;
@@ -195,6 +208,8 @@ fn shade_vertex(model: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32> {
         var visibility = 1.0;
         if params.self_shadow == 1u {
             visibility = exp(-params.absorption * march(model, md, p, to_light, dist));
+        } else if params.self_shadow == 2u {
+            visibility = baked_visibility(groom_shadow_sh[vertex], to_light);
         }
         out += light.radiance.xyz * falloff * hair_shading(t, v, to_light, color, md.color.w, visibility);
     }
@@ -256,12 +271,12 @@ fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) 
     let p1 = world_of_clip(clip_positions[seg.vb]);
     let d = p0 - p1;
     let t = select(vec3<f32>(0.0, 1.0, 0.0), normalize(d), length(d) > 0.0);
-    store_lighting(seg.va, shade_vertex(seg.model, p0, t));
+    store_lighting(seg.va, shade_vertex(seg.model, seg.va, p0, t));
     let md = models[seg.model];
     let per = md.points_per_strand - 1u;
     let last = seg.local % per + 1u >= load_lod(lod_models[seg.model]).segments_per_strand;
     let next = id + 1u;
     if last || (segment_visibility[next / 32u] & (1u << (next % 32u))) == 0u {
-        store_lighting(seg.vb, shade_vertex(seg.model, p1, t));
+        store_lighting(seg.vb, shade_vertex(seg.model, seg.vb, p1, t));
     }
 }

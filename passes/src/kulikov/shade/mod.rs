@@ -16,8 +16,16 @@
 //! - `"VoxelMarch"`: march the model's `density_grid` towards each light
 //!   (`march_steps` samples, grid `resolution`), "Density volume raymarching
 //!   for each light"; visibility = exp(−absorption · strands crossed);
-//! - `"Baked"`: the offline ray-traced SH (`groom.shadow_sh`); not built
-//!   yet, so asking for it is an error naming the missing bake.
+//! - `"Baked"`: Kulikov's "Precomputed self-shadowing", the shipped one:
+//!   per vertex, clamped L1 SH of the number of scattering events towards
+//!   every direction, ray traced offline against the strands and the head
+//!   (`strandgraph-bake`, packed as `groom.shadow_sh`, 4 × f32 per vertex);
+//!   "Fetch baked visibility at runtime and use for all lights":
+//!   visibility = exp(−absorption · max(0, SH · light direction)). The bake
+//!   settings are this pass's parameters too (`bake_rays`,
+//!   `bake_max_distance`, `bake_vertex_stride`, `bake_occluder_stride`,
+//!   `max_scatter_events`), so `frame::prepare` bakes with them when the
+//!   live shade pass selects `"Baked"`.
 
 pub mod karis;
 
@@ -31,6 +39,7 @@ use crate::layout::{LightData, read};
 use crate::sim::{Ctx, Words};
 use glam::Vec3;
 use karis::{Lobes, hair_shading};
+use strandgraph_bake::{BakeSettings, HAIR_MAX_SCATTER_EVENTS};
 
 pub struct Shade;
 
@@ -60,7 +69,22 @@ pub struct ShadeParams {
     pub march_steps: u32,
     /// Fraction of the base colour added as ambient light.
     pub ambient: f32,
+    /// The offline bake `"Baked"` reads (ignored by the other modes).
+    pub bake: BakeSettings,
 }
+
+/// Rays per probe vertex of the self-shadowing bake when the graph names none.
+pub const DEFAULT_BAKE_RAYS: u32 = 16;
+/// Probe every 8th vertex of a strand and its tip (Kulikov found "1 probe
+/// per 4 vertices [...] very similar to 1 probe per 1 vertex"; 8 keeps the
+/// showcase's 2.1M-vertex bake near a minute and a half on two cores).
+pub const DEFAULT_BAKE_VERTEX_STRIDE: u32 = 8;
+/// Trace against every 8th strand, 8× as thick (see
+/// `strandgraph_bake::bvh::Occluders::new`).
+pub const DEFAULT_BAKE_OCCLUDER_STRIDE: u32 = 8;
+/// Metres a bake ray looks for occluders: "what matters most is short
+/// neighborhood of each segment".
+pub const DEFAULT_BAKE_MAX_DISTANCE: f32 = 0.1;
 
 impl ShadeParams {
     pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
@@ -73,15 +97,7 @@ impl ShadeParams {
         let self_shadow = match p.string("self_shadow", "VoxelMarch")?.as_str() {
             "None" => SelfShadow::None,
             "VoxelMarch" => SelfShadow::VoxelMarch,
-            "Baked" => {
-                return Err(err(
-                    "self_shadow",
-                    "\"Baked\" reads the offline self-shadowing bake `groom.shadow_sh` \
-                     (ray-traced clamped L1 SH per vertex), which is not built yet; \
-                     use \"VoxelMarch\" or \"None\""
-                        .into(),
-                ));
-            }
+            "Baked" => SelfShadow::Baked,
             other => {
                 return Err(err(
                     "self_shadow",
@@ -97,6 +113,17 @@ impl ShadeParams {
             ));
         }
         let multiple = p.bool("multiple_scattering", true)?;
+        let bake = BakeSettings {
+            rays: p.u32("bake_rays", DEFAULT_BAKE_RAYS)?,
+            max_scatter_events: p.f32("max_scatter_events", HAIR_MAX_SCATTER_EVENTS)?,
+            max_distance: p.f32("bake_max_distance", DEFAULT_BAKE_MAX_DISTANCE)?,
+            vertex_stride: p.u32("bake_vertex_stride", DEFAULT_BAKE_VERTEX_STRIDE)?,
+            occluder_stride: p.u32("bake_occluder_stride", DEFAULT_BAKE_OCCLUDER_STRIDE)?,
+            ..BakeSettings::default()
+        };
+        if let Err(e) = bake.check() {
+            return Err(err("bake", e.to_string()));
+        }
         Ok(Self {
             lobes: Lobes {
                 r: p.f32("r_scale", 1.0)?,
@@ -114,6 +141,7 @@ impl ShadeParams {
             resolution: resolution(KIND, v)?,
             march_steps,
             ambient: p.f32("ambient", 0.05)?,
+            bake,
         })
     }
 }
@@ -154,6 +182,7 @@ impl PassDef for Shade {
             Binding::read("segment_visibility"),
             Binding::read("clip_positions"),
             Binding::read("density_grid"),
+            Binding::read("groom.shadow_sh"),
             Binding::write("vertex_lighting"),
         ];
         Some(BINDINGS)
@@ -233,6 +262,7 @@ impl ShadeKernel {
         scene: &Scene,
         lights: &[LightData],
         grid: &Words<'_>,
+        sh: [f32; 4],
         model: usize,
         p: Vec3,
         t: Vec3,
@@ -259,7 +289,12 @@ impl ShadeKernel {
                     let n = march(grid, base, &g, p, to_light, dist, k.march_steps);
                     (-k.absorption * n).exp()
                 }
-                SelfShadow::None | SelfShadow::Baked => 1.0,
+                // Kulikov: "numScatterEvents = max(0, ProjectL1SH(visSH,
+                // lightDirection)); visibility = exp(-absorption * numScatterEvents)".
+                SelfShadow::Baked => {
+                    strandgraph_bake::sh::visibility_towards(&sh, to_light.to_array(), k.absorption)
+                }
+                SelfShadow::None => 1.0,
             };
             let radiance = Vec3::from_slice(&l.radiance[..3]) * falloff;
             out +=
@@ -273,13 +308,23 @@ impl CpuKernel for ShadeKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
         let lods = scene.lods(ctx);
-        let (list, bits, clip, grid, out) = (
+        let (list, bits, clip, grid, sh_words, out) = (
             ctx.words("shading_segments"),
             ctx.words("segment_visibility"),
             ctx.words("clip_positions"),
             ctx.words("density_grid"),
+            ctx.words("groom.shadow_sh"),
             ctx.words("vertex_lighting"),
         );
+        // The vertex's baked SH (4 words); only loaded when it is read.
+        let baked = self.0.self_shadow == SelfShadow::Baked;
+        let sh = |v: u32| -> [f32; 4] {
+            if baked {
+                std::array::from_fn(|i| f32::from_bits(sh_words.load(4 * v as usize + i)))
+            } else {
+                [0.0; 4]
+            }
+        };
         let lw = ctx.words("lights");
         let lights: Vec<LightData> = (0..(scene.frame.light_count as usize).min(lw.len() / 16))
             .map(|i| read(&lw, i))
@@ -295,13 +340,13 @@ impl CpuKernel for ShadeKernel {
             let (p0, p1) = (world(seg.v0), world(seg.v1));
             // Towards the root (Karis's convention).
             let t = (p0 - p1).normalize_or(Vec3::Y);
-            let c0 = self.shade_vertex(&scene, &lights, &grid, seg.model, p0, t);
+            let c0 = self.shade_vertex(&scene, &lights, &grid, sh(seg.v0), seg.model, p0, t);
             store_rgba16f(&out, seg.v0 as usize, [c0.x, c0.y, c0.z, 1.0]);
             let per = scene.models[seg.model].points_per_strand - 1;
             let last = seg.local % per + 1 >= lods[seg.model].segments_per_strand;
             let next = id + 1;
             if last || bits.load((next / 32) as usize) & (1 << (next % 32)) == 0 {
-                let c1 = self.shade_vertex(&scene, &lights, &grid, seg.model, p1, t);
+                let c1 = self.shade_vertex(&scene, &lights, &grid, sh(seg.v1), seg.model, p1, t);
                 store_rgba16f(&out, seg.v1 as usize, [c1.x, c1.y, c1.z, 1.0]);
             }
         }

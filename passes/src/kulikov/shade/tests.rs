@@ -1,5 +1,6 @@
 //! Shading on hand-made strands: only visible segments' vertices are shaded,
-//! the voxel march darkens what lies behind dense hair, Baked is refused.
+//! the voxel march darkens what lies behind dense hair, the baked SH darkens
+//! towards the directions it counts scattering events in.
 
 use super::*;
 use crate::kulikov::ModelLod;
@@ -81,6 +82,7 @@ fn harness(strands: u32, hidden: &[u32]) -> (Harness, Vec<u32>) {
         .buffer("clip_positions", clip)
         .buffer("groom.vertices", verts)
         .buffer("density_grid", vec![0; GRID_WORDS as usize])
+        .buffer("groom.shadow_sh", vec![0; (4 * strands * POINTS) as usize])
         .buffer(
             "vertex_lighting",
             vec![u32::MAX; (2 * strands * POINTS) as usize],
@@ -149,14 +151,60 @@ fn voxel_march_darkens_hair_behind_dense_hair() {
     assert!(none[2][0] > 10.0 * shadowed[2][0]);
 }
 
+/// Kulikov's fetch: visibility = exp(−absorption · max(0, SH · light)).
+/// The light is at +z: an SH that counts events towards +z darkens by
+/// exactly that factor, one that counts them away from it (or the biased
+/// "all missed" SH) leaves the shading as unshadowed.
 #[test]
-fn baked_self_shadowing_names_the_missing_bake() {
-    let e = ShadeParams::from_ron(&ron::from_str(r#"{"self_shadow": "Baked"}"#).unwrap())
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("groom.shadow_sh") && e.contains("self_shadow"),
-        "{e}"
+fn baked_sh_shadows_towards_the_light_only() {
+    let (mut hs, _) = harness(2, &[]);
+    let n = (2 * POINTS) as usize;
+    let params = r#"{"self_shadow": "Baked", "ambient": 0.0, "absorption": 0.5}"#;
+    let none = shade(&hs, r#"{"self_shadow": "None", "ambient": 0.0}"#);
+    let sh_of = |z: f32, c0: f32| -> Vec<u32> {
+        (0..n)
+            .flat_map(|_| [c0, 0.0, z, 0.0].map(f32::to_bits))
+            .collect()
+    };
+    // Two events towards +z (and -2 towards -z): Y1 * c = 2.
+    let c = 2.0 / strandgraph_bake::sh::Y1;
+    hs.buffer("groom.shadow_sh", sh_of(c, 0.0));
+    let towards = shade(&hs, params);
+    hs.buffer("groom.shadow_sh", sh_of(-c, 0.0));
+    let away = shade(&hs, params);
+    // Every ray missed: the zero-event bias, -5 everywhere.
+    hs.buffer(
+        "groom.shadow_sh",
+        sh_of(0.0, -5.0 / strandgraph_bake::sh::Y0),
     );
-    assert!(ShadeParams::from_ron(&ron::from_str(r#"{"self_shadow": "Soft"}"#).unwrap()).is_err());
+    let open = shade(&hs, params);
+    let k = (-0.5f32 * 2.0).exp();
+    for v in 0..n {
+        assert_eq!(away[v], none[v], "vertex {v}");
+        assert_eq!(open[v], none[v], "vertex {v}");
+        // Karis's scatter fake also tints by pow(colour / luma, 1 − k), so
+        // the red channel is scaled by k within that tint.
+        assert!(
+            towards[v][0] < none[v][0] * k * 1.3 && towards[v][0] > none[v][0] * k * 0.7,
+            "vertex {v}: {:?} vs {:?} (k = {k})",
+            towards[v],
+            none[v]
+        );
+    }
+}
+
+#[test]
+fn bake_settings_are_checked() {
+    let p = |s: &str| ShadeParams::from_ron(&ron::from_str(s).unwrap());
+    let ok = p(r#"{"self_shadow": "Baked", "bake_rays": 8}"#).unwrap();
+    assert_eq!(ok.self_shadow, SelfShadow::Baked);
+    assert_eq!(ok.bake.rays, 8);
+    for bad in [
+        r#"{"bake_rays": 0}"#,
+        r#"{"bake_vertex_stride": 0}"#,
+        r#"{"max_scatter_events": -1.0}"#,
+        r#"{"self_shadow": "Soft"}"#,
+    ] {
+        assert!(p(bad).is_err(), "{bad}");
+    }
 }
