@@ -92,3 +92,34 @@ fn a_clear_pass_writes_its_value() {
     }
     assert_eq!(session.read("no such resource").unwrap(), None);
 }
+
+/// 64-bit atomicMin (the roofline's `bench.atomic_min64`) needs
+/// shaderInt64 and shaderBufferInt64Atomics and the Int64/Int64Atomics
+/// SPIR-V capabilities, enabled only because that pass needs them.
+#[test]
+fn int64_atomics_are_enabled_for_the_pass_that_needs_them() {
+    let plan = compile_file(&root().join("scenes/graphs/roofline.ron"), &Registry).unwrap();
+    let q = strandgraph_graph::Quantities {
+        width: 64,
+        height: 32,
+        ..Default::default()
+    };
+    let instance = plan.instantiate(&q).unwrap();
+    let mut session = validated()
+        .open(&plan, &instance)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let features = &session.notes[0];
+    assert!(
+        features.contains("shaderBufferInt64Atomics") && features.contains("shaderInt64"),
+        "{features}"
+    );
+    session
+        .run(&Default::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let words = session.read("atomics_u64").unwrap().unwrap();
+    assert_eq!(words.len(), 64 * 32 * 2);
+    assert!(
+        words.chunks(2).any(|w| w != [u32::MAX, u32::MAX]),
+        "some atomicMin landed"
+    );
+}
