@@ -103,7 +103,12 @@ pub static KINDS: &[PassKind] = &[
     ),
     kind(
         "kulikov.store_history",
-        "compress this frame's post-transform positions for next frame's motion vectors",
+        "compress this frame's post-transform NDC (clamped UNORM16 x, y) for next frame's motion vectors",
+        "Kulikov 2025, 'Motion vectors'",
+    ),
+    kind(
+        "kulikov.motion",
+        "per-vertex screen motion from last frame's compressed NDC (none where either frame skipped the vertex)",
         "Kulikov 2025, 'Motion vectors'",
     ),
     // Lipp et al., deferred software rasterization of hair meshes.

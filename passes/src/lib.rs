@@ -44,6 +44,8 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::shade_sort::ShadeSort,
     &kulikov::shade::Shade,
     &kulikov::compose::Compose,
+    &kulikov::history::Motion,
+    &kulikov::history::StoreHistory,
     &bench::AtomicMin32,
     &bench::AtomicMin64,
     &bench::Copy,

@@ -6,6 +6,7 @@ pub mod compose;
 pub mod cull;
 pub mod debug_resolve;
 pub mod density;
+pub mod history;
 pub mod hiz;
 pub mod lod;
 pub mod payload;

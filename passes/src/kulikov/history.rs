@@ -1,0 +1,218 @@
+//! Motion vectors from the post-transform cache (Kulikov, "Motion vectors"):
+//! "Compress post-transform NDC from current frame; use as last frame
+//! positions in the next frame; assume no movement if vertex wasn't
+//! transformed last frame (LOD change); clamped UNORM16 for x and y."
+//!
+//! - `kulikov.motion` reads last frame's compressed NDC (the History buffer
+//!   `prev_clip_positions`: the graph compiler makes this frame's writer wait
+//!   for it) and this frame's `clip_positions`, and writes each vertex's
+//!   screen motion in pixels (now − previous, y down) to `vertex_motion`.
+//! - `kulikov.store_history` compresses this frame's NDC into
+//!   `prev_clip_positions` for the next frame.
+//!
+//! A vertex was transformed this frame when its clip w is in front of the
+//! near plane: the graph clears `clip_positions` before skinning, so a
+//! vertex the LOD skipped reads w = 0.
+
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, count};
+use crate::layout::{FrameData, read};
+use crate::sim::Ctx;
+use strandgraph_graph::Quantities;
+use strandgraph_graph::schema::Quantity;
+
+const GROUP: u32 = 256;
+/// Largest UNORM16 code used for NDC; the one above marks "not transformed".
+const UNORM_MAX: f32 = 65534.0;
+/// `prev_clip_positions` of a vertex that was not transformed.
+pub const NOT_TRANSFORMED: u32 = u32::MAX;
+
+/// NDC in [−1, 1] (clamped) to the UNORM16 code, and back.
+pub fn compress(ndc: f32) -> u32 {
+    ((ndc.clamp(-1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX).round() as u32
+}
+pub fn decompress(code: u32) -> f32 {
+    code as f32 / UNORM_MAX * 2.0 - 1.0
+}
+
+/// The packed history word of clip position `c`.
+pub fn pack(c: [f32; 4], near: f32) -> u32 {
+    if !(c[3] > near) {
+        return NOT_TRANSFORMED;
+    }
+    compress(c[0] / c[3]) | compress(c[1] / c[3]) << 16
+}
+
+/// Screen motion in pixels (y down) from a history word to clip position
+/// `c`; zero where either frame did not transform the vertex.
+pub fn motion(prev: u32, c: [f32; 4], near: f32, width: f32, height: f32) -> [f32; 2] {
+    if prev == NOT_TRANSFORMED || !(c[3] > near) {
+        return [0.0, 0.0];
+    }
+    let (px, py) = (decompress(prev & 0xFFFF), decompress(prev >> 16));
+    let (nx, ny) = (c[0] / c[3], c[1] / c[3]);
+    [(nx - px) * 0.5 * width, (py - ny) * 0.5 * height]
+}
+
+fn per_vertex() -> Dispatch {
+    Dispatch::PerElement {
+        quantity: Quantity::Vertices,
+        per_group: GROUP,
+    }
+}
+
+/// `HistoryParams`: vertex count, three pad words.
+fn params(kind: &'static str, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
+    Params::new(kind, params)?;
+    Ok(vec![count(q.vertices), 0, 0, 0])
+}
+
+pub struct StoreHistory;
+
+impl PassDef for StoreHistory {
+    fn kind(&self) -> &'static str {
+        "kulikov.store_history"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        const B: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("clip_positions"),
+            Binding::write("prev_clip_positions"),
+        ];
+        Some(B)
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        per_vertex()
+    }
+    fn shader(&self) -> Shader {
+        Shader::compute("kulikov/history.wgsl", "store_history")
+    }
+    fn cpu_kernel(&self, p: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Params::new(self.kind(), p)?;
+        Ok(Box::new(StoreKernel))
+    }
+    fn gpu_params(&self, p: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
+        params(self.kind(), p, q)
+    }
+}
+
+/// The vertices of workgroup `group` (clamped to the vertex count).
+fn vertices(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<usize> {
+    let n = ctx.quantities.vertices as usize;
+    let start = (group * GROUP) as usize;
+    start.min(n)..(start + GROUP as usize).min(n)
+}
+
+struct StoreKernel;
+
+impl CpuKernel for StoreKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let frame: FrameData = read(&ctx.words("frame"), 0);
+        let (clip, out) = (
+            ctx.words("clip_positions"),
+            ctx.words("prev_clip_positions"),
+        );
+        for v in vertices(group, ctx) {
+            out.store(v, pack(clip.load_vec4(v), frame.near));
+        }
+    }
+}
+
+pub struct Motion;
+
+impl PassDef for Motion {
+    fn kind(&self) -> &'static str {
+        "kulikov.motion"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        const B: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("clip_positions"),
+            Binding::read("prev_clip_positions"),
+            Binding::write("vertex_motion"),
+        ];
+        Some(B)
+    }
+    fn workgroup_size(&self) -> u32 {
+        GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        per_vertex()
+    }
+    fn shader(&self) -> Shader {
+        Shader::compute("kulikov/history.wgsl", "motion")
+    }
+    fn cpu_kernel(&self, p: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Params::new(self.kind(), p)?;
+        Ok(Box::new(MotionKernel))
+    }
+    fn gpu_params(&self, p: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
+        params(self.kind(), p, q)
+    }
+}
+
+struct MotionKernel;
+
+impl CpuKernel for MotionKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let f: FrameData = read(&ctx.words("frame"), 0);
+        let (clip, prev, out) = (
+            ctx.words("clip_positions"),
+            ctx.words("prev_clip_positions"),
+            ctx.words("vertex_motion"),
+        );
+        for v in vertices(group, ctx) {
+            let m = motion(
+                prev.load(v),
+                clip.load_vec4(v),
+                f.near,
+                f.screen[0],
+                f.screen[1],
+            );
+            out.store(2 * v, m[0].to_bits());
+            out.store(2 * v + 1, m[1].to_bits());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn compression_keeps_sub_pixel_precision_and_clamps() {
+        for ndc in [-1.0, -0.3721, 0.0, 0.5, 0.99999] {
+            // 2 / 65534 NDC: 0.03 px across a 1920-pixel screen.
+            assert!((decompress(compress(ndc)) - ndc).abs() <= 1.0 / UNORM_MAX);
+        }
+        assert_eq!(compress(3.0), compress(1.0));
+        assert_eq!(compress(1.0), 65534);
+        assert_ne!(pack([1.0, 1.0, 0.0, 1.0], 0.02), NOT_TRANSFORMED);
+    }
+
+    #[test]
+    fn untransformed_vertices_have_no_motion() {
+        let c = [0.2, -0.1, 0.5, 2.0];
+        assert_eq!(pack([0.0; 4], 0.02), NOT_TRANSFORMED);
+        assert_eq!(motion(NOT_TRANSFORMED, c, 0.02, 100.0, 100.0), [0.0, 0.0]);
+        assert_eq!(
+            motion(pack(c, 0.02), [0.0; 4], 0.02, 100.0, 100.0),
+            [0.0, 0.0]
+        );
+        // Same position both frames: (quantisation-level) zero motion.
+        let m = motion(pack(c, 0.02), c, 0.02, 1920.0, 1080.0);
+        assert!(m[0].abs() < 0.02 && m[1].abs() < 0.02, "{m:?}");
+    }
+
+    #[test]
+    fn motion_is_in_pixels_with_y_down() {
+        let (a, b) = ([0.0, 0.0, 0.5, 1.0], [0.1, 0.1, 0.5, 1.0]);
+        let m = motion(pack(a, 0.02), b, 0.02, 1000.0, 500.0);
+        assert!(
+            (m[0] - 50.0).abs() < 0.05 && (m[1] + 25.0).abs() < 0.05,
+            "{m:?}"
+        );
+    }
+}

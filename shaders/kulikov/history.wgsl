@@ -1,0 +1,70 @@
+// kulikov.store_history and kulikov.motion: motion vectors from the
+// post-transform cache (Kulikov, "Motion vectors"). CPU kernels:
+// passes/src/kulikov/history.rs, which documents the packing.
+//
+// Bindings (group 0): 0 = HistoryParams, then the pass's bindings() in
+// order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions.
+// motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions, 4 = vertex_motion.
+#import strandgraph::layout::FrameData
+
+struct HistoryParams {
+    vertices: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+const UNORM_MAX: f32 = 65534.0;
+const NOT_TRANSFORMED: u32 = 0xFFFFFFFFu;
+
+@group(0) @binding(0) var<uniform> params: HistoryParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> clip_positions: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> store_history_prev_clip_positions: array<u32>;
+@group(0) @binding(3) var<storage, read> motion_prev_clip_positions: array<u32>;
+@group(0) @binding(4) var<storage, read_write> vertex_motion: array<vec2<f32>>;
+
+// Rust's f32::round: halves away from zero.
+fn round_away(x: f32) -> f32 {
+    let t = trunc(x);
+    return select(t, t + sign(x), abs(x - t) >= 0.5);
+}
+
+fn compress(ndc: f32) -> u32 {
+    return u32(round_away((clamp(ndc, -1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX));
+}
+
+fn decompress(code: u32) -> f32 {
+    return f32(code) / UNORM_MAX * 2.0 - 1.0;
+}
+
+@compute @workgroup_size(256)
+fn store_history(@builtin(global_invocation_id) id: vec3<u32>) {
+    let v = id.x;
+    if v >= params.vertices {
+        return;
+    }
+    let c = clip_positions[v];
+    var packed = NOT_TRANSFORMED;
+    if c.w > frame.near {
+        packed = compress(c.x / c.w) | (compress(c.y / c.w) << 16u);
+    }
+    store_history_prev_clip_positions[v] = packed;
+}
+
+@compute @workgroup_size(256)
+fn motion(@builtin(global_invocation_id) id: vec3<u32>) {
+    let v = id.x;
+    if v >= params.vertices {
+        return;
+    }
+    let c = clip_positions[v];
+    let prev = motion_prev_clip_positions[v];
+    var m = vec2<f32>(0.0);
+    if prev != NOT_TRANSFORMED && c.w > frame.near {
+        let p = vec2<f32>(decompress(prev & 0xFFFFu), decompress(prev >> 16u));
+        let n = vec2<f32>(c.x / c.w, c.y / c.w);
+        m = vec2<f32>((n.x - p.x) * 0.5 * frame.screen.x, (p.y - n.y) * 0.5 * frame.screen.y);
+    }
+    vertex_motion[v] = m;
+}
