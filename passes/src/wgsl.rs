@@ -160,10 +160,20 @@ impl Shaders {
     pub fn compose(&mut self, file: &str) -> Result<Composed, String> {
         let module = self.module(file)?;
         validate(&module, all_capabilities()).map_err(|e| format!("{file}: {e}"))?;
-        let needs = CAPABILITIES
+        let mut needs = CAPABILITIES
             .iter()
             .filter(|cap| validate(&module, all_capabilities() - **cap).is_err())
             .fold(Capabilities::empty(), |c, cap| c | *cap);
+        // Either int64-atomic tier allows `atomic<u64>`, so dropping one at
+        // a time never fails: ask for the smaller tier that suffices.
+        let (min_max, all_ops) = (
+            Capabilities::SHADER_INT64_ATOMIC_MIN_MAX,
+            Capabilities::SHADER_INT64_ATOMIC_ALL_OPS,
+        );
+        if validate(&module, all_capabilities() - min_max - all_ops).is_err() {
+            let enough = validate(&module, all_capabilities() - all_ops).is_ok();
+            needs |= if enough { min_max } else { all_ops };
+        }
         Ok(Composed { module, needs })
     }
 }
@@ -189,6 +199,20 @@ mod tests {
         // The LOD's proportional reduction is done in f64, like the CPU kernel.
         let lod = shaders.compose("kulikov/lod.wgsl").unwrap();
         assert!(lod.needs.contains(Capabilities::FLOAT64), "{:?}", lod.needs);
+        // atomicMin on atomic<u64> with the result unused: the smaller tier.
+        let min64 = shaders.compose("bench/atomic_min64.wgsl").unwrap();
+        assert!(
+            min64
+                .needs
+                .contains(Capabilities::SHADER_INT64_ATOMIC_MIN_MAX | Capabilities::SHADER_INT64),
+            "{:?}",
+            min64.needs
+        );
+        assert!(
+            !min64
+                .needs
+                .contains(Capabilities::SHADER_INT64_ATOMIC_ALL_OPS)
+        );
     }
 
     #[test]

@@ -50,6 +50,10 @@ pub(crate) struct Gpu {
     pub enabled: Vec<String>,
     /// SPIR-V capabilities the enabled features allow.
     pub spirv_caps: Vec<naga::back::spv::Capability>,
+    /// `shaderZeroInitializeWorkgroupMemory` is enabled: WGSL's zeroed
+    /// workgroup memory is the driver's job (as wgpu-hal does on 1.3),
+    /// not a loop naga adds to every shader.
+    pub zero_init_native: bool,
 }
 
 unsafe extern "system" fn on_message(
@@ -160,7 +164,17 @@ impl Gpu {
         };
         let gpu = Self::with_device(backend, needs, &entry, &mut partial)?;
         let (instance, debug) = (partial.instance.take(), partial.debug.take());
-        let (physical, device, props, memory_props, queues, subgroup, enabled, spirv_caps) = gpu;
+        let (
+            physical,
+            device,
+            props,
+            memory_props,
+            queues,
+            subgroup,
+            enabled,
+            spirv_caps,
+            zero_init_native,
+        ) = gpu;
         Ok(Gpu {
             _entry: entry,
             instance: instance.expect("instance kept until the device exists"),
@@ -175,6 +189,7 @@ impl Gpu {
             subgroup_size: subgroup.subgroup_size,
             enabled,
             spirv_caps,
+            zero_init_native,
         })
     }
 
@@ -194,6 +209,7 @@ impl Gpu {
             vk::PhysicalDeviceSubgroupProperties<'static>,
             Vec<String>,
             Vec<naga::back::spv::Capability>,
+            bool,
         ),
         AshError,
     > {
@@ -244,6 +260,7 @@ impl Gpu {
             (f12.timeline_semaphore, f12.shader_buffer_int64_atomics),
             (f13.synchronization2, f13.dynamic_rendering),
         );
+        let zero_init_native = f13.shader_zero_initialize_workgroup_memory == vk::TRUE;
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         // SAFETY: as above.
@@ -275,9 +292,14 @@ impl Gpu {
             ));
         }
         let mut enabled = vec!["synchronization2".to_string(), "timelineSemaphore".into()];
+        if zero_init_native {
+            enabled.push("shaderZeroInitializeWorkgroupMemory".into());
+        }
         let mut want_core = vk::PhysicalDeviceFeatures::default();
         let mut want12 = vk::PhysicalDeviceVulkan12Features::default().timeline_semaphore(true);
-        let mut want13 = vk::PhysicalDeviceVulkan13Features::default().synchronization2(true);
+        let mut want13 = vk::PhysicalDeviceVulkan13Features::default()
+            .synchronization2(true)
+            .shader_zero_initialize_workgroup_memory(zero_init_native);
         use naga::back::spv::Capability as C;
         let mut spirv_caps = vec![
             C::Shader,
@@ -440,6 +462,7 @@ impl Gpu {
             subgroup,
             enabled,
             spirv_caps,
+            zero_init_native,
         ))
     }
 

@@ -24,6 +24,26 @@
 //! runs it; [`Session::read`] reads any resource back. Validation
 //! ([`Validation::Sync`]) collects every message of the Khronos layer,
 //! synchronization validation included, and fails the run with them.
+//!
+//! ## What it does not do (yet)
+//! - **Queue-family ownership transfers**: with two families every resource
+//!   is `VK_SHARING_MODE_CONCURRENT` (memory.rs says why).
+//! - **Narrow semaphore waits**: cross-queue waits use `ALL_COMMANDS`,
+//!   because the plan's happens-before chains continue through lane order
+//!   after the wait; only the plan's sync points wait at all.
+//! - **Frames in flight**: each [`Session::run`] waits on the host for its
+//!   frame (with [`AshBackend::timeout`]) before returning.
+//! - **Workgroup counts of aliased indirect arguments**: the frame's end has
+//!   reused their bytes, so [`PassTiming::workgroups`] is `None` there.
+//! - **Raster passes on the compute queue** are refused (a raster pass must
+//!   be on the Graphics lane).
+//! - **`VK_EXT_layer_settings`**: Debian 12's layer (1.3.239) predates it, so
+//!   synchronization validation is enabled through `VK_EXT_validation_features`.
+//! - **Pipeline cache, subgroup size control, robustness2**: none; bounds
+//!   checks are naga's `Restrict` policy (as wgpu-hal without robustness2).
+//! - Concurrent reads of one image in different layouts (a depth image
+//!   sampled on one queue and depth-tested on the other) share one layout
+//!   that serves all of them (barriers.rs), not the plan's per-pass layouts.
 
 mod barriers;
 mod device;

@@ -151,6 +151,7 @@ fn build_into(
             &prep.composed,
             &entries,
             &gpu.spirv_caps,
+            gpu.zero_init_native,
             &pass.name,
             &gpu.name,
         )?;

@@ -26,6 +26,7 @@ pub(crate) fn translate(
     composed: &Composed,
     entries: &[&str],
     caps: &[spv::Capability],
+    zero_init_native: bool,
     pass: &str,
     device: &str,
 ) -> Result<Spirv, AshError> {
@@ -88,8 +89,13 @@ pub(crate) fn translate(
             image_load: naga::proc::BoundsCheckPolicy::Restrict,
             binding_array: naga::proc::BoundsCheckPolicy::Unchecked,
         },
-        // WGSL zero-initialises workgroup memory.
-        zero_initialize_workgroup_memory: spv::ZeroInitializeWorkgroupMemoryMode::Polyfill,
+        // WGSL zero-initialises workgroup memory: by the driver where
+        // shaderZeroInitializeWorkgroupMemory is enabled, else by naga.
+        zero_initialize_workgroup_memory: if zero_init_native {
+            spv::ZeroInitializeWorkgroupMemoryMode::Native
+        } else {
+            spv::ZeroInitializeWorkgroupMemoryMode::Polyfill
+        },
         ..Default::default()
     };
     let words = spv::write_vec(module, &info, &options, None).map_err(|e| match e {
@@ -170,6 +176,7 @@ mod tests {
             &composed,
             &[&entry],
             &[spv::Capability::Shader],
+            false,
             "clear",
             "test",
         )
@@ -194,6 +201,7 @@ mod tests {
             &composed,
             &[&entry],
             &[spv::Capability::Shader],
+            false,
             "lod",
             "test",
         )
