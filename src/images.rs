@@ -94,7 +94,9 @@ pub fn depth_to_view(
         .iter()
         .flat_map(|&w| {
             let z = f32::from_bits(w).clamp(0.0, 1.0);
-            let d = near * far / (far - z * (far - near));
+            // Written as a blend rather than `far - z * (far - near)`: the
+            // subtraction cancels catastrophically near z = 1 in f32.
+            let d = near * far / (far * (1.0 - z) + near * z);
             [d, d, d]
         })
         .collect();

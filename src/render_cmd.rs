@@ -4,7 +4,7 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, override_param, parse_size, prepare};
-use strandgraph::images::to_picture;
+use strandgraph::images::{depth_to_view, to_linear, to_picture};
 use strandgraph_cpu::{CpuBackend, PassTiming};
 use strandgraph_graph::Plan;
 use strandgraph_wgpu::WgpuBackend;
@@ -23,9 +23,13 @@ pub struct Args {
     pub scene: PathBuf,
     #[arg(long, value_enum, default_value = "cpu")]
     pub backend: Backend,
-    /// Where to write the main image (PNG); other image outputs go beside it.
+    /// Where to write the main image: PNG (sRGB), or linear EXR when the
+    /// name ends in `.exr`; other image outputs go beside it.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Also write the view depth (metres, EXR) of `scene.depth` here.
+    #[arg(long, value_name = "FILE.exr")]
+    pub depth: Option<PathBuf>,
     /// Run this graph instead of the scene's (A/B-test pipelines on one scene).
     #[arg(long)]
     pub graph: Option<PathBuf>,
@@ -48,11 +52,6 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if args.backend == Backend::Ash {
-        return Err(miette::miette!(
-            "the ash backend is not built yet; use --backend cpu, wgpu or all"
-        ));
-    }
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let t0 = Instant::now();
     let mut p = prepare(&args.scene, args.graph.as_deref(), size)?;
@@ -86,21 +85,37 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         None
     };
+    // With several backends the CPU's files keep their names and the others
+    // are tagged: showcase.png, showcase.wgpu.png, showcase.ash.png.
     let gpu = if matches!(args.backend, Backend::Wgpu | Backend::All) {
-        // With --backend all the CPU images keep the main name.
-        let main = if cpu.is_some() {
-            main.with_extension("wgpu.png")
-        } else {
-            main.clone()
-        };
-        Some(run_wgpu(&p, &main)?)
+        let tag = |p: &Path| tagged(p, cpu.is_some().then_some("wgpu"));
+        let depth = args.depth.as_deref().map(tag);
+        Some(run_wgpu(&p, &tag(&main), depth.as_deref())?)
     } else {
         None
     };
-    if let (Some(cpu), Some(gpu)) = (&cpu, &gpu) {
+    let ash = if matches!(args.backend, Backend::Ash | Backend::All) {
+        let tag = |p: &Path| tagged(p, (cpu.is_some() || gpu.is_some()).then_some("ash"));
+        let depth = args.depth.as_deref().map(tag);
+        Some(run_ash(&args, &p, &tag(&main), depth.as_deref())?)
+    } else {
+        None
+    };
+    if let (Some(cpu), Some(gpu), Some(ash)) = (&cpu, &gpu, &ash) {
+        print_three_way(&p.plan, cpu, gpu, ash);
+    } else if let (Some(cpu), Some(gpu)) = (&cpu, &gpu) {
         print_side_by_side(&p.plan, cpu, gpu);
     }
     Ok(())
+}
+
+/// `path` with `.tag` before its extension (`a.png` → `a.wgpu.png`).
+fn tagged(path: &Path, tag: Option<&str>) -> PathBuf {
+    match (tag, path.extension().and_then(|e| e.to_str())) {
+        (Some(tag), Some(ext)) => path.with_extension(format!("{tag}.{ext}")),
+        (Some(tag), None) => path.with_extension(tag),
+        (None, _) => path.to_path_buf(),
+    }
 }
 
 fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
@@ -134,11 +149,17 @@ fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
     if oob > 0 {
         tracing::warn!(oob, "kernels accessed memory out of range");
     }
-    write_outputs(p, main, |name| Ok(frame.read(&p.plan, name)))?;
+    write_outputs(p, main, args.depth.as_deref(), |name| {
+        Ok(frame.read(&p.plan, name))
+    })?;
     Ok(frame.timings)
 }
 
-fn run_wgpu(p: &Prepared, main: &Path) -> Result<Vec<strandgraph_wgpu::PassTiming>> {
+fn run_wgpu(
+    p: &Prepared,
+    main: &Path,
+    depth: Option<&Path>,
+) -> Result<Vec<strandgraph_wgpu::PassTiming>> {
     let t1 = Instant::now();
     let frame = WgpuBackend::default()
         .execute(&p.plan, &p.instance, &p.upload)
@@ -164,14 +185,99 @@ fn run_wgpu(p: &Prepared, main: &Path) -> Result<Vec<strandgraph_wgpu::PassTimin
     for note in &frame.notes {
         println!("  {note}");
     }
-    write_outputs(p, main, |name| frame.read(&p.plan, name).into_diagnostic())?;
+    write_outputs(p, main, depth, |name| {
+        frame.read(&p.plan, name).into_diagnostic()
+    })?;
     Ok(frame.timings)
 }
 
-/// Writes every image output: the first to `main`, the others beside it.
+/// The ash backend: one frame on raw Vulkan (`STRANDGRAPH_VK_VALIDATION=1`
+/// runs it under the Khronos validation layer, `STRANDGRAPH_VK_DEVICE`
+/// picks a device by name).
+fn run_ash(
+    args: &Args,
+    p: &Prepared,
+    main: &Path,
+    depth: Option<&Path>,
+) -> Result<Vec<strandgraph_ash::PassTiming>> {
+    let backend = strandgraph_ash::AshBackend {
+        alias: !args.no_alias,
+        ..strandgraph_ash::AshBackend::default()
+    };
+    let t1 = Instant::now();
+    let (session, frame) = backend
+        .execute(&p.plan, &p.instance, &p.upload)
+        .into_diagnostic()?;
+    let wall = t1.elapsed().as_secs_f64() * 1e3;
+    print!(
+        "\n  {:<14} {:<16} {:<24} {:>6} {:>9} {:>10} {:>19}\n",
+        "queue", "pass", "kind", "family", "groups", "GPU ms", "span ms"
+    );
+    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for t in &frame.timings {
+        println!(
+            "  {:<14} {:<16} {:<24} {:>6} {:>9} {:>10} {:>19}",
+            t.queue.to_string(),
+            t.name,
+            p.plan.graph.passes[t.pass].kind,
+            t.family,
+            t.workgroups.map_or("-".to_string(), |n| n.to_string()),
+            show(t.millis),
+            t.span
+                .map_or("-".to_string(), |(a, b)| format!("{a:.3}..{b:.3}"))
+        );
+    }
+    let total: f64 = frame.timings.iter().filter_map(|t| t.millis).sum();
+    println!("  sum of passes {total:.3} ms (per-pass timestamps per queue)");
+    println!("ash backend: frame {wall:.1} ms wall, including device and pipeline creation");
+    for note in &session.notes {
+        println!("  {note}");
+    }
+    write_outputs(p, main, depth, |name| session.read(name).into_diagnostic())?;
+    Ok(frame.timings)
+}
+
+fn print_three_way(
+    plan: &Plan,
+    cpu: &[PassTiming],
+    gpu: &[strandgraph_wgpu::PassTiming],
+    ash: &[strandgraph_ash::PassTiming],
+) {
+    println!(
+        "\n  {:<16} {:<24} {:>14} {:>14} {:>14}",
+        "pass", "kind", "cpu wall ms", "wgpu GPU ms", "ash GPU ms"
+    );
+    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for &pass in &plan.order {
+        println!(
+            "  {:<16} {:<24} {:>14} {:>14} {:>14}",
+            plan.pass_name(pass),
+            plan.graph.passes[pass].kind,
+            show(cpu.iter().find(|t| t.pass == pass).map(|t| t.millis)),
+            show(gpu.iter().find(|t| t.pass == pass).map(|t| t.millis)),
+            show(ash.iter().find(|t| t.pass == pass).and_then(|t| t.millis)),
+        );
+    }
+    println!(
+        "  {:<16} {:<24} {:>14.3} {:>14.3} {:>14.3}",
+        "total",
+        "",
+        cpu.iter().map(|t| t.millis).sum::<f64>(),
+        gpu.iter().map(|t| t.millis).sum::<f64>(),
+        ash.iter().filter_map(|t| t.millis).sum::<f64>()
+    );
+}
+
+/// Writes every image output: the first to `main`, the others beside it;
+/// and the view depth to `depth` (EXR) when asked.
+/// The scene depth every graph keeps (all its versions share the memory, so
+/// this reads the last one: with hair depth after `kulikov.compose`).
+const DEPTH: &str = "scene.depth";
+
 fn write_outputs(
     p: &Prepared,
     main: &Path,
+    depth: Option<&Path>,
     read: impl Fn(&str) -> Result<Option<Vec<u32>>>,
 ) -> Result<()> {
     let q = p.upload.quantities;
@@ -181,19 +287,49 @@ fn write_outputs(
         let Some(words) = read(&name)? else {
             continue;
         };
-        let Some(img) = to_picture(&p.plan, r, &words, q.width, q.height) else {
-            continue;
-        };
+        // `-o NAME.exr`: linear float images; PNG (sRGB, 8 bit) otherwise.
+        let exr = main
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        let ext = if exr { "exr" } else { "png" };
         let path = if wrote_main {
-            main.with_extension(format!("{}.png", name.replace('.', "_")))
+            main.with_extension(format!("{}.{ext}", name.replace('.', "_")))
         } else {
             main.to_path_buf()
         };
-        img.save(&path)
+        let saved = match (exr, to_linear(&p.plan, r, &words, q.width, q.height)) {
+            (true, Some(img)) => img.save(&path),
+            _ => match to_picture(&p.plan, r, &words, q.width, q.height) {
+                Some(img) if !exr => img.save(&path),
+                Some(img) => img.save(path.with_extension("png")),
+                None => continue,
+            },
+        };
+        saved
             .into_diagnostic()
             .wrap_err_with(|| format!("writing {}", path.display()))?;
         println!("wrote {} ({name})", path.display());
         wrote_main = true;
+    }
+    if let Some(depth_path) = depth {
+        let (near, far) = p
+            .upload
+            .frame
+            .as_ref()
+            .map_or((0.02, 500.0), |f| (f.near, f.far));
+        let words = read(DEPTH)?.ok_or_else(|| {
+            miette::miette!("--depth: graph `{}` has no `{DEPTH}`", p.plan.graph.name)
+        })?;
+        let img = depth_to_view(&words, near, far, q.width, q.height).ok_or_else(|| {
+            miette::miette!("--depth: `{DEPTH}` is not a screen-sized depth image")
+        })?;
+        img.save(depth_path)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("writing {}", depth_path.display()))?;
+        println!(
+            "wrote {} (view depth in metres, from {DEPTH})",
+            depth_path.display()
+        );
     }
     if !wrote_main {
         return Err(miette::miette!(

@@ -145,6 +145,36 @@ fn render_command_writes_pngs_and_a_timing_table() {
     assert!(out.with_extension("debug_layers.png").exists());
 }
 
+/// `-o NAME.exr` writes linear float images and `--depth` the view depth.
+#[test]
+fn render_command_writes_linear_exr_and_depth() {
+    let dir = std::env::temp_dir().join(format!("strandgraph-exr-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, depth) = (dir.join("showcase.exr"), dir.join("depth.exr"));
+    let o = Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+        .current_dir(root())
+        .args(["render", "scenes/showcase.ron", "--graph"])
+        .args(["scenes/graphs/kulikov_visibility.ron", "--size", "160x90"])
+        .arg("-o")
+        .arg(&out)
+        .arg("--depth")
+        .arg(&depth)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(&out).unwrap().into_rgba32f();
+    assert_eq!(img.dimensions(), (160, 90));
+    // Linear, unclamped values: the lit head is brighter than the background.
+    let max = img.pixels().map(|p| p[0]).fold(0.0f32, f32::max);
+    assert!(max > 0.05, "brightest red {max}");
+    let d = image::open(&depth).unwrap().into_rgb32f();
+    let near = d.pixels().map(|p| p[0]).fold(f32::MAX, f32::min);
+    let far = d.pixels().map(|p| p[0]).fold(0.0f32, f32::max);
+    // The camera is ~0.9 m from the head; empty pixels read the far plane.
+    assert!((0.3..2.0).contains(&near), "nearest depth {near} m");
+    assert!(far > 100.0, "background depth {far} m");
+}
+
 #[test]
 fn render_rejects_a_bad_parameter_by_name() {
     let o = Command::new(env!("CARGO_BIN_EXE_strandgraph"))
