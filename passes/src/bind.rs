@@ -1,5 +1,7 @@
 //! Matching a graph pass's accesses to its kind's bindings, the same way on
 //! every backend: by resource name, in the order the definition lists them.
+//! A pass reading a version of a resource (`clip_positions.skinned`) binds
+//! it under the resource's name (`clip_positions`).
 
 use crate::contract::PassDef;
 use strandgraph_graph::resolve::{Access, Graph, PassId};
@@ -38,10 +40,17 @@ pub fn bind(def: &dyn PassDef, g: &Graph, p: PassId) -> Result<Vec<Bound>, Missi
         Some(wanted) => wanted
             .iter()
             .map(|b| {
+                // A version (`a -> a.next`) binds under its resource's name,
+                // so kernels need not know how the graph versions a resource.
+                let root = |a: &&Access| g.resources[g.physical(a.resource)].name == b.name;
                 pass.accesses
                     .iter()
                     .find(|a| g.resources[a.resource].name == b.name)
-                    .map(named)
+                    .or_else(|| pass.accesses.iter().find(root))
+                    .map(|a| Bound {
+                        name: b.name.to_string(),
+                        access: *a,
+                    })
                     .ok_or_else(|| MissingBinding {
                         pass: pass.name.clone(),
                         kind: pass.kind.clone(),
