@@ -30,3 +30,6 @@ cargo fmt --all -- --check
 cargo test --workspace --release --locked
 # Benches report, they do not assert; --quick keeps this to seconds.
 cargo bench --locked --bench graph_compile -- --quick
+# The Table-1 bench on every backend that opens here (cpu, and wgpu on
+# lavapipe): 320x180, 2 frames per cell; about a minute on 2 cores.
+cargo run --release --locked -- bench --quick --backend all

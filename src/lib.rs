@@ -5,3 +5,4 @@
 pub mod compare;
 pub mod frame;
 pub mod images;
+pub mod runner;

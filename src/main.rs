@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own module; `main` only parses arguments,
 //! sets up logging and turns errors into diagnostics with exit code 2.
 
+mod bench_cmd;
 mod graph_cmd;
 mod info;
 mod render_cmd;
@@ -25,6 +26,8 @@ enum Command {
     Info(info::Args),
     /// Render a scene on a backend to PNG and print per-pass times.
     Render(render_cmd::Args),
+    /// Time pipeline variants at close/mid/far views on backends, with a roofline (Lipp's Table 1).
+    Bench(bench_cmd::Args),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
         Command::Graph(args) => graph_cmd::run(args),
         Command::Info(args) => info::run(args),
         Command::Render(args) => render_cmd::run(args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

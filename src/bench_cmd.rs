@@ -1,0 +1,485 @@
+//! `strandgraph bench`: pipeline variants × views × backends, as Lipp's
+//! Table 1 (GPU frame time per configuration at close, mid and far
+//! distance, the raster time in parentheses), with a roofline measured on
+//! the same device in the same run.
+//!
+//! Rows are [`VARIANTS`]: a pipeline's graph plus parameter overrides (the
+//! published optimisations are pass parameters, so an ablation is an
+//! override, as `render --param`). Columns are the scenes given (by default
+//! `scenes/distances/{close,mid,far}.ron`), each prepared for the row's graph.
+
+mod report;
+
+use miette::{Result, miette};
+use report::{Ceilings, Cell, Report, Stats};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
+use strandgraph::runner::{Backend, CpuOptions, Runner};
+use strandgraph_assets::Scene;
+use strandgraph_passes::upload::Upload;
+use strandgraph_passes::{Definitions, Registry};
+
+/// One row of the table: a pipeline configuration.
+#[derive(Debug, Clone, Copy)]
+pub struct Variant {
+    pub pipeline: &'static str,
+    pub name: &'static str,
+    /// The graph, relative to the repository root.
+    pub graph: &'static str,
+    /// `PASS.PARAM=VALUE` overrides, as `render --param`.
+    pub overrides: &'static [&'static str],
+    /// The raster passes: their time goes in parentheses, their atomics are
+    /// compared with the roofline.
+    pub raster: &'static [&'static str],
+    /// The roofline pass whose rate is the raster's ceiling.
+    pub ceiling: &'static str,
+}
+
+const KULIKOV: &str = "scenes/graphs/kulikov.ron";
+
+/// The rows. Kulikov's ablations switch one published optimisation off at
+/// a time (passes/src/kulikov/raster/mod.rs, sort.rs). Lipp's rows run once
+/// its graph's passes have kernels; until then they are listed as skipped.
+pub const VARIANTS: &[Variant] = &[
+    Variant {
+        pipeline: "Kulikov",
+        name: "all optimisations",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no loop flattening",
+        graph: KULIKOV,
+        overrides: &["raster.loop_flattening=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no pixel request stack",
+        graph: KULIKOV,
+        // The depth-test stack is the second half of the same LDS machinery.
+        overrides: &[
+            "raster.pixel_request_stack=false",
+            "raster.depth_test_stack=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no sort",
+        graph: KULIKOV,
+        overrides: &["sort.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no last-layer cull",
+        graph: KULIKOV,
+        overrides: &["raster.last_layer_cull=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L (as published)",
+        graph: "scenes/graphs/lipp.ron",
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+];
+
+const VIEWS: [&str; 3] = [
+    "scenes/distances/close.ron",
+    "scenes/distances/mid.ron",
+    "scenes/distances/far.ron",
+];
+const ROOFLINE: &str = "scenes/graphs/roofline.ron";
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Choice {
+    Cpu,
+    Wgpu,
+    Ash,
+    /// cpu, and wgpu and ash where they open (a Vulkan device exists).
+    All,
+}
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scenes, one column each (default: scenes/distances/{close,mid,far}.ron).
+    pub scenes: Vec<PathBuf>,
+    /// Backends to time (repeatable, or comma-separated).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "cpu")]
+    pub backend: Vec<Choice>,
+    /// Timed frames per cell.
+    #[arg(long, default_value_t = 10)]
+    pub frames: usize,
+    /// Untimed frames per cell before the timed ones.
+    #[arg(long, default_value_t = 2)]
+    pub warmup: usize,
+    /// Resolution as WxH (default: each scene's, 1920x1080 for the views).
+    #[arg(long)]
+    pub size: Option<String>,
+    /// Only rows whose "pipeline: variant" contains this (repeatable).
+    #[arg(long = "row")]
+    pub rows: Vec<String>,
+    /// Write bench.csv, bench.json and bench.txt here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// CI smoke run: 320x180, 2 frames, no warm-up (unless given), VoxelMarch shadows.
+    #[arg(long)]
+    pub quick: bool,
+    /// Emulated subgroup width of the CPU backend (timed and counting runs).
+    #[arg(long, default_value_t = 32)]
+    pub subgroup: u32,
+}
+
+/// `rel` under the working directory, else under the checkout the binary
+/// was built from (the device machine runs from a copy of the tree).
+fn locate(rel: &str) -> PathBuf {
+    let here = PathBuf::from(rel);
+    if here.exists() {
+        return here;
+    }
+    let built = Path::new(env!("CARGO_MANIFEST_DIR")).join(rel);
+    if built.exists() { built } else { here }
+}
+
+/// The backends to time, in order; `all` takes wgpu only if it opens.
+fn backends(args: &Args) -> Vec<(Backend, bool)> {
+    let mut out: Vec<(Backend, bool)> = Vec::new();
+    let mut add = |b: Backend, required: bool| {
+        if !out.iter().any(|(x, _)| *x == b) {
+            out.push((b, required));
+        }
+    };
+    for c in &args.backend {
+        match c {
+            Choice::Cpu => add(Backend::Cpu, true),
+            Choice::Wgpu => add(Backend::Wgpu, true),
+            Choice::Ash => add(Backend::Ash, true),
+            Choice::All => {
+                add(Backend::Cpu, true);
+                add(Backend::Wgpu, false);
+                add(Backend::Ash, false);
+            }
+        }
+    }
+    out
+}
+
+/// Why `graph` cannot run yet: the first live pass kind without a definition.
+fn missing_kernel(graph: &Path) -> Result<Option<String>> {
+    let plan = strandgraph_graph::compile_file(graph, &Registry)?;
+    Ok(plan
+        .order
+        .iter()
+        .map(|&id| &plan.graph.passes[id])
+        .find(|pass| Registry.definition(&pass.kind).is_none())
+        .map(|pass| format!("pass `{}` ({}) has no kernels yet", pass.name, pass.kind)))
+}
+
+/// [`prepare`], with `--quick`'s graph-wide override applied before the
+/// self-shadow bake: quick runs shade with `VoxelMarch` self-shadowing, as
+/// the offline bake (`frame::bake_shadows`) takes minutes per groom on a
+/// 2-core CI machine and its cache is per machine. Full runs keep the
+/// graph's `Baked`, baked once and then read from the cache.
+fn prepare_graph(
+    scene_path: &Path,
+    graph: &Path,
+    size: Option<(u32, u32)>,
+    quick: bool,
+) -> Result<Prepared> {
+    if !quick {
+        return prepare(scene_path, Some(graph), size);
+    }
+    let scene = Scene::load(scene_path).map_err(|e| miette!("{e}"))?;
+    let (w, h) = size.unwrap_or(scene.desc.resolution);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(miette!("--size {w}x{h} is outside 1..=16384"));
+    }
+    let mut plan = strandgraph_graph::compile_file(graph, &Registry)?;
+    let shade: Vec<String> = plan
+        .graph
+        .passes
+        .iter()
+        .filter(|p| p.kind == "kulikov.shade")
+        .map(|p| p.name.clone())
+        .collect();
+    for name in shade {
+        override_param(&mut plan, &format!("{name}.{QUICK_SHADOW}"))?;
+    }
+    let mut upload = strandgraph_passes::upload::upload(&scene, w, h);
+    bake_shadows(&plan, &mut upload)?;
+    let instance = plan.instantiate(&upload.quantities)?;
+    Ok(Prepared {
+        scene,
+        upload,
+        plan,
+        instance,
+    })
+}
+
+/// What `--quick` sets on every `kulikov.shade` pass.
+const QUICK_SHADOW: &str = "self_shadow=\"VoxelMarch\"";
+
+pub fn run(mut args: Args) -> Result<()> {
+    if args.quick {
+        args.size.get_or_insert_with(|| "320x180".into());
+        if args.frames == 10 {
+            args.frames = 2;
+        }
+        if args.warmup == 2 {
+            args.warmup = 0;
+        }
+    }
+    if args.frames == 0 {
+        return Err(miette!("--frames must be at least 1"));
+    }
+    let size = args.size.as_deref().map(parse_size).transpose()?;
+    let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
+        VIEWS.iter().map(|v| locate(v)).collect()
+    } else {
+        args.scenes.clone()
+    };
+    let rows: Vec<&Variant> = VARIANTS
+        .iter()
+        .filter(|v| {
+            let label = format!("{}: {}", v.pipeline, v.name);
+            args.rows.is_empty() || args.rows.iter().any(|r| label.contains(r.as_str()))
+        })
+        .collect();
+    let cpu = CpuOptions {
+        subgroup_width: args.subgroup,
+        instrument: false,
+    };
+    let counting = CpuOptions {
+        instrument: true,
+        ..cpu
+    };
+    let t0 = Instant::now();
+    let mut report = Report::new(&args, &scenes);
+    if args.quick {
+        report.note(format!(
+            "--quick: every kulikov.shade pass runs with {QUICK_SHADOW} (no offline bake)"
+        ));
+    }
+
+    // Graphs whose passes lack kernels (Lipp, for now) are listed, not run.
+    let mut skipped: BTreeMap<&str, String> = BTreeMap::new();
+    for v in &rows {
+        if !skipped.contains_key(v.graph)
+            && let Some(why) = missing_kernel(&locate(v.graph))?
+        {
+            skipped.insert(v.graph, why);
+        }
+    }
+    // Each (scene, graph) is loaded and compiled once; rows clone its plan.
+    let mut prepared: BTreeMap<(usize, &str), Prepared> = BTreeMap::new();
+    for (s, scene) in scenes.iter().enumerate() {
+        for graph in rows.iter().map(|v| v.graph) {
+            if skipped.contains_key(graph) {
+                continue;
+            }
+            if let std::collections::btree_map::Entry::Vacant(e) = prepared.entry((s, graph)) {
+                tracing::info!(scene = %scene.display(), graph, "preparing");
+                e.insert(prepare_graph(scene, &locate(graph), size, args.quick)?);
+            }
+        }
+    }
+    let first = prepared
+        .values()
+        .next()
+        .ok_or_else(|| miette!("no runnable rows: {skipped:?}"))?;
+    // Raster atomics per (row, view), counted once for every backend.
+    let mut counts: BTreeMap<(usize, usize), u64> = BTreeMap::new();
+    'backends: for (backend, required) in backends(&args) {
+        // The roofline, on the first scene's screen size. A device that
+        // cannot run it (no 64-bit atomics) still gets its rows timed.
+        match roofline(backend, first, &args, cpu, counting) {
+            Ok(r) => {
+                report.device(backend, &r.device, &r.notes);
+                report.ceilings(backend, r.ceilings);
+            }
+            Err(e) => eprintln!("{}: no roofline: {e:?}", backend.name()),
+        }
+        for (r, v) in rows.iter().enumerate() {
+            for s in 0..scenes.len() {
+                if let Some(why) = skipped.get(v.graph) {
+                    report.cell(backend, v, s, Cell::Skipped(why.clone()));
+                    continue;
+                }
+                let p = &prepared[&(s, v.graph)];
+                eprintln!(
+                    "[{:>5.0} s] {} {}: {} / {}",
+                    t0.elapsed().as_secs_f64(),
+                    backend.name(),
+                    v.pipeline,
+                    v.name,
+                    report.views[s]
+                );
+                let atomics = match counts.get(&(r, s)) {
+                    Some(&n) => n,
+                    None => {
+                        let n = count_atomics(p, v, counting)?;
+                        counts.insert((r, s), n);
+                        n
+                    }
+                };
+                match measure(backend, p, v, &args, cpu, atomics) {
+                    Ok((device, notes, stats)) => {
+                        report.device(backend, &device, &notes);
+                        report.cell(backend, v, s, Cell::Measured(stats));
+                    }
+                    // `all` takes the backends that open here.
+                    Err(e) if !required && !report.has_device(backend) => {
+                        eprintln!("skipping {}: {e:?}", backend.name());
+                        continue 'backends;
+                    }
+                    Err(e) => return Err(e),
+                }
+            }
+        }
+    }
+    report.elapsed_s = t0.elapsed().as_secs_f64();
+    print!("{}", report.table());
+    if let Some(dir) = &args.out {
+        report.write(dir)?;
+        println!(
+            "wrote {0}/bench.txt, {0}/bench.csv, {0}/bench.json",
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+/// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
+/// and the frame times (CPU: wall time of the frame, its queues overlap;
+/// GPU: the sum of the passes' GPU times on wgpu's one queue).
+fn frames(
+    runner: &mut Runner,
+    plan: &strandgraph_graph::Plan,
+    upload: &Upload,
+    args: &Args,
+) -> Result<(Vec<Vec<strandgraph::runner::PassTime>>, Vec<f64>)> {
+    for _ in 0..args.warmup {
+        runner.run(plan, upload)?;
+    }
+    let mut passes = Vec::with_capacity(args.frames);
+    let mut totals = Vec::with_capacity(args.frames);
+    for _ in 0..args.frames {
+        let t = Instant::now();
+        let times = runner.run(plan, upload)?;
+        let wall = t.elapsed().as_secs_f64() * 1e3;
+        totals.push(match runner.backend() {
+            Backend::Cpu => wall,
+            _ => times.iter().map(|t| t.millis).sum(),
+        });
+        passes.push(times);
+    }
+    Ok((passes, totals))
+}
+
+/// `v`'s plan for one prepared scene: the graph with the row's overrides.
+fn variant_plan(p: &Prepared, v: &Variant) -> Result<strandgraph_graph::Plan> {
+    let mut plan = p.plan.clone();
+    for spec in v.overrides {
+        override_param(&mut plan, spec)?;
+    }
+    Ok(plan)
+}
+
+/// The raster passes' atomics in an instrumented CPU run of this
+/// configuration. GPUs expose no atomic counters, so GPU rows use this count.
+fn count_atomics(p: &Prepared, v: &Variant, counting: CpuOptions) -> Result<u64> {
+    let plan = variant_plan(p, v)?;
+    let mut counter = Runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
+    Ok(counter
+        .run(&plan, &p.upload)?
+        .iter()
+        .filter(|t| v.raster.contains(&t.name.as_str()))
+        .filter_map(|t| t.atomics)
+        .sum())
+}
+
+/// One cell's timed frames: the device, its notes, the statistics.
+fn measure(
+    backend: Backend,
+    p: &Prepared,
+    v: &Variant,
+    args: &Args,
+    cpu: CpuOptions,
+    atomics: u64,
+) -> Result<(String, Vec<String>, Stats)> {
+    let plan = variant_plan(p, v)?;
+    let mut runner = Runner::open(backend, &plan, &p.instance, cpu)?;
+    let (passes, totals) = frames(&mut runner, &plan, &p.upload, args)?;
+    let stats = Stats::new(&passes, &totals, v.raster, atomics);
+    Ok((runner.device(), runner.notes(), stats))
+}
+
+/// What the roofline run gives one backend.
+struct Roofline {
+    device: String,
+    notes: Vec<String>,
+    ceilings: Ceilings,
+}
+
+/// Runs `scenes/graphs/roofline.ron` at `first`'s screen size on `backend`.
+fn roofline(
+    backend: Backend,
+    first: &Prepared,
+    args: &Args,
+    cpu: CpuOptions,
+    counting: CpuOptions,
+) -> Result<Roofline> {
+    let plan = strandgraph_graph::compile_file(&locate(ROOFLINE), &Registry)?;
+    let instance = plan.instantiate(&first.upload.quantities)?;
+    let upload = Upload {
+        quantities: first.upload.quantities,
+        ..Default::default()
+    };
+    let mut counter = Runner::open(Backend::Cpu, &plan, &instance, counting)?;
+    let counted = counter.run(&plan, &upload)?;
+    let ops = |name: &str| {
+        counted
+            .iter()
+            .find(|t| t.name == name)
+            .and_then(|t| t.atomics)
+            .unwrap_or(0)
+    };
+    let (atomics32, atomics64) = (ops("atomic_min32"), ops("atomic_min64"));
+    drop(counter);
+
+    let mut runner = Runner::open(backend, &plan, &instance, cpu)?;
+    let (passes, _) = frames(&mut runner, &plan, &upload, args)?;
+    let median = |name: &str| {
+        let v: Vec<f64> = passes
+            .iter()
+            .filter_map(|f| f.iter().find(|t| t.name == name).map(|t| t.millis))
+            .collect();
+        report::median(&v)
+    };
+    let copy_bytes = plan
+        .graph
+        .resource_id("copy_dst")
+        .map_or(0, |r| instance.sizes[r].bytes);
+    Ok(Roofline {
+        device: runner.device(),
+        notes: runner.notes(),
+        ceilings: Ceilings {
+            atomic_min32: (atomics32, median("atomic_min32")),
+            atomic_min64: (atomics64, median("atomic_min64")),
+            copy: (copy_bytes, median("copy")),
+        },
+    })
+}

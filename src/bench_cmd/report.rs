@@ -1,0 +1,443 @@
+//! The bench's results: statistics per cell, the printed table (shaped as
+//! Lipp's Table 1), and the CSV and JSON files.
+
+use super::{Args, Variant};
+use miette::{IntoDiagnostic, Result, WrapErr};
+use serde_json::{Value, json};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use strandgraph::runner::{Backend, PassTime};
+
+/// Median of `v` (mean of the middle two for an even count); NaN if empty.
+pub fn median(v: &[f64]) -> f64 {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return f64::NAN;
+    }
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+/// Median, min and max over frames, in ms.
+#[derive(Debug, Clone, Copy)]
+pub struct Spread {
+    pub median: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+impl Spread {
+    fn of(v: &[f64]) -> Spread {
+        Spread {
+            median: median(v),
+            min: v.iter().copied().fold(f64::INFINITY, f64::min),
+            max: v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+    fn json(&self) -> Value {
+        json!({"median_ms": self.median, "min_ms": self.min, "max_ms": self.max})
+    }
+}
+
+/// One measured cell.
+#[derive(Debug, Clone)]
+pub struct Stats {
+    pub frames: usize,
+    pub total: Spread,
+    /// The raster passes' summed time per frame.
+    pub raster: Spread,
+    /// Per pass, in plan order: name, kind, spread over frames.
+    pub passes: Vec<(String, String, Spread)>,
+    /// Atomics of the raster passes, from the instrumented CPU run.
+    pub raster_atomics: u64,
+    /// Every frame's per-pass times (JSON only).
+    pub per_frame: Vec<Vec<f64>>,
+}
+
+impl Stats {
+    pub fn new(frames: &[Vec<PassTime>], totals: &[f64], raster: &[&str], atomics: u64) -> Stats {
+        let first = frames.first().map_or(&[][..], Vec::as_slice);
+        let passes = first
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let v: Vec<f64> = frames
+                    .iter()
+                    .filter_map(|f| f.get(i).map(|t| t.millis))
+                    .collect();
+                (t.name.clone(), t.kind.clone(), Spread::of(&v))
+            })
+            .collect();
+        let raster_ms: Vec<f64> = frames
+            .iter()
+            .map(|f| {
+                f.iter()
+                    .filter(|t| raster.contains(&t.name.as_str()))
+                    .map(|t| t.millis)
+                    .sum()
+            })
+            .collect();
+        Stats {
+            frames: frames.len(),
+            total: Spread::of(totals),
+            raster: Spread::of(&raster_ms),
+            passes,
+            raster_atomics: atomics,
+            per_frame: frames
+                .iter()
+                .map(|f| f.iter().map(|t| t.millis).collect())
+                .collect(),
+        }
+    }
+
+    /// Raster atomics per second.
+    fn atomic_rate(&self) -> f64 {
+        self.raster_atomics as f64 / (self.raster.median * 1e-3)
+    }
+}
+
+#[derive(Debug, Clone)]
+pub enum Cell {
+    Measured(Stats),
+    Skipped(String),
+}
+
+/// The roofline of one backend: (operations or bytes, median ms).
+#[derive(Debug, Clone, Copy)]
+pub struct Ceilings {
+    pub atomic_min32: (u64, f64),
+    pub atomic_min64: (u64, f64),
+    /// Bytes copied (each read once and written once).
+    pub copy: (u64, f64),
+}
+
+impl Ceilings {
+    /// Operations per second of the roofline pass `name`.
+    fn rate(&self, name: &str) -> Option<f64> {
+        let (n, ms) = match name {
+            "atomic_min32" => self.atomic_min32,
+            "atomic_min64" => self.atomic_min64,
+            _ => return None,
+        };
+        Some(n as f64 / (ms * 1e-3))
+    }
+}
+
+pub struct Report {
+    pub views: Vec<String>,
+    scenes: Vec<PathBuf>,
+    size: String,
+    frames: usize,
+    warmup: usize,
+    subgroup: u32,
+    devices: Vec<(Backend, String, Vec<String>)>,
+    ceilings: Vec<(Backend, Ceilings)>,
+    cells: Vec<(Backend, Variant, usize, Cell)>,
+    notes: Vec<String>,
+    pub elapsed_s: f64,
+}
+
+/// `close` from `scenes/distances/close.ron`.
+fn view_name(p: &Path) -> String {
+    p.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("scene")
+        .to_string()
+}
+
+fn rate(x: f64) -> String {
+    if !x.is_finite() {
+        "-".into()
+    } else if x >= 1e9 {
+        format!("{:.2} G", x / 1e9)
+    } else {
+        format!("{:.1} M", x / 1e6)
+    }
+}
+
+impl Report {
+    pub fn new(args: &Args, scenes: &[PathBuf]) -> Report {
+        Report {
+            views: scenes.iter().map(|s| view_name(s)).collect(),
+            scenes: scenes.to_vec(),
+            size: args
+                .size
+                .clone()
+                .unwrap_or_else(|| "scene resolution".into()),
+            frames: args.frames,
+            warmup: args.warmup,
+            subgroup: args.subgroup,
+            devices: Vec::new(),
+            ceilings: Vec::new(),
+            cells: Vec::new(),
+            notes: Vec::new(),
+            elapsed_s: 0.0,
+        }
+    }
+    /// A line printed under the table (and kept in the JSON).
+    pub fn note(&mut self, line: String) {
+        self.notes.push(line);
+    }
+    /// Records the device of `b` (once; later calls are ignored).
+    pub fn device(&mut self, b: Backend, name: &str, notes: &[String]) {
+        if !self.has_device(b) {
+            self.devices.push((b, name.to_string(), notes.to_vec()));
+        }
+    }
+    pub fn has_device(&self, b: Backend) -> bool {
+        self.devices.iter().any(|(x, ..)| *x == b)
+    }
+    pub fn ceilings(&mut self, b: Backend, c: Ceilings) {
+        self.ceilings.push((b, c));
+    }
+    pub fn cell(&mut self, b: Backend, v: &Variant, view: usize, cell: Cell) {
+        self.cells.push((b, *v, view, cell));
+    }
+
+    fn ceiling(&self, b: Backend, v: &Variant) -> Option<f64> {
+        self.ceilings
+            .iter()
+            .find(|(x, _)| *x == b)
+            .and_then(|(_, c)| c.rate(v.ceiling))
+    }
+
+    fn device_name(&self, b: Backend) -> &str {
+        self.devices
+            .iter()
+            .find(|(x, ..)| *x == b)
+            .map_or("?", |(_, d, _)| d.as_str())
+    }
+
+    /// The text table.
+    pub fn table(&self) -> String {
+        let mut o = String::new();
+        let _ = writeln!(
+            o,
+            "\nstrandgraph bench: {} at {}, {} timed frames after {} warm-up",
+            self.views.join(", "),
+            self.size,
+            self.frames,
+            self.warmup
+        );
+        for (b, d, _) in &self.devices {
+            let _ = writeln!(o, "  {:<5} {d}  [{}]", b.name(), b.clock());
+        }
+        let _ = writeln!(
+            o,
+            "\nRoofline (scenes/graphs/roofline.ron, same device and run; median of {} frames)",
+            self.frames
+        );
+        let _ = writeln!(
+            o,
+            "  {:<5} {:>24} {:>24} {:>22}",
+            "", "32-bit atomicMin", "64-bit atomicMin", "copy"
+        );
+        for (b, c) in &self.ceilings {
+            let atom = |(n, ms): (u64, f64)| {
+                format!("{}atom/s ({ms:.3} ms)", rate(n as f64 / (ms * 1e-3)))
+            };
+            let (bytes, ms) = c.copy;
+            let copy = format!("{}B/s ({ms:.3} ms)", rate(2.0 * bytes as f64 / (ms * 1e-3)));
+            let _ = writeln!(
+                o,
+                "  {:<5} {:>24} {:>24} {:>22}",
+                b.name(),
+                atom(c.atomic_min32),
+                atom(c.atomic_min64),
+                copy
+            );
+        }
+        let w = 34;
+        let _ = writeln!(
+            o,
+            "\nFrame time, ms: median [min-max] over frames (raster pass median; raster atomics/s as % of the roofline atomicMin rate)"
+        );
+        let _ = write!(o, "  {:<5} {:<34}", "", "pipeline: variant");
+        for v in &self.views {
+            let _ = write!(o, " {v:>w$}");
+        }
+        let _ = writeln!(o);
+        let mut rows: Vec<(Backend, Variant)> = Vec::new();
+        for (b, v, ..) in &self.cells {
+            if !rows
+                .iter()
+                .any(|(x, y)| x == b && y.name == v.name && y.pipeline == v.pipeline)
+            {
+                rows.push((*b, *v));
+            }
+        }
+        let mut skipped = Vec::new();
+        for (b, v) in &rows {
+            let label = format!("{}: {}", v.pipeline, v.name);
+            let _ = write!(o, "  {:<5} {label:<34}", b.name());
+            for s in 0..self.views.len() {
+                let cell = self.cells.iter().find(|(x, y, view, _)| {
+                    x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s
+                });
+                let text = match cell.map(|c| &c.3) {
+                    Some(Cell::Measured(st)) => {
+                        let pct = self.ceiling(*b, v).map_or("-".into(), |c| {
+                            format!("{:.0}%", 100.0 * st.atomic_rate() / c)
+                        });
+                        format!(
+                            "{:.2} [{:.2}-{:.2}] ({:.2}; {pct})",
+                            st.total.median, st.total.min, st.total.max, st.raster.median
+                        )
+                    }
+                    Some(Cell::Skipped(why)) => {
+                        if !skipped.contains(why) {
+                            skipped.push(why.clone());
+                        }
+                        "skipped".into()
+                    }
+                    None => "-".into(),
+                };
+                let _ = write!(o, " {text:>w$}");
+            }
+            let _ = writeln!(o);
+        }
+        for why in skipped {
+            let _ = writeln!(o, "  skipped: {why}");
+        }
+        for note in &self.notes {
+            let _ = writeln!(o, "  {note}");
+        }
+        let _ = writeln!(
+            o,
+            "  The atomicMin roofline is random-address; raster atomics hit nearby texels, so a raster can exceed 100% of it."
+        );
+        let _ = writeln!(
+            o,
+            "  CPU frame time is the frame's wall clock (its queues run concurrently on threads); GPU frame time is the sum of per-pass GPU timestamps.\n  Raster atomics are counted by an instrumented CPU run of the same configuration (subgroup width {}); GPU rows use that count.\n  Per-pass medians are in bench.csv / bench.json (--out). Bench took {:.0} s.",
+            self.subgroup, self.elapsed_s
+        );
+        o
+    }
+
+    fn csv(&self) -> String {
+        let mut o = String::from(
+            "backend,device,pipeline,variant,view,pass,kind,frames,median_ms,min_ms,max_ms,raster_atomics,raster_atomics_per_s,fraction_of_ceiling\n",
+        );
+        let q = |s: &str| format!("\"{}\"", s.replace('"', "\"\""));
+        for (b, v, s, cell) in &self.cells {
+            let Cell::Measured(st) = cell else { continue };
+            let frac = self
+                .ceiling(*b, v)
+                .map_or(String::new(), |c| format!("{:.4}", st.atomic_rate() / c));
+            let head = format!(
+                "{},{},{},{},{}",
+                b.name(),
+                q(self.device_name(*b)),
+                q(v.pipeline),
+                q(v.name),
+                self.views[*s]
+            );
+            let mut line = |pass: &str, kind: &str, sp: &Spread, extra: &str| {
+                let _ = writeln!(
+                    o,
+                    "{head},{},{},{},{:.4},{:.4},{:.4},{extra}",
+                    q(pass),
+                    q(kind),
+                    st.frames,
+                    sp.median,
+                    sp.min,
+                    sp.max
+                );
+            };
+            line("frame", "", &st.total, ",,");
+            let raster_extra = format!("{},{:.0},{frac}", st.raster_atomics, st.atomic_rate());
+            line("raster (sum)", "", &st.raster, &raster_extra);
+            for (name, kind, sp) in &st.passes {
+                line(name, kind, sp, ",,");
+            }
+        }
+        o
+    }
+
+    fn json(&self) -> Value {
+        let cells: Vec<Value> = self
+            .cells
+            .iter()
+            .map(|(b, v, s, cell)| {
+                let mut j = json!({
+                    "backend": b.name(),
+                    "pipeline": v.pipeline,
+                    "variant": v.name,
+                    "graph": v.graph,
+                    "overrides": v.overrides,
+                    "view": self.views[*s],
+                    "scene": self.scenes[*s].display().to_string(),
+                });
+                match cell {
+                    Cell::Skipped(why) => j["skipped"] = json!(why),
+                    Cell::Measured(st) => {
+                        j["frames"] = json!(st.frames);
+                        j["frame"] = st.total.json();
+                        j["raster"] = st.raster.json();
+                        j["raster_passes"] = json!(v.raster);
+                        j["raster_atomics"] = json!(st.raster_atomics);
+                        j["raster_atomics_source"] = json!("instrumented CPU run");
+                        j["raster_atomics_per_s"] = json!(st.atomic_rate());
+                        j["ceiling"] = json!(v.ceiling);
+                        j["fraction_of_ceiling"] =
+                            json!(self.ceiling(*b, v).map(|c| st.atomic_rate() / c));
+                        j["passes"] = st
+                            .passes
+                            .iter()
+                            .map(|(n, k, sp)| {
+                                let mut p = sp.json();
+                                p["pass"] = json!(n);
+                                p["kind"] = json!(k);
+                                p
+                            })
+                            .collect();
+                        j["per_frame_ms"] = json!(st.per_frame);
+                    }
+                }
+                j
+            })
+            .collect();
+        json!({
+            "size": self.size,
+            "frames": self.frames,
+            "warmup": self.warmup,
+            "cpu_subgroup_width": self.subgroup,
+            "devices": self.devices.iter().map(|(b, d, notes)| json!({
+                "backend": b.name(), "device": d, "clock": b.clock(), "notes": notes,
+            })).collect::<Vec<_>>(),
+            "roofline": self.ceilings.iter().map(|(b, c)| json!({
+                "backend": b.name(),
+                "atomic_min32": {"ops": c.atomic_min32.0, "median_ms": c.atomic_min32.1, "ops_per_s": c.rate("atomic_min32")},
+                "atomic_min64": {"ops": c.atomic_min64.0, "median_ms": c.atomic_min64.1, "ops_per_s": c.rate("atomic_min64")},
+                "copy": {"bytes": c.copy.0, "median_ms": c.copy.1, "bytes_moved_per_s": 2.0 * c.copy.0 as f64 / (c.copy.1 * 1e-3)},
+            })).collect::<Vec<_>>(),
+            "cells": cells,
+            "notes": self.notes,
+            "elapsed_s": self.elapsed_s,
+        })
+    }
+
+    /// Writes bench.txt, bench.csv and bench.json into `dir`.
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        std::fs::create_dir_all(dir)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("creating {}", dir.display()))?;
+        let json = serde_json::to_string_pretty(&self.json()).into_diagnostic()?;
+        for (name, text) in [
+            ("bench.txt", self.table()),
+            ("bench.csv", self.csv()),
+            ("bench.json", json),
+        ] {
+            let path = dir.join(name);
+            std::fs::write(&path, text)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("writing {}", path.display()))?;
+        }
+        Ok(())
+    }
+}
