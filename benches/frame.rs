@@ -2,8 +2,8 @@
 //!
 //! The CPU simulator is timed by wall clock around a frame. GPU backends are
 //! timed by their per-pass GPU timestamps through `iter_custom`, not by CPU
-//! wall time around a submit. Backends that cannot open here (no Vulkan
-//! adapter; ash not wired into the runner yet) are skipped with a message,
+//! wall time around a submit (ash: first begin to last end over its queues).
+//! Backends that cannot open here (no Vulkan adapter) are skipped with a message,
 //! as are pipelines whose passes have no kernels yet (Lipp).
 //!
 //! `STRANDGRAPH_BENCH_SIZE=1920x1080 cargo bench --bench frame` for Lipp's
@@ -14,7 +14,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strandgraph::frame::prepare;
-use strandgraph::runner::{Backend, CpuOptions, Runner};
+use strandgraph::runner::{Backend, CpuOptions, Runner, gpu_frame_millis};
 
 const PIPELINES: [(&str, &str); 2] = [
     ("kulikov", "scenes/graphs/kulikov.ron"),
@@ -57,7 +57,7 @@ fn frame_benches(c: &mut Criterion) {
                     group.bench_function(&id, |b| {
                         b.iter_custom(|iters| {
                             let ms: f64 = (0..iters)
-                                .map(|_| frame().iter().map(|t| t.millis).sum::<f64>())
+                                .map(|_| gpu_frame_millis(&frame()))
                                 .sum();
                             Duration::from_secs_f64(ms * 1e-3)
                         })

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
-use strandgraph::runner::{Backend, CpuOptions, Runner};
+use strandgraph::runner::{Backend, CpuOptions, Runner, gpu_frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_passes::upload::Upload;
 use strandgraph_passes::{Definitions, Registry};
@@ -364,7 +364,7 @@ pub fn run(mut args: Args) -> Result<()> {
 
 /// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
 /// and the frame times (CPU: wall time of the frame, its queues overlap;
-/// GPU: the sum of the passes' GPU times on wgpu's one queue).
+/// GPU: [`gpu_frame_millis`], timestamps only).
 fn frames(
     runner: &mut Runner,
     plan: &strandgraph_graph::Plan,
@@ -382,7 +382,7 @@ fn frames(
         let wall = t.elapsed().as_secs_f64() * 1e3;
         totals.push(match runner.backend() {
             Backend::Cpu => wall,
-            _ => times.iter().map(|t| t.millis).sum(),
+            _ => gpu_frame_millis(&times),
         });
         passes.push(times);
     }

@@ -6,7 +6,7 @@
 //! Adding a backend is a variant of [`Backend`] and of [`Runner`], and an arm
 //! in each `match` below.
 
-use miette::{IntoDiagnostic, Result, miette};
+use miette::{IntoDiagnostic, Result};
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::Registry;
 use strandgraph_passes::upload::Upload;
@@ -18,7 +18,7 @@ pub enum Backend {
     Cpu,
     /// wgpu on Vulkan; times are GPU timestamps per pass.
     Wgpu,
-    /// Raw Vulkan through ash (not wired into this runner yet).
+    /// Raw Vulkan through ash; times are GPU timestamps per pass per queue.
     Ash,
 }
 
@@ -69,6 +69,22 @@ pub struct PassTime {
     pub millis: f64,
     /// Atomics the pass performed (instrumented CPU runs only).
     pub atomics: Option<u64>,
+    /// Begin and end in ms from the frame's first timestamp on any queue
+    /// (ash only: its queues overlap, so a frame is a span, not a sum).
+    pub span: Option<(f64, f64)>,
+}
+
+/// A frame's GPU time: first begin to last end where passes carry spans
+/// (ash, whose async compute overlaps graphics), else the sum of the
+/// passes (wgpu's one queue).
+pub fn gpu_frame_millis(passes: &[PassTime]) -> f64 {
+    let spans: Vec<(f64, f64)> = passes.iter().filter_map(|p| p.span).collect();
+    if spans.is_empty() {
+        return passes.iter().map(|p| p.millis).sum();
+    }
+    let begin = spans.iter().map(|s| s.0).fold(f64::INFINITY, f64::min);
+    let end = spans.iter().map(|s| s.1).fold(f64::NEG_INFINITY, f64::max);
+    end - begin
 }
 
 /// An open session on one backend.
@@ -79,6 +95,7 @@ pub enum Runner {
         instrument: bool,
     },
     Wgpu(Box<strandgraph_wgpu::Session>),
+    Ash(Box<strandgraph_ash::Session>),
 }
 
 impl Runner {
@@ -117,9 +134,12 @@ impl Runner {
                     .into_diagnostic()?;
                 Ok(Runner::Wgpu(Box::new(session)))
             }
-            Backend::Ash => Err(miette!(
-                "the ash backend is not wired into the runner yet (src/runner.rs); use cpu or wgpu"
-            )),
+            Backend::Ash => {
+                let session = strandgraph_ash::AshBackend::default()
+                    .open(plan, instance)
+                    .into_diagnostic()?;
+                Ok(Runner::Ash(Box::new(session)))
+            }
         }
     }
 
@@ -127,6 +147,7 @@ impl Runner {
         match self {
             Runner::Cpu { .. } => Backend::Cpu,
             Runner::Wgpu(_) => Backend::Wgpu,
+            Runner::Ash(_) => Backend::Ash,
         }
     }
 
@@ -135,14 +156,26 @@ impl Runner {
         match self {
             Runner::Cpu { device, .. } => device.clone(),
             Runner::Wgpu(s) => s.adapter.clone(),
+            Runner::Ash(s) => s.device.clone(),
         }
     }
 
-    /// How the plan degraded on this backend (wgpu: one queue, no aliasing).
+    /// How the plan ran on this backend (wgpu: one queue, no aliasing;
+    /// ash: queues and transient bytes with and without aliasing).
     pub fn notes(&self) -> Vec<String> {
         match self {
             Runner::Cpu { .. } => Vec::new(),
             Runner::Wgpu(s) => s.notes.clone(),
+            Runner::Ash(s) => {
+                let mib = |b: u64| b as f64 / (1 << 20) as f64;
+                let mut notes = s.notes.clone();
+                notes.push(format!(
+                    "transients {:.2} MiB aliased, {:.2} MiB unaliased",
+                    mib(s.transient_bytes),
+                    mib(s.unaliased_bytes)
+                ));
+                notes
+            }
         }
     }
 
@@ -163,6 +196,7 @@ impl Runner {
                         kind: kind(t.pass),
                         millis: t.millis,
                         atomics: instrument.then_some(t.counters.atomics),
+                        span: None,
                     })
                     .collect())
             }
@@ -175,6 +209,22 @@ impl Runner {
                         kind: kind(t.pass),
                         millis: t.millis,
                         atomics: None,
+                        span: None,
+                    })
+                    .collect())
+            }
+            Runner::Ash(session) => {
+                let frame = session.run(upload).into_diagnostic()?;
+                Ok(frame
+                    .timings
+                    .iter()
+                    .map(|t| PassTime {
+                        name: t.name.clone(),
+                        kind: kind(t.pass),
+                        // NaN where the queue family has no timestamps.
+                        millis: t.millis.unwrap_or(f64::NAN),
+                        atomics: None,
+                        span: t.span,
                     })
                     .collect())
             }

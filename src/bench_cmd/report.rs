@@ -313,7 +313,7 @@ impl Report {
         );
         let _ = writeln!(
             o,
-            "  CPU frame time is the frame's wall clock (its queues run concurrently on threads); GPU frame time is the sum of per-pass GPU timestamps.\n  Raster atomics are counted by an instrumented CPU run of the same configuration (subgroup width {}); GPU rows use that count.\n  Per-pass medians are in bench.csv / bench.json (--out). Bench took {:.0} s.",
+            "  CPU frame time is the frame's wall clock (its queues run concurrently on threads); GPU frame time is first begin to last end of the per-pass GPU timestamps on ash (its queues overlap), their sum on wgpu (one queue).\n  Raster atomics are counted by an instrumented CPU run of the same configuration (subgroup width {}); GPU rows use that count.\n  Per-pass medians are in bench.csv / bench.json (--out). Bench took {:.0} s.",
             self.subgroup, self.elapsed_s
         );
         o
