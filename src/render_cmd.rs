@@ -3,7 +3,7 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandgraph::frame::{Prepared, override_param, parse_size, prepare};
+use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
 use strandgraph::images::{depth_to_view, to_linear, to_picture};
 use strandgraph_cpu::{CpuBackend, PassTiming};
 use strandgraph_graph::Plan;
@@ -58,6 +58,9 @@ pub fn run(args: Args) -> Result<()> {
     for spec in &args.params {
         override_param(&mut p.plan, spec)?;
     }
+    // An override may have selected the baked self-shadowing prepare did not
+    // bake for (a no-op when it did, or when nothing selects it).
+    bake_shadows(&p.plan, &mut p.upload)?;
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",

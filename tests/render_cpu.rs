@@ -243,3 +243,42 @@ fn showcase_renders_lit_and_composited_with_its_own_graph() {
     let deep = depth.iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
     assert!(deep > n / 6, "{deep} pixels with depth");
 }
+
+/// Kulikov, "Hair volumetric shadows": the showcase's head is shadowed where
+/// hair lies between it and the light, lit elsewhere, and occluded under hair.
+#[test]
+fn hair_shadows_the_head_where_hair_lies_between_it_and_the_light() {
+    let p = prepare(&root().join("scenes/showcase.ron"), None, Some((320, 180)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let backend = CpuBackend {
+        alias: false,
+        ..CpuBackend::default()
+    };
+    let f = run(&p, &backend);
+    let mask = f.read(&p.plan, "skin_shadow").unwrap();
+    let head: Vec<u32> = mask.iter().copied().filter(|&m| m != u32::MAX).collect();
+    let vis = |m: u32| (m & 0xFF) as f32 / 255.0;
+    let shadowed = head.iter().filter(|&&m| vis(m) < 0.5).count();
+    let occluded = head.iter().filter(|&&m| (m >> 24) < 230).count();
+    assert!(
+        head.len() > 500,
+        "{} head pixels with any shadow",
+        head.len()
+    );
+    assert!(
+        shadowed > head.len() / 20,
+        "{shadowed} of {} shadowed",
+        head.len()
+    );
+    assert!(shadowed < head.len() * 19 / 20, "all {shadowed} shadowed");
+    assert!(occluded > 0, "no ambient occlusion under hair");
+    // Switching the march off leaves every pixel lit.
+    let mut off = p.plan.clone();
+    strandgraph::frame::override_param(&mut off, "skin_shadow.steps=0").unwrap();
+    strandgraph::frame::override_param(&mut off, "skin_shadow.ao_steps=0").unwrap();
+    let f = backend
+        .execute(&off, &p.instance, &p.upload)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mask = f.read(&off, "skin_shadow").unwrap();
+    assert!(mask.iter().all(|&m| m == u32::MAX));
+}

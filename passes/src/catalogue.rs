@@ -102,6 +102,11 @@ pub static KINDS: &[PassKind] = &[
         "Kulikov 2025, 'Composition', 'Motion vectors'",
     ),
     kind(
+        "kulikov.skin_shadow",
+        "hair shadows and AO on opaque pixels: march the density grids towards each light (6 steps) and along the normal (2 steps), into a per-pixel mask scene.opaque reads",
+        "Kulikov 2025, 'Hair volumetric shadows'",
+    ),
+    kind(
         "kulikov.store_history",
         "compress this frame's post-transform NDC (clamped UNORM16 x, y) for next frame's motion vectors",
         "Kulikov 2025, 'Motion vectors'",

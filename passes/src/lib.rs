@@ -15,6 +15,7 @@ pub mod contract;
 pub mod draw;
 pub mod kulikov;
 pub mod layout;
+pub mod lipp;
 pub mod scene;
 pub mod sim;
 pub mod upload;
@@ -41,11 +42,16 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::raster::Raster,
     &kulikov::debug_resolve::DebugResolve,
     &kulikov::density::Density,
+    &kulikov::skin_shadow::SkinShadow,
     &kulikov::shade_sort::ShadeSort,
     &kulikov::shade::Shade,
     &kulikov::compose::Compose,
     &kulikov::history::Motion,
     &kulikov::history::StoreHistory,
+    &lipp::lod::Lod,
+    &lipp::raster::Raster,
+    &lipp::shade::Shade,
+    &lipp::filter::Filter,
     &bench::AtomicMin32,
     &bench::AtomicMin64,
     &bench::Copy,

@@ -7,7 +7,8 @@
 // params.background, alpha 1. Draw 3 × triangles vertices, no vertex buffers.
 //
 // Bindings (group 0), in the order of the pass's bindings less its attachments,
-// every record a storage buffer: 0 = frame, 1 = mesh.triangles, 2 = lights.
+// every record a storage buffer: 0 = frame, 1 = mesh.triangles, 2 = lights,
+// 3 = skin_shadow (one mask word per pixel, kulikov/skin_shadow.wgsl).
 // Parameters are the uniform block at binding 0 (OpaqueParams::uniform).
 //
 #import strandgraph::layout::{FrameData, TriangleData, LightData}
@@ -23,6 +24,7 @@ struct OpaqueParams {
 @group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> mesh_triangles: array<TriangleData>;
 @group(0) @binding(3) var<storage, read> lights: array<LightData>;
+@group(0) @binding(4) var<storage, read> skin_shadow: array<u32>;
 
 
 const PI: f32 = 3.14159265358979;
@@ -87,7 +89,8 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
     return out;
 }
 
-// Lambert (BRDF albedo/π) over every light plus ambient × albedo, as
+// Lambert (BRDF albedo/π) over every light plus ambient × albedo, scaled by
+// the pixel's shadow mask (bytes 0-2: lights 0-2, byte 3: ambient), as
 // `shade` in passes/src/scene/opaque.rs. Linear RGB.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
@@ -97,6 +100,9 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         n = normalize(in.normal);
     }
     let count = min(frame.light_count, arrayLength(&lights));
+    // The fragment's pixel: position.xy is its centre (x + 0.5, y + 0.5).
+    let pixel = vec2<u32>(in.position.xy);
+    let mask = skin_shadow[pixel.y * u32(frame.screen.x) + pixel.x];
     var irradiance = vec3<f32>(0.0);
     for (var i = 0u; i < count; i += 1u) {
         let l = lights[i];
@@ -112,9 +118,15 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
             to_light = d * inverseSqrt(d2);
             falloff = 1.0 / d2;
         }
-        irradiance += l.radiance.rgb * (max(dot(n, to_light), 0.0) * falloff);
+        // kulikov::skin_shadow::light_visibility: lights past the third are lit.
+        var visible = 1.0;
+        if i < 3u {
+            visible = f32((mask >> (8u * i)) & 0xFFu) / 255.0;
+        }
+        irradiance += l.radiance.rgb * (max(dot(n, to_light), 0.0) * falloff * visible);
     }
     let albedo = params.albedo_ambient.rgb;
-    let color = albedo * (irradiance / PI + vec3<f32>(params.albedo_ambient.a));
+    let ambient = params.albedo_ambient.a * (f32(mask >> 24u) / 255.0);
+    let color = albedo * (irradiance / PI + vec3<f32>(ambient));
     return vec4<f32>(color, 1.0);
 }

@@ -14,6 +14,7 @@ pub mod raster;
 pub mod shade;
 pub mod shade_sort;
 pub mod skin;
+pub mod skin_shadow;
 pub mod sort;
 pub mod tiles;
 

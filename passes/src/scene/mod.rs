@@ -186,6 +186,7 @@ pub(crate) mod testing {
         hs.buffer("frame", words_of(&[frame]))
             .buffer("mesh.triangles", words_of(tris))
             .buffer("lights", words_of(lights))
+            .buffer("skin_shadow", vec![u32::MAX; (w * h) as usize])
             .buffer("scene.depth", vec![0; (w * h) as usize])
             .buffer("output", vec![0; (2 * w * h) as usize]);
         hs

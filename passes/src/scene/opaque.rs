@@ -12,8 +12,11 @@
 //!
 //! Shading is Lambert with the scene's lights plus a small ambient term, in
 //! linear RGB (the CLI converts to sRGB when saving): the opaque head the
-//! Kulikov issue composes its coverage visualisation over. Hair shadows on
-//! skin (`hair_shadow_steps`, `hair_ao_steps` in the graph) are not read yet.
+//! Kulikov issue composes its coverage visualisation over. Each light's
+//! irradiance and the ambient term are scaled by the pixel's `skin_shadow`
+//! mask word (bytes 0–2: lights 0–2, byte 3: ambient; see
+//! `kulikov::skin_shadow`), written by `kulikov.skin_shadow` from the hair
+//! density, or cleared to `0xFFFFFFFF` (lit) by graphs without hair volumes.
 //!
 //! `output` is `Rgba16Float`: 2 words per texel, row-major,
 //! word 0 = r | g << 16, word 1 = b | a << 16 (IEEE half floats).
@@ -26,6 +29,7 @@
 use super::{GROUP, View, corner_normals, corners, dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use crate::kulikov::skin_shadow::{ambient_visibility, light_visibility};
 use crate::layout::{LightData, read};
 use crate::sim::{CounterValues, Ctx, Words};
 use glam::Vec3;
@@ -44,6 +48,7 @@ impl PassDef for Opaque {
             Binding::read("frame"),
             Binding::read("mesh.triangles"),
             Binding::read("lights"),
+            Binding::read("skin_shadow"),
             Binding::read("scene.depth"),
             Binding::write("output"),
         ];
@@ -191,10 +196,18 @@ fn rgb(value: &ron::Value, name: &str, default: [f32; 3]) -> Result<[f32; 3], Pa
 /// Linear RGB reflected towards the camera from a point `p` with unit
 /// normal `n`: Lambert (BRDF albedo/π) over every light, whose radiance is
 /// taken as irradiance at normal incidence (at 1 m for point lights, which
-/// fall off with the inverse square), plus `ambient` × albedo.
-pub fn shade(p: Vec3, n: Vec3, lights: &[LightData], albedo: Vec3, ambient: f32) -> Vec3 {
+/// fall off with the inverse square), plus `ambient` × albedo; lights and
+/// ambient scaled by the `shadow` mask word.
+pub fn shade(
+    p: Vec3,
+    n: Vec3,
+    lights: &[LightData],
+    albedo: Vec3,
+    ambient: f32,
+    shadow: u32,
+) -> Vec3 {
     let mut irradiance = Vec3::ZERO;
-    for l in lights {
+    for (i, l) in lights.iter().enumerate() {
         let [x, y, z, kind] = l.position_or_direction;
         let (to_light, falloff) = if kind == 0.0 {
             // A direction the light travels: the light is the other way.
@@ -206,8 +219,10 @@ pub fn shade(p: Vec3, n: Vec3, lights: &[LightData], albedo: Vec3, ambient: f32)
             (d / d2.sqrt(), 1.0 / d2)
         };
         let radiance = Vec3::new(l.radiance[0], l.radiance[1], l.radiance[2]);
-        irradiance += radiance * (n.dot(to_light).max(0.0) * falloff);
+        let visible = light_visibility(shadow, i);
+        irradiance += radiance * (n.dot(to_light).max(0.0) * falloff * visible);
     }
+    let ambient = ambient * ambient_visibility(shadow);
     albedo * (irradiance * std::f32::consts::FRAC_1_PI + Vec3::splat(ambient))
 }
 
@@ -256,6 +271,7 @@ impl CpuKernel for OpaqueKernel {
         let view = View::load(ctx);
         let lights = Self::lights(ctx, &view);
         let (depth, out) = (ctx.words("scene.depth"), ctx.words("output"));
+        let mask = ctx.words("skin_shadow");
         let albedo = Vec3::from(self.params.albedo);
         let mut local = CounterValues::default();
         view.for_each_triangle(group, |tri, setup| {
@@ -271,7 +287,8 @@ impl CpuKernel for OpaqueKernel {
                 let b = setup.perspective(f.screen);
                 let pos = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
                 let normal = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or(face);
-                let c = shade(pos, normal, &lights, albedo, self.params.ambient);
+                let shadow = mask.load(i);
+                let c = shade(pos, normal, &lights, albedo, self.params.ambient, shadow);
                 let [w0, w1] = pack([c.x, c.y, c.z, 1.0]);
                 out.store(2 * i, w0);
                 out.store(2 * i + 1, w1);

@@ -1,0 +1,215 @@
+// kulikov.skin_shadow: hair shadows and ambient occlusion on opaque pixels,
+// marched through every hair model's density grid (Kulikov, "Hair
+// volumetric shadows": 6 steps per light, 1 ray with 2 steps for AO).
+// Port of passes/src/kulikov/skin_shadow.rs; one invocation per pixel.
+// Mask word: bytes 0-2 the visibility of lights 0-2, byte 3 the AO.
+
+#import strandgraph::layout::{FrameData, ModelData, LightData}
+
+// SkinShadowParams::uniform.
+struct SkinShadowParams {
+    width: u32,
+    height: u32,
+    resolution: u32,
+    steps: u32,
+    ao_steps: u32,
+    ao_distance: f32,
+    absorption: f32,
+    ao_absorption: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: SkinShadowParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> models: array<ModelData>;
+@group(0) @binding(3) var<storage, read> lights: array<LightData>;
+@group(0) @binding(4) var<storage, read> density_grid: array<u32>;
+@group(0) @binding(5) var scene_depth: texture_depth_2d;
+@group(0) @binding(6) var<storage, read_write> skin_shadow: array<u32>;
+
+const GROUP: u32 = 64u;
+// kulikov::density::{GRID_WORDS, AREA_UNIT}.
+const GRID_WORDS: u32 = 110592u;
+const AREA_UNIT: f32 = 1e-9;
+const F32_MAX: f32 = 3.40282347e38;
+const MASK_LIGHTS: u32 = 3u;
+const LIT: u32 = 0xFFFFFFFFu;
+
+struct Hit {
+    hit: bool,
+    world: vec3<f32>,
+}
+
+// Pixels::world: the world position at a pixel centre; no hit on background.
+fn world_at(x: i32, y: i32) -> Hit {
+    var out = Hit(false, vec3<f32>(0.0));
+    if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
+        return out;
+    }
+    let z = textureLoad(scene_depth, vec2<i32>(x, y), 0);
+    if !(z < 1.0) {
+        return out;
+    }
+    let ndc = vec4<f32>(
+        (f32(x) + 0.5) / f32(params.width) * 2.0 - 1.0,
+        1.0 - (f32(y) + 0.5) / f32(params.height) * 2.0,
+        z,
+        1.0,
+    );
+    let w = frame.inv_view_proj * ndc;
+    out.hit = true;
+    out.world = w.xyz / w.w;
+    return out;
+}
+
+// Pixels::normal's choice on one axis: the neighbour with the smaller step.
+fn step_towards(p: vec3<f32>, a: Hit, b: Hit) -> vec3<f32> {
+    if a.hit && b.hit {
+        let da = a.world - p;
+        let db = p - b.world;
+        if dot(da, da) <= dot(db, db) {
+            return da;
+        }
+        return db;
+    }
+    if a.hit {
+        return a.world - p;
+    }
+    if b.hit {
+        return p - b.world;
+    }
+    return vec3<f32>(0.0);
+}
+
+fn normal_at(x: i32, y: i32, p: vec3<f32>) -> vec3<f32> {
+    let dx = step_towards(p, world_at(x + 1, y), world_at(x - 1, y));
+    let dy = step_towards(p, world_at(x, y + 1), world_at(x, y - 1));
+    let c = cross(dx, dy);
+    let len = length(c);
+    let e = frame.camera_pos.xyz - p;
+    let to_eye = select(vec3<f32>(0.0, 0.0, 1.0), normalize(e), length(e) > 0.0);
+    if len == 0.0 {
+        return to_eye;
+    }
+    let n = c / len;
+    let d = dot(n, to_eye);
+    if d > 0.0 {
+        return n;
+    } else if d < 0.0 {
+        return -n;
+    }
+    return to_eye;
+}
+
+// skin_shadow::trilinear: density units at q, trilinear between voxel
+// centres, zero outside the grid.
+fn trilinear(m: u32, md: ModelData, size: vec3<f32>, q: vec3<f32>) -> f32 {
+    let res = i32(params.resolution);
+    let r = f32(res);
+    var f = vec3<f32>(0.0);
+    for (var a = 0u; a < 3u; a++) {
+        f[a] = (q[a] - md.bounds_min[a]) / size[a] * r - 0.5;
+    }
+    let i0f = floor(f);
+    let t = f - i0f;
+    let i0 = vec3<i32>(i0f);
+    var sum = 0.0;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let bit = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
+        let idx = i0 + vec3<i32>(bit);
+        if any(idx < vec3<i32>(0)) || any(idx >= vec3<i32>(res)) {
+            continue;
+        }
+        let w3 = select(vec3<f32>(1.0) - t, t, bit == vec3<u32>(1u));
+        let v = u32((idx.z * res + idx.y) * res + idx.x);
+        sum += w3.x * w3.y * w3.z * f32(density_grid[m * GRID_WORDS + v]);
+    }
+    return sum;
+}
+
+// skin_shadow::crossed: strands crossed through model m's grid, `steps`
+// samples at the centres of equal intervals of the ray inside the box.
+fn crossed(m: u32, p: vec3<f32>, dir: vec3<f32>, max_t: f32, steps: u32) -> f32 {
+    let md = models[m];
+    var size = vec3<f32>(0.0);
+    var enter = 0.0;
+    var exit = F32_MAX;
+    for (var a = 0u; a < 3u; a++) {
+        size[a] = max(md.bounds_max[a] - md.bounds_min[a], 1e-6);
+        let lo = md.bounds_min[a];
+        let hi = lo + size[a];
+        if abs(dir[a]) > 1e-8 {
+            let t0 = (lo - p[a]) / dir[a];
+            let t1 = (hi - p[a]) / dir[a];
+            enter = max(enter, min(t0, t1));
+            exit = min(exit, max(t0, t1));
+        } else if p[a] < lo || p[a] > hi {
+            return 0.0;
+        }
+    }
+    let t1 = min(exit, max_t);
+    if !(enter < exit) || steps == 0u || t1 <= enter {
+        return 0.0;
+    }
+    let res = params.resolution;
+    let r = f32(res);
+    let volume = size.x * size.y * size.z / (r * r * r);
+    let dt = (t1 - enter) / f32(steps);
+    var units = 0.0;
+    for (var i = 0u; i < steps; i++) {
+        let q = p + dir * (enter + (f32(i) + 0.5) * dt);
+        units += trilinear(m, md, size, q);
+    }
+    return units * AREA_UNIT / volume * dt;
+}
+
+fn march(p: vec3<f32>, dir: vec3<f32>, max_t: f32, steps: u32) -> f32 {
+    var sum = 0.0;
+    for (var m = 0u; m < frame.model_count; m++) {
+        sum += crossed(m, p, dir, max_t, steps);
+    }
+    return sum;
+}
+
+// skin_shadow::unorm8.
+fn unorm8(v: f32) -> u32 {
+    return u32(floor(clamp(v, 0.0, 1.0) * 255.0 + 0.5));
+}
+
+@compute @workgroup_size(64)
+fn march_skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let i = wg.x * GROUP + lane;
+    if i >= params.width * params.height {
+        return;
+    }
+    let x = i32(i % params.width);
+    let y = i32(i / params.width);
+    let here = world_at(x, y);
+    if !here.hit {
+        skin_shadow[i] = LIT;
+        return;
+    }
+    let p = here.world;
+    var mask = LIT;
+    let count = min(min(frame.light_count, arrayLength(&lights)), MASK_LIGHTS);
+    for (var l = 0u; l < count; l++) {
+        let light = lights[l];
+        var dir: vec3<f32>;
+        var dist = F32_MAX;
+        if light.position_or_direction.w == 0.0 {
+            let d = light.position_or_direction.xyz;
+            dir = select(vec3<f32>(0.0), -normalize(d), length(d) > 0.0);
+        } else {
+            let d = light.position_or_direction.xyz - p;
+            dir = select(vec3<f32>(0.0), normalize(d), length(d) > 0.0);
+            dist = length(d);
+        }
+        let v = exp(-params.absorption * march(p, dir, dist, params.steps));
+        mask = (mask & ~(0xFFu << (8u * l))) | (unorm8(v) << (8u * l));
+    }
+    if params.ao_steps > 0u {
+        let n = normal_at(x, y, p);
+        let v = exp(-params.ao_absorption * march(p, n, params.ao_distance, params.ao_steps));
+        mask = (mask & 0x00FFFFFFu) | (unorm8(v) << 24u);
+    }
+    skin_shadow[i] = mask;
+}
