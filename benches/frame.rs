@@ -56,9 +56,7 @@ fn frame_benches(c: &mut Criterion) {
                 if backend.is_gpu() {
                     group.bench_function(&id, |b| {
                         b.iter_custom(|iters| {
-                            let ms: f64 = (0..iters)
-                                .map(|_| gpu_frame_millis(&frame()))
-                                .sum();
+                            let ms: f64 = (0..iters).map(|_| gpu_frame_millis(&frame())).sum();
                             Duration::from_secs_f64(ms * 1e-3)
                         })
                     });
