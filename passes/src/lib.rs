@@ -15,7 +15,6 @@ pub mod contract;
 pub mod draw;
 pub mod kulikov;
 pub mod layout;
-pub mod lipp;
 pub mod scene;
 pub mod sim;
 pub mod upload;
@@ -48,10 +47,6 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::compose::Compose,
     &kulikov::history::Motion,
     &kulikov::history::StoreHistory,
-    &lipp::lod::Lod,
-    &lipp::raster::Raster,
-    &lipp::shade::Shade,
-    &lipp::filter::Filter,
     &bench::AtomicMin32,
     &bench::AtomicMin64,
     &bench::Copy,
