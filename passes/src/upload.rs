@@ -245,6 +245,8 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
     up.set("groom.vertices", bytemuck::cast_slice(&vertices).to_vec());
     up.set("groom.strands", bytemuck::cast_slice(&strands).to_vec());
     up.set("groom.skinning", bytemuck::cast_slice(&skinning).to_vec());
+    // Lipp: hair-mesh bundles, layers and the environment SH (passes/src/lipp/upload.rs).
+    crate::lipp::upload::pack(scene, &mut up);
     up.frame = Some(frame);
     up.models = models;
     up

@@ -53,7 +53,8 @@ fn capabilities_of(file: &str) -> Capabilities {
         // CPU kernel does (`budget as f64 / total as f64`).
         "kulikov/lod.wgsl" => BASE | Capabilities::FLOAT64,
         // atomic<u64> with atomicMin whose result is unused (DESIGN.md, "Shaders").
-        "bench/atomic_min64.wgsl" => {
+        // Lipp §3.1.2: 64-bit atomicMin into the G-buffer, result unused.
+        "bench/atomic_min64.wgsl" | "lipp/raster.wgsl" => {
             BASE | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
         }
         _ => BASE,

@@ -1,0 +1,294 @@
+//! `lipp.lod`: Lipp §3.2, the per-bundle level-of-detail prepass.
+//!
+//! For every bundle: the screen-space AABB of its projected layer quads
+//! (Lipp Eq. 3), the LOD value L (Eq. 2), the strand count N_LOD (Eq. 1, with
+//! a per-bundle random δ), and the control-point count C (Eq. 4-5, snapped to
+//! 2^k + 1). Bundles whose AABB lies outside the viewport are frustum-culled
+//! (N_LOD = 0). The counts are prefix-summed into each bundle's first strand
+//! and the total goes into the rasterizer's indirect dispatch arguments.
+//!
+//! Deviation: the paper runs one thread per bundle and feeds N_LOD to a
+//! per-bundle indirect dispatch. Here the rasterizer is one flat indirect
+//! dispatch over all drawn strands (one workgroup per strand), so this pass
+//! also needs the exclusive prefix sum of N_LOD: it runs one workgroup of 256
+//! threads, each owning a contiguous run of bundles, and scans their sums in
+//! workgroup memory. The CPU kernel computes the same values sequentially.
+
+use super::{
+    BUNDLE_WORDS, BundleLod, BundleRecord, Corner, LOD_CULLED, MAX_CONTROL_POINTS, MAX_GROUPS_X,
+    bundle_count, frame, pcg, transform, unit,
+};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::layout::FrameData;
+use crate::sim::{Ctx, Words};
+
+pub struct Lod;
+
+/// Threads of the single LOD workgroup (WGSL).
+pub const LOD_GROUP: u32 = 256;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LodParams {
+    /// Off: every bundle draws N strands of C_max points (frustum culling still applies).
+    pub enabled: bool,
+    /// λ of Eq. 2.
+    pub lambda: f32,
+    /// δ ~ U[0, 1) per bundle (Eq. 1); off, δ = 0.
+    pub random_delta: bool,
+    /// C_max of Eq. 4-5 (3..=129).
+    pub max_control_points: u32,
+    pub frustum_cull: bool,
+    /// §3.2.1 dynamic strand counts (Eq. 1); off, N_LOD = N.
+    pub strand_lod: bool,
+    /// §3.2.2 dynamic strand resolution (Eq. 4-5); off, C from L = 1.
+    pub resolution_lod: bool,
+}
+
+impl LodParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new("lipp.lod", v)?;
+        let out = Self {
+            enabled: p.bool("enabled", true)?,
+            lambda: p.f32("lambda", 1.0)?,
+            random_delta: p.bool("random_delta", true)?,
+            max_control_points: p.u32("max_control_points", 127)?,
+            frustum_cull: p.bool("frustum_cull", true)?,
+            strand_lod: p.bool("strand_lod", true)?,
+            resolution_lod: p.bool("resolution_lod", true)?,
+        };
+        let err = |param: &str, message: String| ParamError {
+            kind: "lipp.lod",
+            param: param.into(),
+            message,
+        };
+        if !(3..=MAX_CONTROL_POINTS).contains(&out.max_control_points) {
+            return Err(err(
+                "max_control_points",
+                format!(
+                    "{} is outside 3..={MAX_CONTROL_POINTS} (32 lanes x 4 points per lane)",
+                    out.max_control_points
+                ),
+            ));
+        }
+        if !(out.lambda.is_finite() && out.lambda >= 0.0) {
+            return Err(err(
+                "lambda",
+                format!("{} is not a finite λ >= 0", out.lambda),
+            ));
+        }
+        Ok(out)
+    }
+}
+
+impl PassDef for Lod {
+    fn kind(&self) -> &'static str {
+        "lipp.lod"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("hairmesh.bundles"),
+            Binding::read("hairmesh.layers"),
+            Binding::write("bundle_lod"),
+            Binding::write("raster_args"),
+        ];
+        Some(BINDINGS)
+    }
+    fn workgroup_size(&self) -> u32 {
+        LOD_GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::Fixed(1)
+    }
+    fn shader(&self) -> Shader {
+        Shader::compute("lipp/lod.wgsl", "lod")
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(LodKernel(LodParams::from_ron(params)?)))
+    }
+    /// `LodParams` in shaders/lipp/lod.wgsl.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = LodParams::from_ron(params)?;
+        Ok(vec![
+            flag(p.enabled),
+            p.lambda.to_bits(),
+            flag(p.random_delta),
+            p.max_control_points,
+            flag(p.frustum_cull),
+            flag(p.strand_lod),
+            flag(p.resolution_lod),
+            crate::contract::count(q.bundles),
+        ])
+    }
+}
+
+/// Lipp Eq. 5: C_raw snapped up to 2^k + 1, at most C_max (C_raw >= 3).
+pub fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
+    let x = c_raw.max(3) - 1;
+    (x.next_power_of_two() + 1).min(c_max)
+}
+
+/// Lipp Eq. 4: C_raw = max(floor(sqrt(L) · C_max), C_layers).
+pub fn raw_control_points(l: f32, c_max: u32, layers: u32) -> u32 {
+    ((l.sqrt() * c_max as f32).floor() as u32).max(layers)
+}
+
+/// Lipp Eq. 1: N_LOD = clamp(ceil(L (N + δ)), 1, N).
+pub fn lod_strands(l: f32, n: u32, delta: f32) -> u32 {
+    if n == 0 {
+        return 0;
+    }
+    ((l * (n as f32 + delta)).ceil() as u32).clamp(1, n)
+}
+
+/// Lipp Eq. 2: L = clamp(|AABB_max − AABB_min| / R_y · λ, 0, 1).
+pub fn lod_value(aabb_min: [f32; 2], aabb_max: [f32; 2], height: f32, lambda: f32) -> f32 {
+    let (dx, dy) = (aabb_max[0] - aabb_min[0], aabb_max[1] - aabb_min[1]);
+    ((dx * dx + dy * dy).sqrt() / height * lambda).clamp(0.0, 1.0)
+}
+
+/// Lipp Eq. 3: the screen AABB (pixels) of bundle `b`'s layer corners, and
+/// whether a corner lies behind the near plane.
+pub fn screen_aabb(
+    f: &FrameData,
+    layers: &Words<'_>,
+    b: &BundleRecord,
+) -> ([f32; 2], [f32; 2], bool) {
+    let (mut lo, mut hi) = ([f32::MAX; 2], [f32::MIN; 2]);
+    let mut behind = false;
+    for i in 0..b.layers() {
+        for k in 0..4 {
+            let c = Corner::load(layers, (b.first_layer + i) as usize, k);
+            let p = c.position;
+            let clip = transform(&f.view_proj, [p[0], p[1], p[2], 1.0]);
+            if clip[3] <= f.near {
+                behind = true;
+                continue;
+            }
+            let s = crate::kulikov::clip_to_screen(clip, f.screen[0], f.screen[1]);
+            lo = [lo[0].min(s[0]), lo[1].min(s[1])];
+            hi = [hi[0].max(s[0]), hi[1].max(s[1])];
+        }
+    }
+    (lo, hi, behind)
+}
+
+/// The decision for one bundle (first_strand is filled in by the scan).
+pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord) -> BundleLod {
+    let (lo, hi, behind) = screen_aabb(f, layers, b);
+    let (w, h) = (f.screen[0], f.screen[1]);
+    let any_in_front = lo[0] <= hi[0];
+    let outside = !any_in_front || hi[0] < 0.0 || lo[0] > w || hi[1] < 0.0 || lo[1] > h;
+    // A corner behind the camera: the bundle may cover the screen; not culled, full detail.
+    let culled = p.frustum_cull && outside && !behind;
+    let l = if !p.enabled || behind {
+        1.0
+    } else {
+        lod_value(lo, hi, h, p.lambda)
+    };
+    let delta = if p.random_delta {
+        unit(pcg(b.seed))
+    } else {
+        0.0
+    };
+    let strands = if culled {
+        0
+    } else if p.strand_lod {
+        lod_strands(l, b.strands, delta)
+    } else {
+        b.strands
+    };
+    let l_res = if p.resolution_lod { l } else { 1.0 };
+    let c = snap_control_points(
+        raw_control_points(l_res, p.max_control_points, b.layers()),
+        p.max_control_points,
+    );
+    BundleLod {
+        strands,
+        control_points: c,
+        first_strand: 0,
+        flags: if culled { LOD_CULLED } else { 0 },
+    }
+}
+
+struct LodKernel(LodParams);
+
+impl CpuKernel for LodKernel {
+    fn run_workgroup(&self, _group: u32, ctx: &Ctx<'_>) {
+        let f = frame(ctx);
+        let (bundles, layers, out) = (
+            ctx.words("hairmesh.bundles"),
+            ctx.words("hairmesh.layers"),
+            ctx.words("bundle_lod"),
+        );
+        let count = bundle_count(ctx).min(bundles.len() / BUNDLE_WORDS);
+        let mut total = 0u32;
+        for b in 0..count {
+            let rec = BundleRecord::load(&bundles, b);
+            let mut lod = choose(&self.0, &f, &layers, &rec);
+            lod.first_strand = total;
+            total = total.saturating_add(lod.strands);
+            lod.store(&out, b);
+        }
+        let args = ctx.words("raster_args");
+        args.store(0, total.min(MAX_GROUPS_X));
+        args.store(1, 1);
+        args.store(2, 1);
+        args.store(3, total);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eq5_snaps_to_power_of_two_plus_one_below_c_max() {
+        assert_eq!(snap_control_points(3, 127), 3);
+        assert_eq!(snap_control_points(4, 127), 5);
+        assert_eq!(snap_control_points(8, 127), 9);
+        assert_eq!(snap_control_points(9, 127), 9);
+        assert_eq!(snap_control_points(10, 127), 17);
+        assert_eq!(snap_control_points(66, 127), 127, "129 is capped at C_max");
+        assert_eq!(snap_control_points(2, 127), 3, "C_raw >= 3");
+        assert_eq!(snap_control_points(127, 129), 129);
+    }
+
+    #[test]
+    fn eq4_uses_sqrt_l_and_the_layer_floor() {
+        assert_eq!(raw_control_points(1.0, 127, 8), 127);
+        assert_eq!(raw_control_points(0.25, 127, 8), 63);
+        assert_eq!(raw_control_points(0.0, 127, 8), 8);
+        assert_eq!(raw_control_points(0.0001, 127, 8), 8);
+    }
+
+    #[test]
+    fn eq1_keeps_at_least_one_strand_and_at_most_n() {
+        assert_eq!(lod_strands(1.0, 127, 0.9), 127);
+        assert_eq!(lod_strands(0.0, 127, 0.5), 1);
+        assert_eq!(lod_strands(0.5, 100, 0.0), 50);
+        assert_eq!(lod_strands(0.5, 100, 0.9), 51);
+        assert_eq!(lod_strands(0.5, 0, 0.9), 0);
+    }
+
+    #[test]
+    fn eq2_is_the_aabb_diagonal_over_the_height_times_lambda() {
+        let l = lod_value([0.0, 0.0], [30.0, 40.0], 1000.0, 2.0);
+        assert!((l - 0.1).abs() < 1e-6);
+        assert_eq!(lod_value([0.0, 0.0], [3000.0, 4000.0], 1000.0, 1.0), 1.0);
+    }
+
+    #[test]
+    fn bad_params_are_errors() {
+        let v: ron::Value = ron::from_str(r#"{"max_control_points": 300}"#).unwrap();
+        assert!(LodParams::from_ron(&v).is_err());
+        let v: ron::Value = ron::from_str(r#"{"lambda": -1.0}"#).unwrap();
+        assert!(LodParams::from_ron(&v).is_err());
+        let v: ron::Value = ron::from_str(r#"{"enabled": 3}"#).unwrap();
+        assert!(LodParams::from_ron(&v).is_err());
+    }
+}

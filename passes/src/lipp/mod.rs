@@ -1,0 +1,278 @@
+//! The Lipp-style pipeline (Lipp, Jarabo, Wimmer, Bode: "Deferred Software
+//! Rasterization for Efficient Real-time Hair Rendering"): a per-bundle LOD
+//! prepass feeding an indirect dispatch (§3.2), cooperative strand assembly
+//! and DDA rasterization into a 64-bit centre/conservative G-buffer (§3.1,
+//! Code 1), deferred shading (§3.4) and the reconnection filter (§3.3, Code 2).
+//! Each pass is one file: definition, CPU kernel, citation. The WGSL in
+//! `shaders/lipp/` ports the CPU kernels operation for operation.
+
+pub mod filter;
+pub mod lod;
+pub mod payload;
+pub mod raster;
+pub mod shade;
+pub mod strand;
+pub mod upload;
+
+use crate::layout::{FrameData, read};
+use crate::sim::{Ctx, Words};
+
+/// Layers a bundle may have on the GPU (the `hairmesh.layers` size is
+/// 16 layers per bundle; upload resamples taller bundles to this many).
+pub const MAX_LAYERS: u32 = 16;
+/// Words per packed layer: 4 corners × (position.xyz, AO, tangent.xyz, w).
+pub const LAYER_WORDS: usize = 32;
+/// Words per packed bundle record (`hairmesh.bundles`, 64 bytes).
+pub const BUNDLE_WORDS: usize = 16;
+/// Words per `bundle_lod` entry (Lipp §3.2.2: "fitting into a single uint4 per bundle").
+pub const LOD_WORDS: usize = 4;
+/// Workgroup size of the strand rasterizer: Lipp Code 1, "We use a WG size of
+/// 32 since NVIDIA has a subgroup size of 32".
+pub const RASTER_GROUP: u32 = 32;
+/// Largest control-point count (C_max may not exceed it): 32 lanes × 4 points.
+pub const MAX_CONTROL_POINTS: u32 = 129;
+/// Most workgroups one dispatch dimension may have (WebGPU's default limit);
+/// the rasterizer strides over strands beyond it.
+pub const MAX_GROUPS_X: u32 = 65535;
+
+/// `hairmesh.bundles`: one bundle (16 words).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BundleRecord {
+    /// Index of the bundle's first layer in `hairmesh.layers`.
+    pub first_layer: u32,
+    /// 2..=16 layers.
+    pub layer_count: u32,
+    /// N, the full strand count (Lipp Eq. 1).
+    pub strands: u32,
+    /// Index into `models` (material).
+    pub model: u32,
+    /// Styling parameters (curl radius and turns, twist in turns, noise amplitude).
+    pub curl_radius: f32,
+    pub curl_turns: f32,
+    pub twist: f32,
+    pub noise: f32,
+    /// Per-bundle random seed (δ of Eq. 1, strand identities).
+    pub seed: u32,
+}
+
+impl BundleRecord {
+    pub fn load(w: &Words<'_>, b: usize) -> Self {
+        let o = b * BUNDLE_WORDS;
+        Self {
+            first_layer: w.load(o),
+            layer_count: w.load(o + 1),
+            strands: w.load(o + 2),
+            model: w.load(o + 3),
+            curl_radius: w.load_f32(o + 4),
+            curl_turns: w.load_f32(o + 5),
+            twist: w.load_f32(o + 6),
+            noise: w.load_f32(o + 7),
+            seed: w.load(o + 8),
+        }
+    }
+
+    pub fn words(&self) -> [u32; BUNDLE_WORDS] {
+        let mut o = [0u32; BUNDLE_WORDS];
+        o[0] = self.first_layer;
+        o[1] = self.layer_count;
+        o[2] = self.strands;
+        o[3] = self.model;
+        o[4] = self.curl_radius.to_bits();
+        o[5] = self.curl_turns.to_bits();
+        o[6] = self.twist.to_bits();
+        o[7] = self.noise.to_bits();
+        o[8] = self.seed;
+        o
+    }
+
+    /// Layer count clamped to what the kernels handle (2..=16).
+    pub fn layers(&self) -> u32 {
+        self.layer_count.clamp(2, MAX_LAYERS)
+    }
+}
+
+/// One corner of a packed layer (world space).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Corner {
+    pub position: [f32; 3],
+    pub ao: f32,
+    pub tangent: [f32; 3],
+    /// w of the layer's uvw (root 0, tip 1).
+    pub w: f32,
+}
+
+impl Corner {
+    pub fn load(w: &Words<'_>, layer: usize, corner: usize) -> Self {
+        let o = layer * LAYER_WORDS + corner * 8;
+        Self {
+            position: [w.load_f32(o), w.load_f32(o + 1), w.load_f32(o + 2)],
+            ao: w.load_f32(o + 3),
+            tangent: [w.load_f32(o + 4), w.load_f32(o + 5), w.load_f32(o + 6)],
+            w: w.load_f32(o + 7),
+        }
+    }
+}
+
+/// `bundle_lod`: Lipp §3.2's per-bundle decision (uint4).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BundleLod {
+    /// N_LOD (Eq. 1); 0 when frustum-culled.
+    pub strands: u32,
+    /// C, control points per strand (Eq. 4-5).
+    pub control_points: u32,
+    /// First drawn strand of this bundle in the dispatch's numbering.
+    pub first_strand: u32,
+    /// Bit 0: culled.
+    pub flags: u32,
+}
+
+pub const LOD_CULLED: u32 = 1;
+
+impl BundleLod {
+    pub fn load(w: &Words<'_>, b: usize) -> Self {
+        let o = b * LOD_WORDS;
+        Self {
+            strands: w.load(o),
+            control_points: w.load(o + 1),
+            first_strand: w.load(o + 2),
+            flags: w.load(o + 3),
+        }
+    }
+    pub fn store(&self, w: &Words<'_>, b: usize) {
+        let o = b * LOD_WORDS;
+        w.store(o, self.strands);
+        w.store(o + 1, self.control_points);
+        w.store(o + 2, self.first_strand);
+        w.store(o + 3, self.flags);
+    }
+}
+
+/// The bundle owning drawn strand `s`: the last bundle whose first strand is
+/// at most `s` (bundles with no strands share their successor's first strand,
+/// so they are skipped). `lods` is sorted by `first_strand`.
+pub fn bundle_of_strand(first_strand: impl Fn(usize) -> u32, bundles: usize, s: u32) -> usize {
+    // upper_bound over first_strand, minus one.
+    let (mut lo, mut hi) = (0usize, bundles);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if first_strand(mid) <= s {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo.saturating_sub(1)
+}
+
+/// Number of bundles actually packed (the buffer may be larger).
+pub fn bundle_count(ctx: &Ctx<'_>) -> usize {
+    ctx.quantities.bundles as usize
+}
+
+/// The frame record.
+pub fn frame(ctx: &Ctx<'_>) -> FrameData {
+    read(&ctx.words("frame"), 0)
+}
+
+/// PCG hash (Jarzynski and Olano 2020), as `bench::pcg` and the WGSL.
+pub use crate::bench::pcg;
+
+/// A hash to [0, 1) with 24 bits (exact in f32 on every backend).
+pub fn unit(h: u32) -> f32 {
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Column-major 4×4 times a point (as `kulikov::transform`).
+pub use crate::kulikov::transform;
+
+/// Octahedral encoding of a unit vector into [-1, 1]² (Cigolle et al. 2014).
+pub fn oct_encode(n: [f32; 3]) -> [f32; 2] {
+    let l1 = n[0].abs() + n[1].abs() + n[2].abs();
+    if l1 <= 0.0 || !l1.is_finite() {
+        return [0.0, 0.0];
+    }
+    let (px, py) = (n[0] / l1, n[1] / l1);
+    if n[2] < 0.0 {
+        let sx = if px >= 0.0 { 1.0 } else { -1.0 };
+        let sy = if py >= 0.0 { 1.0 } else { -1.0 };
+        [(1.0 - py.abs()) * sx, (1.0 - px.abs()) * sy]
+    } else {
+        [px, py]
+    }
+}
+
+pub fn oct_decode(e: [f32; 2]) -> [f32; 3] {
+    let z = 1.0 - e[0].abs() - e[1].abs();
+    let (x, y) = if z < 0.0 {
+        let sx = if e[0] >= 0.0 { 1.0 } else { -1.0 };
+        let sy = if e[1] >= 0.0 { 1.0 } else { -1.0 };
+        ((1.0 - e[1].abs()) * sx, (1.0 - e[0].abs()) * sy)
+    } else {
+        (e[0], e[1])
+    };
+    normalize([x, y, z])
+}
+
+pub fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+pub fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+pub fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+pub fn scale(a: [f32; 3], s: f32) -> [f32; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+pub fn mix(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
+    [
+        a[0] + (b[0] - a[0]) * t,
+        a[1] + (b[1] - a[1]) * t,
+        a[2] + (b[2] - a[2]) * t,
+    ]
+}
+pub fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+pub fn length(a: [f32; 3]) -> f32 {
+    dot(a, a).sqrt()
+}
+/// Normalised, or zero for a zero vector (WGSL: `select(v / l, 0, l == 0)`).
+pub fn normalize(a: [f32; 3]) -> [f32; 3] {
+    let l = length(a);
+    if l > 0.0 { scale(a, 1.0 / l) } else { [0.0; 3] }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bundle_lookup_skips_empty_bundles() {
+        // Bundles: 3 strands, 0 (culled), 2, 0 -> firsts 0, 3, 3, 5.
+        let firsts = [0u32, 3, 3, 5];
+        let f = |i: usize| firsts[i];
+        assert_eq!(bundle_of_strand(f, 4, 0), 0);
+        assert_eq!(bundle_of_strand(f, 4, 2), 0);
+        assert_eq!(bundle_of_strand(f, 4, 3), 2);
+        assert_eq!(bundle_of_strand(f, 4, 4), 2);
+    }
+
+    #[test]
+    fn octahedral_round_trip() {
+        for n in [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+            [0.6, -0.8, 0.0],
+            [0.3, 0.4, -0.866],
+        ] {
+            let d = oct_decode(oct_encode(n));
+            assert!(length(sub(d, normalize(n))) < 1e-5, "{n:?} -> {d:?}");
+        }
+    }
+}

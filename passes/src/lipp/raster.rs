@@ -1,0 +1,471 @@
+//! `lipp.raster`: Lipp §3.1, one workgroup per strand (indirect dispatch
+//! from `lipp.lod`): cooperative strand assembly (Appendix B, Code 1) and DDA
+//! line rasterization into the 64-bit centre and conservative G-buffer
+//! layers with 64-bit `atomicMin` (§3.1.2, payload in [`super::payload`]).
+//!
+//! Strand assembly, per Code 1, in two passes over the 32 lanes:
+//! 1. lane i < L loads layer i at the strand's (u, v) and takes its
+//!    finite-difference tangent from its neighbours' positions, which it gets
+//!    with `subgroupShuffleUp/Down` (Code 1 lines 17-26); the layers go to
+//!    workgroup memory (`smLayer`).
+//! 2. the C control points are split into strips of S = ceil((C − 1) / 32)
+//!    per lane; each lane evaluates its strip once (Hermite subdivision and
+//!    styling), gets the previous lane's last point and the next lane's first
+//!    point and first tangent by shuffles, computes final tangents by finite
+//!    differences and draws its segments (Code 1 lines 31-50).
+//!
+//! Where a neighbour lies in another subgroup (a subgroup narrower than the
+//! 32-lane workgroup, e.g. lavapipe's 8), the lane evaluates the neighbour
+//! itself; the result is the same bits, so the strand does not depend on the
+//! subgroup width. `cooperative_assembly: false` is the naive baseline of
+//! §3.1: every lane recomputes its neighbours instead of shuffling.
+//!
+//! Rasterization: each segment is projected, snapped to a 1/256-pixel grid
+//! (DESIGN.md, "Determinism") and walked column by column along its major
+//! axis (a DDA). The conservative layer receives every pixel the segment
+//! crosses; the centre layer only pixels whose centre is within
+//! `centre_diameter / 2` of the line. Depth is tested against `scene.depth`.
+//! "we rasterize them as single-pixel-wide lines" (§3.1.2).
+//!
+//! Not implemented: the MSAA reference mode (`msaa` > 1 is refused).
+
+use super::payload::{Sample, pack};
+use super::strand::{
+    ControlPoint, LayerPoint, calc_tangent, eval_cp, layer_point, shuffle_down, shuffle_up,
+    strand_id, strand_uv,
+};
+use super::{
+    BundleLod, BundleRecord, LOD_WORDS, MAX_CONTROL_POINTS, RASTER_GROUP, bundle_count,
+    bundle_of_strand, frame, mix, normalize, transform,
+};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::layout::FrameData;
+use crate::sim::{CounterValues, Ctx, Words};
+
+pub struct Raster;
+
+/// Sub-pixel snap grid (as the Kulikov raster's `SNAP`).
+pub const SNAP: f32 = 256.0;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RasterParams {
+    pub cooperative_assembly: bool,
+    pub styling: bool,
+    /// Pixels; the centre-sample layer's acceptance diameter.
+    pub centre_diameter: f32,
+    pub conservative_layer: bool,
+    pub msaa: u32,
+}
+
+impl RasterParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new("lipp.raster", v)?;
+        let out = Self {
+            cooperative_assembly: p.bool("cooperative_assembly", true)?,
+            styling: p.bool("styling", true)?,
+            centre_diameter: p.f32("centre_diameter", 0.5)?,
+            conservative_layer: p.bool("conservative_layer", true)?,
+            msaa: p.u32("msaa", 0)?,
+        };
+        let err = |param: &str, message: &str| ParamError {
+            kind: "lipp.raster",
+            param: param.into(),
+            message: message.into(),
+        };
+        if !(out.centre_diameter > 0.0 && out.centre_diameter <= 2.0) {
+            return Err(err(
+                "centre_diameter",
+                "expected a diameter in (0, 2] pixels",
+            ));
+        }
+        if out.msaa > 1 {
+            return Err(err(
+                "msaa",
+                "the multi-sample reference mode (Lipp §3.3) is not implemented; use 0 or 1",
+            ));
+        }
+        Ok(out)
+    }
+}
+
+impl PassDef for Raster {
+    fn kind(&self) -> &'static str {
+        "lipp.raster"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("raster_args"),
+            Binding::read("bundle_lod"),
+            Binding::read("hairmesh.bundles"),
+            Binding::read("hairmesh.layers"),
+            Binding::read("scene.depth"),
+            Binding::atomic("gbuffer"),
+        ];
+        Some(BINDINGS)
+    }
+    fn workgroup_size(&self) -> u32 {
+        RASTER_GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::Indirect {
+            binding: "raster_args",
+            word: 0,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader::compute("lipp/raster.wgsl", "raster")
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))
+    }
+    /// `RasterParams` in shaders/lipp/raster.wgsl.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = RasterParams::from_ron(params)?;
+        Ok(vec![
+            flag(p.cooperative_assembly),
+            flag(p.styling),
+            p.centre_diameter.to_bits(),
+            flag(p.conservative_layer),
+            crate::contract::count(q.bundles),
+            q.width,
+            q.height,
+            0,
+        ])
+    }
+}
+
+struct RasterKernel(RasterParams);
+
+/// A projected, snapped segment end with its attributes.
+#[derive(Debug, Clone, Copy)]
+struct End {
+    x: f32,
+    y: f32,
+    z: f32,
+    tangent: [f32; 3],
+    w: f32,
+    ao: f32,
+}
+
+/// Everything one workgroup writes with.
+struct Target<'a> {
+    f: &'a FrameData,
+    width: u32,
+    height: u32,
+    depth: Words<'a>,
+    gbuffer: Words<'a>,
+    params: &'a RasterParams,
+    uv: [f32; 2],
+    local: &'a mut CounterValues,
+}
+
+fn snap(v: f32) -> f32 {
+    (v * SNAP + 0.5).floor() / SNAP
+}
+
+impl Target<'_> {
+    fn project(&self, cp: &ControlPoint, tangent: [f32; 3]) -> Option<End> {
+        let c = transform(&self.f.view_proj, [cp.pos[0], cp.pos[1], cp.pos[2], 1.0]);
+        if c[3] <= self.f.near {
+            return None;
+        }
+        let s = crate::kulikov::clip_to_screen(c, self.f.screen[0], self.f.screen[1]);
+        Some(End {
+            x: snap(s[0]),
+            y: snap(s[1]),
+            z: s[2],
+            tangent,
+            w: cp.w,
+            ao: cp.ao,
+        })
+    }
+
+    /// Writes the sample at parameter `t` of segment (a, b) into pixel (x, y)
+    /// of layer `layer` (0 centre, 1 conservative), depth-tested.
+    fn write(&mut self, a: &End, b: &End, t: f32, x: i32, y: i32, layer: usize) {
+        if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 {
+            return;
+        }
+        let z = a.z + (b.z - a.z) * t;
+        let pixel = (y as u32 * self.width + x as u32) as usize;
+        if !(0.0..1.0).contains(&z) || z >= self.depth.load_f32(pixel) {
+            return;
+        }
+        let sample = Sample {
+            depth: z,
+            tangent: normalize(mix(a.tangent, b.tangent, t)),
+            uvw: [self.uv[0], self.uv[1], a.w + (b.w - a.w) * t],
+            ao: a.ao + (b.ao - a.ao) * t,
+        };
+        let slot = layer * (self.width * self.height) as usize + pixel;
+        self.gbuffer.fetch_min_u64(slot, pack(&sample));
+        self.local.atomics += 1;
+        self.local.pixels_written += 1;
+    }
+
+    /// DDA over the segment's major axis, one pixel column (or row) at a time.
+    fn segment(&mut self, a: &End, b: &End) {
+        let x_major = (b.x - a.x).abs() >= (b.y - a.y).abs();
+        // (major, minor) coordinates.
+        let (ma, na, mb, nb) = if x_major {
+            (a.x, a.y, b.x, b.y)
+        } else {
+            (a.y, a.x, b.y, b.x)
+        };
+        let (dm, dn) = (mb - ma, nb - na);
+        let limit = if x_major { self.width } else { self.height } as f32;
+        let lo = ma.min(mb).max(0.0).floor();
+        let hi = ma.max(mb).min(limit - 1.0).floor();
+        if lo > hi && dm != 0.0 {
+            return;
+        }
+        let half = self.params.centre_diameter * 0.5;
+        // |cos| of the angle between the line and the major axis.
+        let len = (dm * dm + dn * dn).sqrt();
+        let cos = if len > 0.0 { dm.abs() / len } else { 1.0 };
+        let pixel = |m: i32, n: i32| if x_major { (m, n) } else { (n, m) };
+        let mut col = lo;
+        while col <= hi {
+            let ci = col as i32;
+            // The segment's t range inside this column.
+            let (t0, t1) = if dm != 0.0 {
+                let ta = ((col - ma) / dm).clamp(0.0, 1.0);
+                let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
+                (ta.min(tb), ta.max(tb))
+            } else {
+                (0.0, 1.0)
+            };
+            // Centre layer: the column centre within the segment (half-open,
+            // so shared ends are drawn once), rows whose centre is near the line.
+            let centre = col + 0.5;
+            if dm != 0.0 && centre >= ma.min(mb) && centre < ma.max(mb) {
+                let t = (centre - ma) / dm;
+                let n = na + dn * t;
+                let r = (n - 0.5).floor() as i32;
+                for row in [r, r + 1] {
+                    if ((n - (row as f32 + 0.5)) * cos).abs() <= half {
+                        let (x, y) = pixel(ci, row);
+                        self.write(a, b, t, x, y, 0);
+                    }
+                }
+            }
+            // Conservative layer: every row the segment touches in the column.
+            if self.params.conservative_layer {
+                let (n0, n1) = (na + dn * t0, na + dn * t1);
+                let (r0, r1) = (n0.min(n1).floor() as i32, n0.max(n1).floor() as i32);
+                let tm = 0.5 * (t0 + t1);
+                for row in r0..=r1 {
+                    let (x, y) = pixel(ci, row);
+                    self.write(a, b, tm, x, y, 1);
+                }
+            }
+            col += 1.0;
+        }
+    }
+}
+
+impl CpuKernel for RasterKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let f = frame(ctx);
+        let (lods, bundles, layers) = (
+            ctx.words("bundle_lod"),
+            ctx.words("hairmesh.bundles"),
+            ctx.words("hairmesh.layers"),
+        );
+        let total = ctx.words("raster_args").load(3);
+        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
+        let mut local = CounterValues::default();
+        let mut target = Target {
+            f: &f,
+            width: ctx.quantities.width,
+            height: ctx.quantities.height,
+            depth: ctx.words("scene.depth"),
+            gbuffer: ctx.words("gbuffer"),
+            params: &self.0,
+            uv: [0.0; 2],
+            local: &mut local,
+        };
+        let stride = ctx.workgroups.max(1);
+        let width = (ctx.subgroup_width.clamp(1, RASTER_GROUP)) as usize;
+        let mut s = group;
+        while s < total {
+            let b = bundle_of_strand(|i| lods.load(i * LOD_WORDS + 2), count, s);
+            let lod = BundleLod::load(&lods, b);
+            let rec = BundleRecord::load(&bundles, b);
+            self.strand(
+                &mut target,
+                &layers,
+                &rec,
+                &lod,
+                s - lod.first_strand,
+                width,
+            );
+            s += stride;
+        }
+        if ctx.instrument {
+            ctx.counters.add(&local);
+        }
+    }
+}
+
+impl RasterKernel {
+    /// Lipp Code 1 for strand `k` of bundle `rec`, lanes emulated as arrays.
+    fn strand(
+        &self,
+        target: &mut Target<'_>,
+        layers: &Words<'_>,
+        rec: &BundleRecord,
+        lod: &BundleLod,
+        k: u32,
+        width: usize,
+    ) {
+        let coop = self.0.cooperative_assembly;
+        let lanes = RASTER_GROUP as usize;
+        let uv = strand_uv(k);
+        let id = strand_id(rec.seed, k);
+        target.uv = uv;
+        let n = rec.layers();
+        // Pass 1 (Code 1 lines 14-28): one layer per lane, neighbours by shuffle.
+        let load = |i: u32| layer_point(layers, rec, i, uv);
+        let mine: Vec<LayerPoint> = (0..lanes as u32)
+            .map(|i| {
+                if i < n {
+                    load(i)
+                } else {
+                    LayerPoint::default()
+                }
+            })
+            .collect();
+        let (up, down) = (shuffle_up(&mine, width), shuffle_down(&mine, width));
+        let mut sm: Vec<LayerPoint> = mine[..n as usize].to_vec();
+        for i in 0..n {
+            let iu = i as usize;
+            let prev = match (coop, up[iu]) {
+                (true, Some(p)) if i > 0 => p.pos,
+                _ if i > 0 => load(i - 1).pos,
+                _ => mine[iu].pos,
+            };
+            let next = match (coop, down[iu]) {
+                (true, Some(p)) if i + 1 < n => p.pos,
+                _ if i + 1 < n => load(i + 1).pos,
+                _ => mine[iu].pos,
+            };
+            sm[iu].tangent = calc_tangent(i, n, prev, mine[iu].pos, next);
+        }
+        // Pass 2 (Code 1 lines 30-50): strips of S control points per lane.
+        let c = lod.control_points.clamp(2, MAX_CONTROL_POINTS);
+        let strip = (c - 1).div_ceil(RASTER_GROUP) as usize;
+        let eval = |i: u32| eval_cp(&sm, rec, id, i, c, self.0.styling);
+        let firsts: Vec<u32> = (0..lanes).map(|l| (l * strip) as u32).collect();
+        let cps: Vec<Vec<ControlPoint>> = firsts
+            .iter()
+            .map(|&f| {
+                (0..strip as u32)
+                    .filter(|m| f + m < c)
+                    .map(|m| eval(f + m))
+                    .collect()
+            })
+            .collect();
+        let first_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.first().copied()).collect();
+        let last_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.last().copied()).collect();
+        let (prev_sh, next_sh) = (shuffle_up(&last_cp, width), shuffle_down(&first_cp, width));
+        // Neighbour at index i: shuffled when cooperative and available, else evaluated.
+        let fetch = |shuffled: Option<Option<ControlPoint>>, i: u32| match (coop, shuffled) {
+            (true, Some(Some(p))) => p,
+            _ => eval(i),
+        };
+        let mut tangents: Vec<Vec<[f32; 3]>> = Vec::with_capacity(lanes);
+        let mut nexts: Vec<Option<ControlPoint>> = Vec::with_capacity(lanes);
+        for l in 0..lanes {
+            let (f, v) = (firsts[l], &cps[l]);
+            if v.is_empty() {
+                tangents.push(Vec::new());
+                nexts.push(None);
+                continue;
+            }
+            let prev = (f > 0).then(|| fetch(prev_sh[l], f - 1));
+            let end = f + v.len() as u32;
+            let next = (end < c).then(|| fetch(next_sh[l], end));
+            let t = (0..v.len())
+                .map(|m| {
+                    let p = if m > 0 {
+                        v[m - 1].pos
+                    } else {
+                        prev.map_or(v[m].pos, |p| p.pos)
+                    };
+                    let q = if m + 1 < v.len() {
+                        v[m + 1].pos
+                    } else {
+                        next.map_or(v[m].pos, |p| p.pos)
+                    };
+                    calc_tangent(f + m as u32, c, p, v[m].pos, q)
+                })
+                .collect();
+            tangents.push(t);
+            nexts.push(next);
+        }
+        // The next lane's first tangent (Code 1 line 46).
+        let first_t: Vec<Option<[f32; 3]>> = tangents.iter().map(|t| t.first().copied()).collect();
+        let next_t = shuffle_down(&first_t, width);
+        let mut active = 0u64;
+        for l in 0..lanes {
+            let Some(next) = nexts[l] else {
+                // Only the last strip: its segments end inside the strip.
+                self.draw_strip(target, &cps[l], &tangents[l], None, &mut active);
+                continue;
+            };
+            let end = firsts[l] + cps[l].len() as u32;
+            let tn = match (coop, next_t[l]) {
+                (true, Some(Some(t))) => t,
+                _ => {
+                    let after = if end + 1 < c {
+                        eval(end + 1).pos
+                    } else {
+                        next.pos
+                    };
+                    calc_tangent(end, c, cps[l][cps[l].len() - 1].pos, next.pos, after)
+                }
+            };
+            self.draw_strip(target, &cps[l], &tangents[l], Some((next, tn)), &mut active);
+        }
+        target.local.active_lanes += active;
+        target.local.total_lanes += (lanes * strip) as u64;
+    }
+
+    /// Draws a lane's segments: consecutive strip points, then the segment to
+    /// the next lane's first point.
+    fn draw_strip(
+        &self,
+        target: &mut Target<'_>,
+        cps: &[ControlPoint],
+        tangents: &[[f32; 3]],
+        next: Option<(ControlPoint, [f32; 3])>,
+        active: &mut u64,
+    ) {
+        for m in 0..cps.len() {
+            let (b, tb) = if m + 1 < cps.len() {
+                (cps[m + 1], tangents[m + 1])
+            } else if let Some(n) = next {
+                n
+            } else {
+                break;
+            };
+            *active += 1;
+            let (Some(pa), Some(pb)) =
+                (target.project(&cps[m], tangents[m]), target.project(&b, tb))
+            else {
+                continue;
+            };
+            target.segment(&pa, &pb);
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "raster_tests.rs"]
+mod tests;

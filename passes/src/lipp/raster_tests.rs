@@ -1,0 +1,160 @@
+//! Tests of `lipp.lod` + `lipp.raster` on hand-made bundles, through the
+//! simulator harness.
+
+use super::*;
+use crate::contract::PassDef;
+use crate::layout::words_of;
+use crate::lipp::lod::Lod;
+use crate::lipp::payload::{EMPTY, unpack};
+use crate::sim::harness::Harness;
+use bytemuck::Zeroable;
+use strandgraph_graph::Quantities;
+
+const W: u32 = 96;
+const H: u32 = 64;
+
+fn frame() -> FrameData {
+    let view = glam::Mat4::look_at_rh(
+        glam::Vec3::new(0.0, -0.15, 0.6),
+        glam::Vec3::new(0.0, -0.15, 0.0),
+        glam::Vec3::Y,
+    );
+    let proj = glam::Mat4::perspective_rh(0.8, W as f32 / H as f32, 0.02, 500.0);
+    let vp = proj * view;
+    let mut f = FrameData::zeroed();
+    f.view_proj = vp.to_cols_array();
+    f.inv_view_proj = vp.inverse().to_cols_array();
+    f.camera_pos = [0.0, -0.15, 0.6, 1.0];
+    f.screen = [W as f32, H as f32, 1.0 / W as f32, 1.0 / H as f32];
+    f.near = 0.02;
+    f.far = 500.0;
+    f
+}
+
+/// Two curly bundles of 4 layers hanging down from y = 0.
+fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
+    let mut bundles = Vec::new();
+    let mut layers = Vec::new();
+    for b in 0..2u32 {
+        let x0 = b as f32 * 0.06 - 0.05;
+        let rec = BundleRecord {
+            first_layer: b * 4,
+            layer_count: 4,
+            strands: 40,
+            model: 0,
+            curl_radius: 0.004,
+            curl_turns: 4.0,
+            twist: 0.25,
+            noise: 0.002,
+            seed: 7 + b,
+        };
+        bundles.extend(rec.words());
+        for i in 0..4 {
+            let y = -(i as f32) * 0.1;
+            for c in [[0.0, 0.0], [0.03, 0.0], [0.03, 0.03], [0.0, 0.03]] {
+                let w = i as f32 / 3.0;
+                layers.extend(
+                    [x0 + c[0], y, c[1], 1.0 - 0.5 * w, 0.0, -1.0, 0.0, w].map(f32::to_bits),
+                );
+            }
+        }
+    }
+    let q = Quantities {
+        bundles: 2,
+        width: W,
+        height: H,
+        ..Default::default()
+    };
+    let mut h = Harness::new(q);
+    h.subgroup_width = subgroup;
+    h.buffer("frame", words_of(&[frame()]))
+        .buffer("hairmesh.bundles", bundles)
+        .buffer("hairmesh.layers", layers)
+        .buffer("bundle_lod", vec![0; 8])
+        .buffer("raster_args", vec![0; 4])
+        .buffer("scene.depth", vec![1.0f32.to_bits(); (W * H) as usize])
+        .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
+    let lod = Lod
+        .cpu_kernel(&ron::from_str(r#"{"enabled": false}"#).unwrap())
+        .unwrap();
+    h.run(lod.as_ref(), 1, 256);
+    let groups = h.read("raster_args")[0];
+    let k = Raster.cpu_kernel(&ron::from_str(raster).unwrap()).unwrap();
+    h.run(k.as_ref(), groups, RASTER_GROUP);
+    (h, groups)
+}
+
+fn payloads(h: &Harness) -> Vec<u64> {
+    h.read("gbuffer")
+        .chunks(2)
+        .map(|w| u64::from(w[0]) | (u64::from(w[1]) << 32))
+        .collect()
+}
+
+#[test]
+fn strands_land_in_both_layers_and_centre_is_a_subset() {
+    let (h, groups) = harness("{}", 32);
+    assert_eq!(groups, 80);
+    assert_eq!(h.out_of_bounds(), 0);
+    let p = payloads(&h);
+    let (centre, cons) = p.split_at((W * H) as usize);
+    let nc = centre.iter().filter(|&&x| x != EMPTY).count();
+    let na = cons.iter().filter(|&&x| x != EMPTY).count();
+    assert!(nc > 100 && na > nc, "centre {nc}, conservative {na}");
+    for (g, a) in centre.iter().zip(cons) {
+        if *g != EMPTY {
+            assert_ne!(*a, EMPTY, "a centre hit is also a conservative hit");
+            // The conservative layer keeps the nearest of more candidates.
+            assert!(unpack(*a).depth <= unpack(*g).depth + 1e-6);
+        }
+    }
+    // Hanging strands: tangents mostly vertical.
+    let vertical = centre
+        .iter()
+        .filter(|&&x| x != EMPTY)
+        .filter(|&&x| unpack(x).tangent[1].abs() > 0.5)
+        .count();
+    assert!(vertical * 2 > nc, "{vertical} of {nc}");
+}
+
+#[test]
+fn shuffles_naive_assembly_and_subgroup_width_give_identical_g_buffers() {
+    let (coop, _) = harness("{}", 32);
+    let reference = payloads(&coop);
+    for (params, width) in [
+        ("{}", 8),
+        ("{}", 4),
+        (r#"{"cooperative_assembly": false}"#, 32),
+    ] {
+        let (h, _) = harness(params, width);
+        assert!(
+            payloads(&h) == reference,
+            "{params} at subgroup width {width}"
+        );
+    }
+}
+
+#[test]
+fn depth_test_against_the_scene_rejects_hidden_strands() {
+    let (mut h, groups) = harness("{}", 32);
+    h.buffer("scene.depth", vec![0.0f32.to_bits(); (W * H) as usize])
+        .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
+    let k = Raster.cpu_kernel(&ron::Value::Unit).unwrap();
+    let c = h.run(k.as_ref(), groups, RASTER_GROUP);
+    assert_eq!(c.pixels_written, 0);
+    assert!(payloads(&h).iter().all(|&x| x == EMPTY));
+}
+
+#[test]
+fn bad_params_are_errors() {
+    for bad in [
+        r#"{"msaa": 4}"#,
+        r#"{"centre_diameter": 0.0}"#,
+        r#"{"styling": 1}"#,
+    ] {
+        assert!(
+            Raster.cpu_kernel(&ron::from_str(bad).unwrap()).is_err(),
+            "{bad}"
+        );
+    }
+}

@@ -1,0 +1,380 @@
+//! `lipp.shade`: Lipp §3.4, deferred shading of both G-buffer layers, one
+//! invocation per pixel.
+//!
+//! Position is reconstructed from the 24-bit depth at the pixel centre ("we
+//! use the common approach in deferred engines and reconstruct it from the
+//! depth value", §3.1.2); the tangent is the octahedral one; the material is
+//! `models[0]`'s colour and roughness, varied per strand by its (u, v).
+//!
+//! Single scattering is Chiang et al. 2016 (R, TT, TRT), in a compact form:
+//! - M_p: a Gaussian in sin θ_i + sin θ_o − shift_p (the form Karis 2016
+//!   fits to it) with Chiang's variances v_0 = (0.726 β_m + 0.812 β_m² +
+//!   3.7 β_m^20)², v_1 = v_0 / 4, v_2 = 4 v_0 (Chiang Eq. 7) and cuticle
+//!   shifts (−2α, α, 4α), α = 2°, in place of the Bessel-function M_p;
+//! - N_p: Chiang's trimmed logistic with s = √(π/8)(0.265 β_n + 1.194 β_n² +
+//!   5.372 β_n^22) (Chiang Eq. 8) around Φ_p = pπ, i.e. evaluated at the
+//!   fibre centre h = 0 instead of integrated over h;
+//! - A_p: Schlick-Fresnel f at θ_o (η = 1.55) and transmittance
+//!   T = exp(−2 σ_a / cos θ_t), A_0 = f, A_1 = (1 − f)² T, A_2 = (1 − f)² T² f,
+//!   with σ_a from the colour by Chiang's Eq. 9 inverted.
+//!
+//! Multiple scattering is the Kajiya-Kay-like diffuse term Lipp uses
+//! ("a Lambertian term similar to Kajiya-Kay's"): colour · sin(T, L) / π.
+//! Lights are directional and point lights without shadows: the deep opacity
+//! maps (`lipp.dom`, Lipp §3.2.3 Eq. 8) are not implemented, so
+//! `dom_shadows: true` is refused. Probe lighting uses `env.sh` (L2 SH,
+//! Ramamoorthi and Hanrahan) at the fibre normal facing the viewer for the
+//! diffuse part, times the baked AO; the specular probe term uses the same
+//! radiance in place of a prefiltered GGX lookup (no environment map is
+//! uploaded, and for the constant environments of our scenes they agree).
+
+use super::payload::{EMPTY, Sample, unpack};
+use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::layout::{FrameData, LightData, ModelData, read};
+use crate::sim::{Ctx, Words};
+use strandgraph_graph::schema::Quantity;
+
+pub struct Shade;
+
+pub const SHADE_GROUP: u32 = 64;
+const PI: f32 = std::f32::consts::PI;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadeParams {
+    pub multiple_scattering: bool,
+    pub probe_lighting: bool,
+    /// Scales the single-scattering lobes (1 = Chiang).
+    pub specular: f32,
+}
+
+impl ShadeParams {
+    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new("lipp.shade", v)?;
+        let err = |param: &str, message: &str| ParamError {
+            kind: "lipp.shade",
+            param: param.into(),
+            message: message.into(),
+        };
+        let model = p.string("model", "Chiang16")?;
+        if model != "Chiang16" {
+            return Err(err("model", "only \"Chiang16\" is implemented"));
+        }
+        if p.bool("dom_shadows", false)? {
+            return Err(err(
+                "dom_shadows",
+                "deep opacity maps (lipp.dom) are not implemented; set it to false",
+            ));
+        }
+        Ok(Self {
+            multiple_scattering: p.bool("multiple_scattering", true)?,
+            probe_lighting: p.bool("probe_lighting", true)?,
+            specular: p.f32("specular", 1.0)?,
+        })
+    }
+}
+
+impl PassDef for Shade {
+    fn kind(&self) -> &'static str {
+        "lipp.shade"
+    }
+    fn bindings(&self) -> Option<&'static [Binding]> {
+        const BINDINGS: &[Binding] = &[
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lights"),
+            Binding::read("env.sh"),
+            Binding::read("gbuffer"),
+            Binding::write("shaded"),
+        ];
+        Some(BINDINGS)
+    }
+    fn workgroup_size(&self) -> u32 {
+        SHADE_GROUP
+    }
+    fn dispatch(&self) -> Dispatch {
+        Dispatch::PerElement {
+            quantity: Quantity::Pixels,
+            per_group: SHADE_GROUP,
+        }
+    }
+    fn shader(&self) -> Shader {
+        Shader::compute("lipp/shade.wgsl", "shade")
+    }
+    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+        Ok(Box::new(ShadeKernel(ShadeParams::from_ron(params)?)))
+    }
+    /// `ShadeParams` in shaders/lipp/shade.wgsl.
+    fn gpu_params(
+        &self,
+        params: &ron::Value,
+        q: &strandgraph_graph::Quantities,
+    ) -> Result<Vec<u32>, ParamError> {
+        let p = ShadeParams::from_ron(params)?;
+        Ok(vec![
+            flag(p.multiple_scattering),
+            flag(p.probe_lighting),
+            p.specular.to_bits(),
+            q.width,
+            q.height,
+            crate::contract::count(q.lights),
+            0,
+            0,
+        ])
+    }
+}
+
+/// Material inputs of one pixel.
+#[derive(Debug, Clone, Copy)]
+pub struct Material {
+    pub color: [f32; 3],
+    pub roughness: f32,
+}
+
+/// Chiang 2016 Eq. 9 inverted: absorption from a desired colour.
+pub fn sigma_a(color: [f32; 3], beta_n: f32) -> [f32; 3] {
+    let b = beta_n;
+    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3)
+        + 5.574 * b.powi(4)
+        + 0.245 * b.powi(5);
+    color.map(|c| {
+        let l = c.clamp(1e-4, 1.0).ln() / d;
+        l * l
+    })
+}
+
+fn logistic(x: f32, s: f32) -> f32 {
+    let e = (-x.abs() / s).exp();
+    e / (s * (1.0 + e) * (1.0 + e))
+}
+
+fn logistic_cdf(x: f32, s: f32) -> f32 {
+    1.0 / (1.0 + (-x / s).exp())
+}
+
+/// Chiang's trimmed logistic on [−π, π].
+fn trimmed_logistic(x: f32, s: f32) -> f32 {
+    logistic(x, s) / (logistic_cdf(PI, s) - logistic_cdf(-PI, s))
+}
+
+/// Wraps an angle to [−π, π].
+fn wrap(mut phi: f32) -> f32 {
+    while phi > PI {
+        phi -= 2.0 * PI;
+    }
+    while phi < -PI {
+        phi += 2.0 * PI;
+    }
+    phi
+}
+
+/// The R + TT + TRT single-scattering BSDF times cos θ_i (compact Chiang 2016).
+pub fn chiang(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [f32; 3] {
+    let (sin_i, sin_o) = (dot(t, l).clamp(-1.0, 1.0), dot(t, v).clamp(-1.0, 1.0));
+    let cos_i = (1.0 - sin_i * sin_i).max(0.0).sqrt();
+    let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
+    let lp = normalize(sub(l, scale(t, sin_i)));
+    let vp = normalize(sub(v, scale(t, sin_o)));
+    let phi = dot(lp, vp).clamp(-1.0, 1.0).acos();
+    let bm = m.roughness.clamp(0.02, 1.0);
+    let v0 = {
+        let x = 0.726 * bm + 0.812 * bm * bm + 3.7 * bm.powi(20);
+        x * x
+    };
+    let s = 0.626_657 * (0.265 * bm + 1.194 * bm * bm + 5.372 * bm.powi(22));
+    let alpha = 2.0f32.to_radians();
+    let eta = 1.55;
+    let f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
+    let f = f0 + (1.0 - f0) * (1.0 - cos_o).powi(5);
+    let sin_t = sin_o / eta;
+    let cos_t = (1.0 - sin_t * sin_t).max(1e-4).sqrt();
+    let sa = sigma_a(m.color, bm);
+    let tr = sa.map(|a| (-2.0 * a / cos_t).exp());
+    let mut out = [0.0f32; 3];
+    let lobes = [
+        (v0, -2.0 * alpha),
+        (0.25 * v0, alpha),
+        (4.0 * v0, 4.0 * alpha),
+    ];
+    for (p, (var, shift)) in lobes.iter().enumerate() {
+        let x = sin_i + sin_o - shift;
+        let mp = (-x * x / (2.0 * var)).exp() / (2.0 * PI * var).sqrt();
+        let np = trimmed_logistic(wrap(phi - p as f32 * PI), s);
+        let a = match p {
+            0 => [f; 3],
+            1 => tr.map(|t| (1.0 - f) * (1.0 - f) * t),
+            _ => tr.map(|t| (1.0 - f) * (1.0 - f) * t * t * f),
+        };
+        for k in 0..3 {
+            out[k] += mp * a[k] * np;
+        }
+    }
+    scale(out, cos_i)
+}
+
+/// Irradiance from L2 SH radiance coefficients at unit normal `n`
+/// (Ramamoorthi and Hanrahan 2001, Eq. 13).
+pub fn sh_irradiance(sh: &[[f32; 3]; 9], n: [f32; 3]) -> [f32; 3] {
+    let (x, y, z) = (n[0], n[1], n[2]);
+    let (c1, c2, c3, c4, c5) = (0.429_043, 0.511_664, 0.743_125, 0.886_227, 0.247_708);
+    std::array::from_fn(|k| {
+        let l = |i: usize| sh[i][k];
+        c1 * l(8) * (x * x - y * y) + c3 * l(6) * z * z + c4 * l(0) - c5 * l(6)
+            + 2.0 * c1 * (l(4) * x * y + l(7) * x * z + l(5) * y * z)
+            + 2.0 * c2 * (l(3) * x + l(1) * y + l(2) * z)
+    })
+}
+
+/// World position of pixel (x, y) at NDC depth z.
+pub fn world_position(f: &FrameData, x: u32, y: u32, z: f32) -> [f32; 3] {
+    let ndc_x = (x as f32 + 0.5) * f.screen[2] * 2.0 - 1.0;
+    let ndc_y = 1.0 - (y as f32 + 0.5) * f.screen[3] * 2.0;
+    let p = transform(&f.inv_view_proj, [ndc_x, ndc_y, z, 1.0]);
+    [p[0] / p[3], p[1] / p[3], p[2] / p[3]]
+}
+
+/// Everything the shading of one sample reads.
+pub struct Inputs<'a> {
+    pub f: &'a FrameData,
+    pub model: &'a ModelData,
+    pub lights: &'a [LightData],
+    pub sh: [[f32; 3]; 9],
+    pub params: &'a ShadeParams,
+}
+
+/// Radiance towards the camera of one G-buffer sample at pixel (x, y).
+pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
+    let pos = world_position(inp.f, x, y, s.depth);
+    let cam = [
+        inp.f.camera_pos[0],
+        inp.f.camera_pos[1],
+        inp.f.camera_pos[2],
+    ];
+    let v = normalize(sub(cam, pos));
+    let t = s.tangent;
+    // Per-strand variation from (u, v) (Lipp: shading parameters from uvw).
+    let q = |x: f32| (x * 63.0 + 0.5).floor() as u32;
+    let vary = 0.85 + 0.3 * unit(pcg(q(s.uvw[0]) | (q(s.uvw[1]) << 6)));
+    let c = inp.model.color;
+    let m = Material {
+        color: [c[0] * vary, c[1] * vary, c[2] * vary].map(|x| x.clamp(0.0, 1.0)),
+        roughness: c[3],
+    };
+    let mut out = [0.0f32; 3];
+    for light in inp.lights {
+        let pd = light.position_or_direction;
+        let (l, atten) = if pd[3] == 0.0 {
+            (normalize([-pd[0], -pd[1], -pd[2]]), 1.0)
+        } else {
+            let d = sub([pd[0], pd[1], pd[2]], pos);
+            (normalize(d), 1.0 / dot(d, d).max(1e-4))
+        };
+        let rad = scale(
+            [light.radiance[0], light.radiance[1], light.radiance[2]],
+            atten,
+        );
+        let single = scale(chiang(t, l, v, &m), inp.params.specular);
+        let mut f = single;
+        if inp.params.multiple_scattering {
+            let sin_tl = (1.0 - dot(t, l) * dot(t, l)).max(0.0).sqrt();
+            f = add(f, scale(m.color, sin_tl / PI));
+        }
+        for k in 0..3 {
+            out[k] += f[k] * rad[k];
+        }
+    }
+    if inp.params.probe_lighting {
+        // Fibre normal facing the viewer (Lipp §3.4).
+        let n = normalize(sub(v, scale(t, dot(t, v))));
+        let n = if dot(n, n) > 0.0 { n } else { v };
+        let e = sh_irradiance(&inp.sh, n);
+        let cos_o = (1.0 - dot(t, v) * dot(t, v)).max(0.0).sqrt();
+        let f = 0.0465 + (1.0 - 0.0465) * (1.0 - cos_o).powi(5);
+        for k in 0..3 {
+            let diffuse = e[k].max(0.0) / PI * m.color[k];
+            let specular = e[k].max(0.0) / PI * f * inp.params.specular;
+            out[k] += (diffuse + specular) * s.ao;
+        }
+    }
+    out
+}
+
+struct ShadeKernel(ShadeParams);
+
+/// `env.sh` as 9 rgb coefficients.
+pub fn load_sh(w: &Words<'_>) -> [[f32; 3]; 9] {
+    std::array::from_fn(|i| {
+        let v = w.load_vec4(i);
+        [v[0], v[1], v[2]]
+    })
+}
+
+impl CpuKernel for ShadeKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let f = frame(ctx);
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let pixels = w * h;
+        let model: ModelData = read(&ctx.words("models"), 0);
+        let lw = ctx.words("lights");
+        let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
+        let inp = Inputs {
+            f: &f,
+            model: &model,
+            lights: &lights,
+            sh: load_sh(&ctx.words("env.sh")),
+            params: &self.0,
+        };
+        let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
+        for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
+            let (x, y) = (i % w, i / w);
+            for layer in 0..2u32 {
+                let slot = (layer * pixels + i) as usize;
+                let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
+                let c = if p == EMPTY {
+                    [0.0; 4]
+                } else {
+                    let c = shade_sample(&inp, &unpack(p), x, y);
+                    [c[0], c[1], c[2], 1.0]
+                };
+                out.store_vec4((2 * i + layer) as usize, c);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chiang_lobes_are_finite_and_r_peaks_at_the_specular_cone() {
+        let m = Material {
+            color: [0.3, 0.2, 0.1],
+            roughness: 0.3,
+        };
+        let t = [0.0, 1.0, 0.0];
+        let v = normalize([0.0, 0.0, 1.0]);
+        // Light on the mirror cone (sin θ_i = −sin θ_o) vs far off it.
+        let on = chiang(t, normalize([0.0, -0.05, 1.0]), v, &m);
+        let off = chiang(t, normalize([0.0, 0.9, 0.3]), v, &m);
+        assert!(on.iter().chain(&off).all(|x| x.is_finite() && *x >= 0.0));
+        assert!(on[0] > off[0] * 2.0, "{on:?} vs {off:?}");
+        let sa = sigma_a([0.3, 0.2, 0.1], 0.3);
+        assert!(sa[0] < sa[1] && sa[1] < sa[2], "{sa:?}");
+    }
+
+    #[test]
+    fn constant_sh_gives_pi_times_radiance() {
+        let mut sh = [[0.0; 3]; 9];
+        let l00 = 4.0 * PI * 0.282_095;
+        sh[0] = [l00; 3];
+        let e = sh_irradiance(&sh, [0.0, 1.0, 0.0]);
+        assert!((e[0] - PI).abs() < 1e-3, "{e:?}");
+    }
+
+    #[test]
+    fn dom_shadows_are_refused_not_ignored() {
+        let v: ron::Value = ron::from_str(r#"{"dom_shadows": true}"#).unwrap();
+        assert!(ShadeParams::from_ron(&v).is_err());
+    }
+}

@@ -1,0 +1,168 @@
+// Helpers the Lipp kernels share, ported operation for operation from
+// passes/src/lipp/{mod,payload,strand}.rs. Composed with naga_oil:
+//   #import strandgraph::lipp::{...}
+#define_import_path strandgraph::lipp
+
+// Words per record (lipp::{BUNDLE_WORDS, LOD_WORDS}); vec4s per packed layer.
+const BUNDLE_WORDS: u32 = 16u;
+const LOD_WORDS: u32 = 4u;
+const LAYER_VEC4S: u32 = 8u;
+const MAX_LAYERS: u32 = 16u;
+const RASTER_GROUP: u32 = 32u;
+const MAX_CONTROL_POINTS: u32 = 129u;
+const MAX_GROUPS_X: u32 = 65535u;
+const LOD_CULLED: u32 = 1u;
+// payload::DEPTH_MAX, the sub-pixel snap grid.
+const DEPTH_MAX: f32 = 16777215.0;
+const SNAP: f32 = 256.0;
+const PI: f32 = 3.14159265358979;
+const TAU: f32 = 6.28318530717959;
+const F32_MAX: f32 = 3.40282347e38;
+const F32_MIN: f32 = -3.40282347e38;
+// payload::EMPTY as the two words WGSL sees.
+const EMPTY_WORD: u32 = 0xFFFFFFFFu;
+
+// PCG hash (Jarzynski and Olano, JCGT 2020), as bench::pcg.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// lipp::unit: 24 bits of a hash in [0, 1).
+fn unit(h: u32) -> f32 {
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// kulikov::transform (column-major matrix times a point).
+fn transform(m: mat4x4<f32>, p: vec4<f32>) -> vec4<f32> {
+    return m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] * p.w;
+}
+
+// kulikov::clip_to_screen: pixels (y down) and NDC depth.
+fn clip_to_screen(c: vec4<f32>, width: f32, height: f32) -> vec3<f32> {
+    let iw = 1.0 / c.w;
+    return vec3<f32>((c.x * iw * 0.5 + 0.5) * width, (0.5 - c.y * iw * 0.5) * height, c.z * iw);
+}
+
+// lipp::normalize: zero for a zero vector.
+fn safe_normalize(a: vec3<f32>) -> vec3<f32> {
+    let l = sqrt(dot(a, a));
+    if l > 0.0 {
+        return a * (1.0 / l);
+    }
+    return vec3<f32>(0.0);
+}
+
+fn lerp_vec(a: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
+    return a + (b - a) * t;
+}
+
+// Sign that is 1 at zero (oct_encode's sign_not_zero).
+fn sign_nz(x: f32) -> f32 {
+    return select(-1.0, 1.0, x >= 0.0);
+}
+
+fn oct_encode(n: vec3<f32>) -> vec2<f32> {
+    let l1 = abs(n.x) + abs(n.y) + abs(n.z);
+    if !(l1 > 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let px = n.x / l1;
+    let py = n.y / l1;
+    if n.z < 0.0 {
+        return vec2<f32>((1.0 - abs(py)) * sign_nz(px), (1.0 - abs(px)) * sign_nz(py));
+    }
+    return vec2<f32>(px, py);
+}
+
+fn oct_decode(e: vec2<f32>) -> vec3<f32> {
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    var xy = e;
+    if z < 0.0 {
+        xy = vec2<f32>((1.0 - abs(e.y)) * sign_nz(e.x), (1.0 - abs(e.x)) * sign_nz(e.y));
+    }
+    return safe_normalize(vec3<f32>(xy.x, xy.y, z));
+}
+
+// payload::quantize.
+fn quantize(x: f32, levels: f32) -> u32 {
+    return u32(floor(clamp(x, 0.0, 1.0) * levels + 0.5));
+}
+
+// payload::depth_bits.
+fn depth_bits(z: f32) -> u32 {
+    return min(u32(floor(clamp(z, 0.0, 1.0) * DEPTH_MAX)), 0xFFFFFEu);
+}
+
+// payload::pack as (low, high) words.
+fn pack_payload(depth: f32, tangent: vec3<f32>, uvw: vec3<f32>, ao: f32) -> vec2<u32> {
+    let e = oct_encode(tangent);
+    let hi = (depth_bits(depth) << 8u) | quantize(e.x * 0.5 + 0.5, 255.0);
+    let lo = (quantize(e.y * 0.5 + 0.5, 255.0) << 24u)
+        | (quantize(uvw.x, 63.0) << 18u)
+        | (quantize(uvw.y, 63.0) << 12u)
+        | (quantize(uvw.z, 63.0) << 6u)
+        | quantize(ao, 63.0);
+    return vec2<u32>(lo, hi);
+}
+
+// payload::unpack.
+struct Sample {
+    depth: f32,
+    tangent: vec3<f32>,
+    uvw: vec3<f32>,
+    ao: f32,
+}
+
+fn is_empty(p: vec2<u32>) -> bool {
+    return p.x == EMPTY_WORD && p.y == EMPTY_WORD;
+}
+
+fn unpack_payload(p: vec2<u32>) -> Sample {
+    let lo = p.x;
+    let hi = p.y;
+    let e = vec2<f32>(f32(hi & 0xFFu) / 255.0 * 2.0 - 1.0, f32(lo >> 24u) / 255.0 * 2.0 - 1.0);
+    return Sample(
+        f32(hi >> 8u) / DEPTH_MAX,
+        oct_decode(e),
+        vec3<f32>(f32((lo >> 18u) & 63u) / 63.0, f32((lo >> 12u) & 63u) / 63.0, f32((lo >> 6u) & 63u) / 63.0),
+        f32(lo & 63u) / 63.0,
+    );
+}
+
+// strand::strand_uv: the R2 sequence in 32-bit fixed point.
+fn strand_uv(k: u32) -> vec2<f32> {
+    return vec2<f32>(unit(0x80000000u + k * 3242174889u), unit(0x80000000u + k * 2447445414u));
+}
+
+// strand::strand_id.
+fn strand_id(seed: u32, k: u32) -> vec3<f32> {
+    let h = pcg(seed ^ pcg(k));
+    let h2 = pcg(h);
+    return vec3<f32>(unit(h), unit(h2), unit(pcg(h2)));
+}
+
+// strand::calc_tangent (Lipp Code 1).
+fn calc_tangent(idx: u32, count: u32, prev: vec3<f32>, curr: vec3<f32>, next: vec3<f32>) -> vec3<f32> {
+    if idx == 0u {
+        return safe_normalize(next - curr);
+    }
+    if idx + 1u >= count {
+        return safe_normalize(curr - prev);
+    }
+    return safe_normalize(next - prev);
+}
+
+// filter::linear_depth (glam perspective_rh, z in [0, 1]).
+fn linear_depth(near: f32, far: f32, z: f32) -> f32 {
+    return near * far / (far - z * (far - near));
+}
+
+// shade::world_position.
+fn world_position(inv_view_proj: mat4x4<f32>, screen: vec4<f32>, x: u32, y: u32, z: f32) -> vec3<f32> {
+    let ndc_x = (f32(x) + 0.5) * screen.z * 2.0 - 1.0;
+    let ndc_y = 1.0 - (f32(y) + 0.5) * screen.w * 2.0;
+    let p = transform(inv_view_proj, vec4<f32>(ndc_x, ndc_y, z, 1.0));
+    return vec3<f32>(p.x / p.w, p.y / p.w, p.z / p.w);
+}

@@ -1,0 +1,167 @@
+// lipp.filter: Lipp §3.3 and Appendix B Code 2, the single-pass elliptical
+// bilateral reconnection filter with opacity reconstruction, blended over
+// `output`. Port of passes/src/lipp/filter.rs (see its deviations).
+// `output` is Rgba16Float, read and written: a read_write storage texture.
+
+#import strandgraph::layout::FrameData
+#import strandgraph::lipp::{safe_normalize, transform, is_empty, unpack_payload, world_position, linear_depth, Sample}
+
+// FilterParams (booleans as 0/1).
+struct FilterParams {
+    enabled: u32,
+    reconnect: u32,
+    opacity_reconstruction: u32,
+    radius: u32,
+    s_parallel: f32,
+    s_perp: f32,
+    sigma_c: f32,
+    strip_width: f32,
+    depth_threshold: f32,
+    front_threshold: f32,
+    // Scene quantities.
+    width: u32,
+    height: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: FilterParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> gbuffer: array<vec2<u32>>;
+@group(0) @binding(3) var<storage, read> shaded: array<vec4<f32>>;
+@group(0) @binding(4) var output: texture_storage_2d<rgba16float, read_write>;
+
+fn payload(layer: u32, i: u32) -> vec2<u32> {
+    return gbuffer[layer * params.width * params.height + i];
+}
+
+fn color(layer: u32, i: u32) -> vec4<f32> {
+    return shaded[2u * i + layer];
+}
+
+fn lin(z: f32) -> f32 {
+    return linear_depth(frame.near, frame.far, z);
+}
+
+// filter::screen_tangent.
+fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
+    let p = world_position(frame.inv_view_proj, frame.screen, x, y, s.depth);
+    let q = p + s.tangent * (0.01 * lin(s.depth));
+    let a = transform(frame.view_proj, vec4<f32>(p, 1.0));
+    let b = transform(frame.view_proj, vec4<f32>(q, 1.0));
+    if a.w <= 0.0 || b.w <= 0.0 {
+        return vec2<f32>(1.0, 0.0);
+    }
+    let dx = (b.x / b.w - a.x / a.w) * frame.screen.x;
+    let dy = -(b.y / b.w - a.y / a.w) * frame.screen.y;
+    let n = safe_normalize(vec3<f32>(dx, dy, 0.0));
+    if n.x == 0.0 && n.y == 0.0 {
+        return vec2<f32>(1.0, 0.0);
+    }
+    return n.xy;
+}
+
+// filter::reconstruct: (filtered colour, alpha).
+fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
+    let r = i32(params.radius);
+    let sp = f32(params.radius) * params.s_parallel;
+    let sq = f32(params.radius) * params.s_perp;
+    var sum = vec3<f32>(0.0);
+    var wsum = 0.0;
+    var hc = 0.0;
+    var hcons = 0.0;
+    let d_ref = lin(z_ref);
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            let qx = i32(x) + dx;
+            let qy = i32(y) + dy;
+            if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
+                continue;
+            }
+            let q = u32(qy) * params.width + u32(qx);
+            let fx = f32(dx);
+            let fy = f32(dy);
+            let dpar = fx * tp.x + fy * tp.y;
+            let ox = fx - dpar * tp.x;
+            let oy = fy - dpar * tp.y;
+            let dperp = sqrt(ox * ox + oy * oy);
+            let gq = payload(0u, q);
+            let aq = payload(1u, q);
+            if dperp <= params.strip_width {
+                if !is_empty(gq) {
+                    hc += 1.0;
+                } else if !is_empty(aq) {
+                    hcons += 1.0;
+                }
+            }
+            if is_empty(gq) {
+                continue;
+            }
+            let zq = unpack_payload(gq).depth;
+            if abs(lin(zq) - d_ref) > params.depth_threshold {
+                continue;
+            }
+            let cq = color(0u, q);
+            let ws = exp(-(dpar * dpar) / (sp * sp) - dperp * dperp / (sq * sq));
+            var wc = 1.0;
+            if !promoted {
+                let d = cp.xyz - cq.xyz;
+                wc = exp(-dot(d, d) / (params.sigma_c * params.sigma_c));
+            }
+            let w = ws * wc;
+            sum += cq.xyz * w;
+            wsum += w;
+        }
+    }
+    var c = cp.xyz;
+    if wsum > 0.0 {
+        c = sum / wsum;
+    }
+    var alpha = 1.0;
+    if params.opacity_reconstruction != 0u && hc + hcons > 0.0 {
+        alpha = hc / (hc + hcons);
+    }
+    return vec4<f32>(c, alpha);
+}
+
+@compute @workgroup_size(64)
+fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if i >= params.width * params.height {
+        return;
+    }
+    let x = i % params.width;
+    let y = i / params.width;
+    let g = payload(0u, i);
+    let a = payload(1u, i);
+    let centre = !is_empty(g);
+    let cons = !is_empty(a);
+    let scene = textureLoad(output, vec2<u32>(x, y));
+    var out = vec4<f32>(0.0);
+    if params.enabled == 0u {
+        if !centre {
+            return;
+        }
+        out = vec4<f32>(color(0u, i).xyz, 1.0);
+    } else if centre {
+        let sg = unpack_payload(g);
+        out = reconstruct(x, y, sg.depth, screen_tangent(x, y, sg), color(0u, i), false);
+        var front = false;
+        if cons && params.reconnect != 0u {
+            let sa = unpack_payload(a);
+            front = lin(sa.depth) <= lin(sg.depth) - params.front_threshold;
+        }
+        if front {
+            // A flyaway in front of the centre hit: blended over it, opacity 1.
+            let sa = unpack_payload(a);
+            let f = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+            out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
+        }
+    } else if cons && params.reconnect != 0u {
+        // Promoted conservative-only pixel (§3.3.2).
+        let sa = unpack_payload(a);
+        out = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+    } else {
+        return;
+    }
+    let alpha = out.w;
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), scene.w));
+}

@@ -1,0 +1,397 @@
+// lipp.raster: Lipp §3.1 and Appendix B Code 1. One 32-lane workgroup per
+// strand (indirect; workgroups stride over strands beyond 65535): cooperative
+// strand assembly with subgroup shuffles, DDA rasterization into the centre
+// and conservative 64-bit G-buffer layers with atomicMin.
+// Port of passes/src/lipp/{raster,strand}.rs. A neighbour held by a lane of
+// another subgroup (subgroups narrower than 32, e.g. lavapipe's 8) or by a
+// lane whose shuffle partner is not its index neighbour is evaluated instead
+// of shuffled; the bits are the same, so the result does not depend on the
+// subgroup width. Needs SHADER_INT64 and SHADER_INT64_ATOMIC_MIN_MAX.
+
+#import strandgraph::layout::FrameData
+#import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+
+// RasterParams (booleans as 0/1).
+struct RasterParams {
+    cooperative_assembly: u32,
+    styling: u32,
+    centre_diameter: f32,
+    conservative_layer: u32,
+    // Scene quantities.
+    bundles: u32,
+    width: u32,
+    height: u32,
+    _pad: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: RasterParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> raster_args: array<u32>;
+@group(0) @binding(3) var<storage, read> bundle_lod: array<u32>;
+@group(0) @binding(4) var<storage, read> hairmesh_bundles: array<u32>;
+@group(0) @binding(5) var<storage, read> hairmesh_layers: array<vec4<f32>>;
+@group(0) @binding(6) var scene_depth: texture_depth_2d;
+@group(0) @binding(7) var<storage, read_write> gbuffer: array<atomic<u64>>;
+
+// Lipp Code 1's smLayer: the base layers with finite-difference tangents.
+var<workgroup> sm_pos: array<vec3<f32>, 16>;
+var<workgroup> sm_tangent: array<vec3<f32>, 16>;
+var<workgroup> sm_axis: array<vec3<f32>, 16>;
+var<workgroup> sm_ao: array<f32, 16>;
+
+// Points per lane: (MAX_CONTROL_POINTS - 1) / 32.
+const MAX_STRIP: u32 = 4u;
+
+struct Bundle {
+    first_layer: u32,
+    layers: u32,
+    seed: u32,
+    curl_radius: f32,
+    curl_turns: f32,
+    twist: f32,
+    noise: f32,
+}
+
+fn load_bundle(b: u32) -> Bundle {
+    let o = b * BUNDLE_WORDS;
+    return Bundle(
+        hairmesh_bundles[o],
+        clamp(hairmesh_bundles[o + 1u], 2u, MAX_LAYERS),
+        hairmesh_bundles[o + 8u],
+        bitcast<f32>(hairmesh_bundles[o + 4u]),
+        bitcast<f32>(hairmesh_bundles[o + 5u]),
+        bitcast<f32>(hairmesh_bundles[o + 6u]),
+        bitcast<f32>(hairmesh_bundles[o + 7u]),
+    );
+}
+
+struct LayerPoint {
+    pos: vec3<f32>,
+    axis: vec3<f32>,
+    ao: f32,
+}
+
+fn bilinear(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>, c3: vec3<f32>, u: f32, v: f32) -> vec3<f32> {
+    let bottom = lerp_vec(c0, c1, u);
+    let top = lerp_vec(c3, c2, u);
+    return lerp_vec(bottom, top, v);
+}
+
+// strand::layer_point.
+fn layer_point(b: Bundle, i: u32, uv: vec2<f32>) -> LayerPoint {
+    let base = (b.first_layer + i) * LAYER_VEC4S;
+    let k0 = hairmesh_layers[base];
+    let k1 = hairmesh_layers[base + 2u];
+    let k2 = hairmesh_layers[base + 4u];
+    let k3 = hairmesh_layers[base + 6u];
+    let w = hairmesh_layers[base + 1u].w;
+    let angle = b.twist * TAU * w;
+    let s = sin(angle);
+    let co = cos(angle);
+    let x = uv.x - 0.5;
+    let y = uv.y - 0.5;
+    let u = x * co - y * s + 0.5;
+    let v = x * s + y * co + 0.5;
+    let pos = bilinear(k0.xyz, k1.xyz, k2.xyz, k3.xyz, u, v);
+    let axis = ((k1.xyz - k0.xyz) + (k2.xyz - k3.xyz)) * 0.5;
+    let ao_b = k0.w + (k1.w - k0.w) * u;
+    let ao_t = k3.w + (k2.w - k3.w) * u;
+    return LayerPoint(pos, axis, ao_b + (ao_t - ao_b) * v);
+}
+
+struct ControlPoint {
+    pos: vec3<f32>,
+    w: f32,
+    ao: f32,
+}
+
+// strand::eval_cp over the layers in workgroup memory.
+fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32) -> ControlPoint {
+    let n = b.layers;
+    let w = f32(k) / f32(c - 1u);
+    let f = w * f32(n - 1u);
+    let i = min(u32(floor(f)), n - 2u);
+    let t = f - f32(i);
+    let p0 = sm_pos[i];
+    let p1 = sm_pos[i + 1u];
+    let t0 = sm_tangent[i];
+    let t1 = sm_tangent[i + 1u];
+    let d = p1 - p0;
+    let len = sqrt(dot(d, d));
+    let t2 = t * t;
+    let t3 = t * t * t;
+    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h10 = t3 - 2.0 * t2 + t;
+    let h01 = -2.0 * t3 + 3.0 * t2;
+    let h11 = t3 - t2;
+    var pos = (p0 * h00 + t0 * (h10 * len)) + (p1 * h01 + t1 * (h11 * len));
+    let ao = sm_ao[i] + (sm_ao[i + 1u] - sm_ao[i]) * t;
+    if params.styling != 0u {
+        let dir = safe_normalize(lerp_vec(t0, t1, t));
+        let axis = lerp_vec(sm_axis[i], sm_axis[i + 1u], t);
+        let b1 = safe_normalize(axis - dir * dot(axis, dir));
+        let b2 = cross(dir, b1);
+        let ramp = min(w * 8.0, 1.0);
+        var off = vec3<f32>(0.0);
+        if b.curl_radius > 0.0 {
+            let a = TAU * (b.curl_turns * w + id.x);
+            off = off + (b1 * cos(a) + b2 * sin(a)) * b.curl_radius;
+        }
+        if b.noise > 0.0 {
+            let amp = b.noise * sin(PI * w * (1.0 + 2.0 * id.y));
+            off = off + (id * 2.0 - vec3<f32>(1.0)) * amp;
+        }
+        pos = pos + off * ramp;
+    }
+    return ControlPoint(pos, w, ao);
+}
+
+struct End {
+    x: f32,
+    y: f32,
+    z: f32,
+    tangent: vec3<f32>,
+    w: f32,
+    ao: f32,
+    ok: bool,
+}
+
+fn snap(v: f32) -> f32 {
+    return floor(v * SNAP + 0.5) / SNAP;
+}
+
+fn project(cp: ControlPoint, tangent: vec3<f32>) -> End {
+    let c = transform(frame.view_proj, vec4<f32>(cp.pos, 1.0));
+    if c.w <= frame.near {
+        return End(0.0, 0.0, 0.0, tangent, cp.w, cp.ao, false);
+    }
+    let s = clip_to_screen(c, frame.screen.x, frame.screen.y);
+    return End(snap(s.x), snap(s.y), s.z, tangent, cp.w, cp.ao, true);
+}
+
+// Target::write.
+fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, uv: vec2<f32>) {
+    if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
+        return;
+    }
+    let z = a.z + (b.z - a.z) * t;
+    if !(z >= 0.0 && z < 1.0) || z >= textureLoad(scene_depth, vec2<i32>(x, y), 0) {
+        return;
+    }
+    let pixel = u32(y) * params.width + u32(x);
+    let p = pack_payload(
+        z,
+        safe_normalize(lerp_vec(a.tangent, b.tangent, t)),
+        vec3<f32>(uv.x, uv.y, a.w + (b.w - a.w) * t),
+        a.ao + (b.ao - a.ao) * t,
+    );
+    let slot = layer * params.width * params.height + pixel;
+    atomicMin(&gbuffer[slot], (u64(p.y) << 32u) | u64(p.x));
+}
+
+fn pixel_of(x_major: bool, m: i32, n: i32) -> vec2<i32> {
+    return select(vec2<i32>(n, m), vec2<i32>(m, n), x_major);
+}
+
+// Target::segment: a DDA over the major axis, one column at a time.
+fn draw_segment(a: End, b: End, uv: vec2<f32>) {
+    let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
+    let ma = select(a.y, a.x, x_major);
+    let na = select(a.x, a.y, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let nb = select(b.x, b.y, x_major);
+    let dm = mb - ma;
+    let dn = nb - na;
+    let limit = f32(select(params.height, params.width, x_major));
+    let lo = floor(max(min(ma, mb), 0.0));
+    let hi = floor(min(max(ma, mb), limit - 1.0));
+    if lo > hi && dm != 0.0 {
+        return;
+    }
+    let half = params.centre_diameter * 0.5;
+    let len = sqrt(dm * dm + dn * dn);
+    let cosa = select(1.0, abs(dm) / len, len > 0.0);
+    for (var col = lo; col <= hi; col += 1.0) {
+        let ci = i32(col);
+        var t0 = 0.0;
+        var t1 = 1.0;
+        if dm != 0.0 {
+            let ta = clamp((col - ma) / dm, 0.0, 1.0);
+            let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
+            t0 = min(ta, tb);
+            t1 = max(ta, tb);
+        }
+        let centre = col + 0.5;
+        if dm != 0.0 && centre >= min(ma, mb) && centre < max(ma, mb) {
+            let t = (centre - ma) / dm;
+            let n = na + dn * t;
+            let r = i32(floor(n - 0.5));
+            for (var row = r; row <= r + 1; row++) {
+                if abs((n - (f32(row) + 0.5)) * cosa) <= half {
+                    let p = pixel_of(x_major, ci, row);
+                    write_sample(a, b, t, p.x, p.y, 0u, uv);
+                }
+            }
+        }
+        if params.conservative_layer != 0u {
+            let n0 = na + dn * t0;
+            let n1 = na + dn * t1;
+            let r0 = i32(floor(min(n0, n1)));
+            let r1 = i32(floor(max(n0, n1)));
+            let tm = 0.5 * (t0 + t1);
+            for (var row = r0; row <= r1; row++) {
+                let p = pixel_of(x_major, ci, row);
+                write_sample(a, b, tm, p.x, p.y, 1u, uv);
+            }
+        }
+    }
+}
+
+fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>) {
+    let pa = project(a, ta);
+    let pb = project(b, tb);
+    if pa.ok && pb.ok {
+        draw_segment(pa, pb, uv);
+    }
+}
+
+// The last bundle whose first strand is at most s (lipp::bundle_of_strand).
+fn bundle_of_strand(count: u32, s: u32) -> u32 {
+    var lo = 0u;
+    var hi = count;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if bundle_lod[mid * LOD_WORDS + 2u] <= s {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return max(lo, 1u) - 1u;
+}
+
+@compute @workgroup_size(32)
+fn raster(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let total = raster_args[3];
+    let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let coop = params.cooperative_assembly != 0u;
+    // Whether the shuffle partners are this lane's index neighbours.
+    let up_lane = subgroupShuffleUp(lane, 1u);
+    let down_lane = subgroupShuffleDown(lane, 1u);
+    let has_up = coop && sg_lane > 0u && up_lane + 1u == lane;
+    let has_down = coop && sg_lane + 1u < sg_size && down_lane == lane + 1u && lane + 1u < RASTER_GROUP;
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let bi = bundle_of_strand(count, s);
+        let first_strand = bundle_lod[bi * LOD_WORDS + 2u];
+        let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
+        let b = load_bundle(bi);
+        let k = s - first_strand;
+        let uv = strand_uv(k);
+        let id = strand_id(b.seed, k);
+        let n = b.layers;
+
+        // Pass 1 (Code 1 lines 14-28): one layer per lane.
+        var mine = LayerPoint(vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
+        if lane < n {
+            mine = layer_point(b, lane, uv);
+        }
+        let up_pos = subgroupShuffleUp(mine.pos, 1u);
+        let down_pos = subgroupShuffleDown(mine.pos, 1u);
+        if lane < n {
+            var prev = mine.pos;
+            if lane > 0u {
+                prev = select(layer_point(b, lane - 1u, uv).pos, up_pos, has_up);
+            }
+            var next = mine.pos;
+            if lane + 1u < n {
+                next = select(layer_point(b, lane + 1u, uv).pos, down_pos, has_down);
+            }
+            sm_pos[lane] = mine.pos;
+            sm_tangent[lane] = calc_tangent(lane, n, prev, mine.pos, next);
+            sm_axis[lane] = mine.axis;
+            sm_ao[lane] = mine.ao;
+        }
+        workgroupBarrier();
+
+        // Pass 2 (Code 1 lines 30-50): a strip of S control points per lane.
+        let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
+        let first = lane * strip;
+        let have = min(select(0u, c - first, first < c), strip);
+        var cps: array<ControlPoint, 4>;
+        for (var m = 0u; m < have; m++) {
+            cps[m] = eval_cp(b, id, first + m, c);
+        }
+        let first_cp = cps[0];
+        let last_cp = cps[max(have, 1u) - 1u];
+        let up_cp_pos = subgroupShuffleUp(last_cp.pos, 1u);
+        let up_cp_w = subgroupShuffleUp(last_cp.w, 1u);
+        let up_cp_ao = subgroupShuffleUp(last_cp.ao, 1u);
+        let down_cp_pos = subgroupShuffleDown(first_cp.pos, 1u);
+        let down_cp_w = subgroupShuffleDown(first_cp.w, 1u);
+        let down_cp_ao = subgroupShuffleDown(first_cp.ao, 1u);
+        let end = first + have;
+        var prev = first_cp;
+        if have > 0u && first > 0u {
+            if has_up {
+                prev = ControlPoint(up_cp_pos, up_cp_w, up_cp_ao);
+            } else {
+                prev = eval_cp(b, id, first - 1u, c);
+            }
+        }
+        let has_next = have > 0u && end < c;
+        var next = last_cp;
+        if has_next {
+            if has_down {
+                next = ControlPoint(down_cp_pos, down_cp_w, down_cp_ao);
+            } else {
+                next = eval_cp(b, id, end, c);
+            }
+        }
+        var tangents: array<vec3<f32>, 4>;
+        for (var m = 0u; m < have; m++) {
+            var p = cps[m].pos;
+            if m > 0u {
+                p = cps[m - 1u].pos;
+            } else if first > 0u {
+                p = prev.pos;
+            }
+            var q = cps[m].pos;
+            if m + 1u < have {
+                q = cps[m + 1u].pos;
+            } else if has_next {
+                q = next.pos;
+            }
+            tangents[m] = calc_tangent(first + m, c, p, cps[m].pos, q);
+        }
+        // The next lane's first tangent (Code 1 line 46).
+        let down_t = subgroupShuffleDown(tangents[0], 1u);
+        var tn = vec3<f32>(0.0);
+        if has_next {
+            if has_down {
+                tn = down_t;
+            } else {
+                var after = next.pos;
+                if end + 1u < c {
+                    after = eval_cp(b, id, end + 1u, c).pos;
+                }
+                tn = calc_tangent(end, c, cps[have - 1u].pos, next.pos, after);
+            }
+        }
+        for (var m = 0u; m < have; m++) {
+            if m + 1u < have {
+                draw(cps[m], tangents[m], cps[m + 1u], tangents[m + 1u], uv);
+            } else if has_next {
+                draw(cps[m], tangents[m], next, tn, uv);
+            }
+        }
+        // smLayer is rewritten by the next strand.
+        workgroupBarrier();
+    }
+}

@@ -1,0 +1,183 @@
+// lipp.shade: Lipp §3.4, deferred shading of both G-buffer layers, one
+// invocation per pixel. Port of passes/src/lipp/shade.rs (compact Chiang 2016
+// R/TT/TRT, Kajiya-Kay-like multiple scattering, L2 SH probe lighting with
+// baked AO; no deep opacity maps yet). Writes rgba32f into `shaded`
+// (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
+
+#import strandgraph::layout::{FrameData, ModelData, LightData}
+#import strandgraph::lipp::{pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
+
+// ShadeParams (booleans as 0/1).
+struct ShadeParams {
+    multiple_scattering: u32,
+    probe_lighting: u32,
+    specular: f32,
+    // Scene quantities.
+    width: u32,
+    height: u32,
+    lights: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: ShadeParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> models: array<ModelData>;
+@group(0) @binding(3) var<storage, read> lights: array<LightData>;
+@group(0) @binding(4) var<storage, read> env_sh: array<vec4<f32>, 9>;
+@group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
+@group(0) @binding(6) var<storage, read_write> shaded: array<vec4<f32>>;
+
+const SHADE_GROUP: u32 = 64u;
+
+// shade::sigma_a (Chiang 2016 Eq. 9 inverted).
+fn sigma_a(color: vec3<f32>, b: f32) -> vec3<f32> {
+    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * pow(b, 3.0) + 5.574 * pow(b, 4.0)
+        + 0.245 * pow(b, 5.0);
+    let l = log(clamp(color, vec3<f32>(1e-4), vec3<f32>(1.0))) / d;
+    return l * l;
+}
+
+fn logistic(x: f32, s: f32) -> f32 {
+    let e = exp(-abs(x) / s);
+    return e / (s * (1.0 + e) * (1.0 + e));
+}
+
+fn logistic_cdf(x: f32, s: f32) -> f32 {
+    return 1.0 / (1.0 + exp(-x / s));
+}
+
+fn trimmed_logistic(x: f32, s: f32) -> f32 {
+    return logistic(x, s) / (logistic_cdf(PI, s) - logistic_cdf(-PI, s));
+}
+
+fn wrap_angle(phi: f32) -> f32 {
+    var p = phi;
+    while p > PI {
+        p -= 2.0 * PI;
+    }
+    while p < -PI {
+        p += 2.0 * PI;
+    }
+    return p;
+}
+
+// shade::chiang: R + TT + TRT times cos θ_i.
+fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
+    let sin_i = clamp(dot(t, l), -1.0, 1.0);
+    let sin_o = clamp(dot(t, v), -1.0, 1.0);
+    let cos_i = sqrt(max(1.0 - sin_i * sin_i, 0.0));
+    let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
+    let lp = safe_normalize(l - t * sin_i);
+    let vp = safe_normalize(v - t * sin_o);
+    let phi = acos(clamp(dot(lp, vp), -1.0, 1.0));
+    let bm = clamp(roughness, 0.02, 1.0);
+    let x0 = 0.726 * bm + 0.812 * bm * bm + 3.7 * pow(bm, 20.0);
+    let v0 = x0 * x0;
+    let s = 0.626657 * (0.265 * bm + 1.194 * bm * bm + 5.372 * pow(bm, 22.0));
+    let alpha = radians(2.0);
+    let eta = 1.55;
+    let f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
+    let f = f0 + (1.0 - f0) * pow(1.0 - cos_o, 5.0);
+    let sin_t = sin_o / eta;
+    let cos_t = sqrt(max(1.0 - sin_t * sin_t, 1e-4));
+    let tr = exp(-2.0 * sigma_a(color, bm) / cos_t);
+    var out = vec3<f32>(0.0);
+    for (var p = 0u; p < 3u; p++) {
+        var var_p = v0;
+        var shift = -2.0 * alpha;
+        var a = vec3<f32>(f);
+        if p == 1u {
+            var_p = 0.25 * v0;
+            shift = alpha;
+            a = (1.0 - f) * (1.0 - f) * tr;
+        } else if p == 2u {
+            var_p = 4.0 * v0;
+            shift = 4.0 * alpha;
+            a = (1.0 - f) * (1.0 - f) * tr * tr * f;
+        }
+        let x = sin_i + sin_o - shift;
+        let mp = exp(-x * x / (2.0 * var_p)) / sqrt(2.0 * PI * var_p);
+        let np = trimmed_logistic(wrap_angle(phi - f32(p) * PI), s);
+        out += mp * a * np;
+    }
+    return out * cos_i;
+}
+
+// shade::sh_irradiance (Ramamoorthi and Hanrahan 2001, Eq. 13).
+fn sh_irradiance(n: vec3<f32>) -> vec3<f32> {
+    let c1 = 0.429043;
+    let c2 = 0.511664;
+    let c3 = 0.743125;
+    let c4 = 0.886227;
+    let c5 = 0.247708;
+    let x = n.x;
+    let y = n.y;
+    let z = n.z;
+    return c1 * env_sh[8].xyz * (x * x - y * y) + c3 * env_sh[6].xyz * z * z + c4 * env_sh[0].xyz
+        - c5 * env_sh[6].xyz
+        + 2.0 * c1 * (env_sh[4].xyz * x * y + env_sh[7].xyz * x * z + env_sh[5].xyz * y * z)
+        + 2.0 * c2 * (env_sh[3].xyz * x + env_sh[1].xyz * y + env_sh[2].xyz * z);
+}
+
+// shade::shade_sample.
+fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
+    let pos = world_position(frame.inv_view_proj, frame.screen, x, y, s.depth);
+    let v = safe_normalize(frame.camera_pos.xyz - pos);
+    let t = s.tangent;
+    let qu = u32(floor(s.uvw.x * 63.0 + 0.5));
+    let qv = u32(floor(s.uvw.y * 63.0 + 0.5));
+    let vary = 0.85 + 0.3 * unit(pcg(qu | (qv << 6u)));
+    let c = models[0].color;
+    let color = clamp(c.xyz * vary, vec3<f32>(0.0), vec3<f32>(1.0));
+    let roughness = c.w;
+    var out = vec3<f32>(0.0);
+    let count = min(frame.light_count, arrayLength(&lights));
+    for (var i = 0u; i < count; i++) {
+        let pd = lights[i].position_or_direction;
+        var l = safe_normalize(-pd.xyz);
+        var atten = 1.0;
+        if pd.w != 0.0 {
+            let d = pd.xyz - pos;
+            l = safe_normalize(d);
+            atten = 1.0 / max(dot(d, d), 1e-4);
+        }
+        let rad = lights[i].radiance.xyz * atten;
+        var f = chiang(t, l, v, color, roughness) * params.specular;
+        if params.multiple_scattering != 0u {
+            let sin_tl = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
+            f += color * (sin_tl / PI);
+        }
+        out += f * rad;
+    }
+    if params.probe_lighting != 0u {
+        var n = safe_normalize(v - t * dot(t, v));
+        if dot(n, n) <= 0.0 {
+            n = v;
+        }
+        let e = max(sh_irradiance(n), vec3<f32>(0.0));
+        let cos_o = sqrt(max(1.0 - dot(t, v) * dot(t, v), 0.0));
+        let fr = 0.0465 + (1.0 - 0.0465) * pow(1.0 - cos_o, 5.0);
+        out += (e / PI * color + e / PI * fr * params.specular) * s.ao;
+    }
+    return out;
+}
+
+@compute @workgroup_size(64)
+fn shade(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let pixels = params.width * params.height;
+    let i = gid.x;
+    if i >= pixels {
+        return;
+    }
+    let x = i % params.width;
+    let y = i / params.width;
+    for (var layer = 0u; layer < 2u; layer++) {
+        let p = gbuffer[layer * pixels + i];
+        var c = vec4<f32>(0.0);
+        if !is_empty(p) {
+            c = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
+        }
+        shaded[2u * i + layer] = c;
+    }
+}
