@@ -15,6 +15,7 @@ pub mod contract;
 pub mod draw;
 pub mod kulikov;
 pub mod layout;
+pub mod lipp;
 pub mod scene;
 pub mod sim;
 pub mod upload;
@@ -47,6 +48,10 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::compose::Compose,
     &kulikov::history::Motion,
     &kulikov::history::StoreHistory,
+    &lipp::lod::Lod,
+    &lipp::raster::Raster,
+    &lipp::shade::Shade,
+    &lipp::filter::Filter,
     &bench::AtomicMin32,
     &bench::AtomicMin64,
     &bench::Copy,
