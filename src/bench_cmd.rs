@@ -40,8 +40,8 @@ pub struct Variant {
 const KULIKOV: &str = "scenes/graphs/kulikov.ron";
 
 /// The rows. Kulikov's ablations switch one published optimisation off at
-/// a time (passes/src/kulikov/raster/mod.rs, sort.rs). Lipp's rows run once
-/// its graph's passes have kernels; until then they are listed as skipped.
+/// a time (passes/src/kulikov/raster/mod.rs, sort.rs). Lipp's rows follow
+/// its Table 1 (passes/src/lipp/).
 pub const VARIANTS: &[Variant] = &[
     Variant {
         pipeline: "Kulikov",
@@ -87,15 +87,46 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
+    // filter (lipp.filter), L = LOD (lipp.lod). `filter.enabled=false`
+    // composites the centre layer as is; `lod.enabled=false` draws every
+    // strand at C_max control points. The MSAA reference rows (SWR 2/4/8)
+    // need the raster's multi-sample mode, which is not implemented.
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1",
+        graph: LIPP,
+        overrides: &["lod.enabled=false", "filter.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F",
+        graph: LIPP,
+        overrides: &["lod.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+L",
+        graph: LIPP,
+        overrides: &["filter.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+F+L (as published)",
-        graph: "scenes/graphs/lipp.ron",
+        graph: LIPP,
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
 ];
+
+const LIPP: &str = "scenes/graphs/lipp.ron";
 
 const VIEWS: [&str; 3] = [
     "scenes/distances/close.ron",
