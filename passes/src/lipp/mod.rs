@@ -6,6 +6,7 @@
 //! Each pass is one file: definition, CPU kernel, citation. The WGSL in
 //! `shaders/lipp/` ports the CPU kernels operation for operation.
 
+pub mod assemble;
 pub mod filter;
 pub mod lod;
 pub mod payload;

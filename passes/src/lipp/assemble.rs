@@ -1,0 +1,169 @@
+//! Lipp §3.1.1 and Appendix B Code 1: cooperative strand assembly, shared
+//! by the main-view rasterizer (`lipp.raster`) and the deep opacity maps
+//! (`lipp.dom_*`), which project the same segments per light ("Strand
+//! assembly is performed only once, while projection is executed per view",
+//! Lipp §5). The 32 lanes of a workgroup are emulated as arrays; shuffles go
+//! through [`shuffle_up`] / [`shuffle_down`] at the emulated subgroup width,
+//! and a neighbour in another subgroup is evaluated instead (same bits).
+//! See `raster.rs` for the two passes.
+
+use super::strand::{
+    ControlPoint, LayerPoint, calc_tangent, eval_cp, layer_point, shuffle_down, shuffle_up,
+    strand_id, strand_uv,
+};
+use super::{BundleLod, BundleRecord, MAX_CONTROL_POINTS, RASTER_GROUP};
+use crate::sim::Words;
+
+/// How a strand is assembled.
+#[derive(Debug, Clone, Copy)]
+pub struct Assembly {
+    /// Emulated subgroup width (1..=32).
+    pub width: usize,
+    /// Shuffle neighbours (Code 1) rather than recompute them.
+    pub cooperative: bool,
+    pub styling: bool,
+}
+
+/// Lipp Code 1 for strand `k` of bundle `rec`, lanes emulated as arrays:
+/// calls `draw` with each segment's ends and tangents; returns (segments
+/// drawn, lane slots of the drawing loop) for the lane-utilisation counter.
+pub fn assemble(
+    layers: &Words<'_>,
+    rec: &BundleRecord,
+    lod: &BundleLod,
+    k: u32,
+    opts: &Assembly,
+    draw: &mut dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]),
+) -> (u64, u64) {
+    let (coop, width) = (opts.cooperative, opts.width);
+    let lanes = RASTER_GROUP as usize;
+    let uv = strand_uv(k);
+    let id = strand_id(rec.seed, k);
+    let n = rec.layers();
+    // Pass 1 (Code 1 lines 14-28): one layer per lane, neighbours by shuffle.
+    let load = |i: u32| layer_point(layers, rec, i, uv);
+    let mine: Vec<LayerPoint> = (0..lanes as u32)
+        .map(|i| {
+            if i < n {
+                load(i)
+            } else {
+                LayerPoint::default()
+            }
+        })
+        .collect();
+    let (up, down) = (shuffle_up(&mine, width), shuffle_down(&mine, width));
+    let mut sm: Vec<LayerPoint> = mine[..n as usize].to_vec();
+    for i in 0..n {
+        let iu = i as usize;
+        let prev = match (coop, up[iu]) {
+            (true, Some(p)) if i > 0 => p.pos,
+            _ if i > 0 => load(i - 1).pos,
+            _ => mine[iu].pos,
+        };
+        let next = match (coop, down[iu]) {
+            (true, Some(p)) if i + 1 < n => p.pos,
+            _ if i + 1 < n => load(i + 1).pos,
+            _ => mine[iu].pos,
+        };
+        sm[iu].tangent = calc_tangent(i, n, prev, mine[iu].pos, next);
+    }
+    // Pass 2 (Code 1 lines 30-50): strips of S control points per lane.
+    let c = lod.control_points.clamp(2, MAX_CONTROL_POINTS);
+    let strip = (c - 1).div_ceil(RASTER_GROUP) as usize;
+    let eval = |i: u32| eval_cp(&sm, rec, id, i, c, opts.styling);
+    let firsts: Vec<u32> = (0..lanes).map(|l| (l * strip) as u32).collect();
+    let cps: Vec<Vec<ControlPoint>> = firsts
+        .iter()
+        .map(|&f| {
+            (0..strip as u32)
+                .filter(|m| f + m < c)
+                .map(|m| eval(f + m))
+                .collect()
+        })
+        .collect();
+    let first_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.first().copied()).collect();
+    let last_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.last().copied()).collect();
+    let (prev_sh, next_sh) = (shuffle_up(&last_cp, width), shuffle_down(&first_cp, width));
+    // Neighbour at index i: shuffled when cooperative and available, else evaluated.
+    let fetch = |shuffled: Option<Option<ControlPoint>>, i: u32| match (coop, shuffled) {
+        (true, Some(Some(p))) => p,
+        _ => eval(i),
+    };
+    let mut tangents: Vec<Vec<[f32; 3]>> = Vec::with_capacity(lanes);
+    let mut nexts: Vec<Option<ControlPoint>> = Vec::with_capacity(lanes);
+    for l in 0..lanes {
+        let (f, v) = (firsts[l], &cps[l]);
+        if v.is_empty() {
+            tangents.push(Vec::new());
+            nexts.push(None);
+            continue;
+        }
+        let prev = (f > 0).then(|| fetch(prev_sh[l], f - 1));
+        let end = f + v.len() as u32;
+        let next = (end < c).then(|| fetch(next_sh[l], end));
+        let t = (0..v.len())
+            .map(|m| {
+                let p = if m > 0 {
+                    v[m - 1].pos
+                } else {
+                    prev.map_or(v[m].pos, |p| p.pos)
+                };
+                let q = if m + 1 < v.len() {
+                    v[m + 1].pos
+                } else {
+                    next.map_or(v[m].pos, |p| p.pos)
+                };
+                calc_tangent(f + m as u32, c, p, v[m].pos, q)
+            })
+            .collect();
+        tangents.push(t);
+        nexts.push(next);
+    }
+    // The next lane's first tangent (Code 1 line 46).
+    let first_t: Vec<Option<[f32; 3]>> = tangents.iter().map(|t| t.first().copied()).collect();
+    let next_t = shuffle_down(&first_t, width);
+    let mut active = 0u64;
+    for l in 0..lanes {
+        let Some(next) = nexts[l] else {
+            // Only the last strip: its segments end inside the strip.
+            draw_strip(draw, &cps[l], &tangents[l], None, &mut active);
+            continue;
+        };
+        let end = firsts[l] + cps[l].len() as u32;
+        let tn = match (coop, next_t[l]) {
+            (true, Some(Some(t))) => t,
+            _ => {
+                let after = if end + 1 < c {
+                    eval(end + 1).pos
+                } else {
+                    next.pos
+                };
+                calc_tangent(end, c, cps[l][cps[l].len() - 1].pos, next.pos, after)
+            }
+        };
+        draw_strip(draw, &cps[l], &tangents[l], Some((next, tn)), &mut active);
+    }
+    (active, (lanes * strip) as u64)
+}
+
+/// Draws a lane's segments: consecutive strip points, then the segment to
+/// the next lane's first point.
+fn draw_strip(
+    draw: &mut dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]),
+    cps: &[ControlPoint],
+    tangents: &[[f32; 3]],
+    next: Option<(ControlPoint, [f32; 3])>,
+    active: &mut u64,
+) {
+    for m in 0..cps.len() {
+        let (b, tb) = if m + 1 < cps.len() {
+            (cps[m + 1], tangents[m + 1])
+        } else if let Some(n) = next {
+            n
+        } else {
+            break;
+        };
+        *active += 1;
+        draw(&cps[m], tangents[m], &b, tb);
+    }
+}
