@@ -5,6 +5,10 @@
 #
 #   bash benches/device.sh            # build, stage, print the call
 #
+# One process per backend: on NVIDIA's driver, creating some thirty Vulkan
+# devices in one process (wgpu's and ash's cells together) ends in
+# "vkCreateInstance: Unable to find a Vulkan driver"; each alone is fine.
+#
 # What travels (carry: .gl .devbin, under 64 MiB): the CLI, the criterion
 # bench binaries, the Vulkan loader and GL debs, and the baked self-shadow
 # SH cache for the distance views' groom when it fits. Scenes, graphs and
@@ -58,5 +62,5 @@ Device-tool call (kind nvidia-h100-x1):
   carry: [".gl", ".devbin"]
   timeout_s: 600
   command:
-for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig; export XDG_RUNTIME_DIR=/tmp VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json STRANDGRAPH_CACHE=$PWD/.devbin/cache; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; timeout 380 .devbin/strandgraph bench --backend all --frames 10 --warmup 2 --out $OUT > $OUT/bench_stdout.txt 2>&1; echo "bench exit $?"; STRANDGRAPH_BENCH_SIZE=1920x1080 timeout 150 .devbin/frame --bench 'frame/(wgpu|ash)/' > $OUT/criterion_frame.txt 2>&1; cat $OUT/bench.txt; grep -E '^frame/|time:' $OUT/criterion_frame.txt | tail -20
+for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig; export XDG_RUNTIME_DIR=/tmp VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json STRANDGRAPH_CACHE=$PWD/.devbin/cache; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; for b in cpu wgpu ash; do mkdir -p $OUT/$b; timeout 180 .devbin/strandgraph bench --backend $b --frames 10 --warmup 2 --out $OUT/$b > $OUT/$b/stdout.txt 2>&1; echo "bench $b exit $?"; done; STRANDGRAPH_BENCH_SIZE=1920x1080 timeout 150 .devbin/frame --bench 'frame/(wgpu|ash)/' > $OUT/criterion_frame.txt 2>&1; cat $OUT/ash/bench.txt; grep -E '^frame/|time:' $OUT/criterion_frame.txt | tail -20
 CALL
