@@ -12,6 +12,8 @@
 //!   math before the 1/256-pixel snap; a different ULP in sin/cos can move a
 //!   sample across a pixel or centre-distance boundary);
 //! - on pixels both cover, depth (24 bits) within 1e-4 on 98%;
+//! - deep opacity maps: texels hit by one side only at most 2%, first-hit
+//!   depths within 1e-4 on 98%, total opacity within 2%;
 //! - `output.final` within a mean FLIP of 0.02 of the CPU, each GPU backend;
 //! - ash with memory aliasing gives the same image as without.
 //!
@@ -140,6 +142,37 @@ fn check_gbuffer(label: &str, reference: &[u32], test: &[u32]) {
     }
 }
 
+/// Deep opacity maps: texels hit on one side only at most 2% of those hit,
+/// first-hit depths within 1e-4 on 98% of both-hit texels, total opacity
+/// within 2%.
+fn check_dom(label: &str, depth_a: &[u32], layers_a: &[u32], depth_b: &[u32], layers_b: &[u32]) {
+    assert_eq!(depth_a.len(), depth_b.len());
+    let (mut one, mut either, mut both, mut close) = (0, 0, 0, 0);
+    for (a, b) in depth_a.iter().zip(depth_b) {
+        let (ha, hb) = (*a != u32::MAX, *b != u32::MAX);
+        if !(ha || hb) {
+            continue;
+        }
+        either += 1;
+        if ha != hb {
+            one += 1;
+            continue;
+        }
+        both += 1;
+        close += usize::from((f32::from_bits(*a) - f32::from_bits(*b)).abs() <= 1e-4);
+    }
+    let sum = |v: &[u32]| v.iter().map(|&x| u64::from(x)).sum::<u64>() as f64;
+    let (sa, sb) = (sum(layers_a), sum(layers_b));
+    eprintln!(
+        "dom {label}: texels hit by one side {one} of {either}, depth close on {close} of {both}; \
+         opacity sums {sa} vs {sb}"
+    );
+    assert!(either > 1000, "{label}: only {either} DOM texels hit");
+    assert!(one as f64 <= 0.02 * either as f64, "{label}: DOM coverage");
+    assert!(close as f64 >= 0.98 * both as f64, "{label}: DOM depths");
+    assert!((sa - sb).abs() <= 0.02 * sa, "{label}: DOM opacity sums");
+}
+
 fn check_lod(label: &str, p: &Prepared, reference: &[u32], test: &[u32]) {
     let bundles = p.upload.quantities.bundles as usize;
     let same = reference
@@ -197,13 +230,15 @@ fn lipp_graph_matches_on_cpu_wgpu_and_ash() {
         "{:<16} {:>10} {:>10} {:>10}",
         "pass", "cpu ms", "wgpu ms", "ash ms"
     );
-    for ((c, g), a) in cpu.timings.iter().zip(&wgpu.timings).zip(&plain.timings) {
+    for c in &cpu.timings {
+        let g = wgpu.timings.iter().find(|t| t.name == c.name);
+        let a = plain.timings.iter().find(|t| t.name == c.name);
         eprintln!(
             "{:<16} {:>10.3} {:>10.3} {:>10.3}",
             c.name,
             c.millis,
-            g.millis,
-            a.millis.unwrap_or(f64::NAN)
+            g.map_or(f64::NAN, |t| t.millis),
+            a.and_then(|t| t.millis).unwrap_or(f64::NAN)
         );
     }
     let read_cpu = |name: &str| cpu.read(&p.plan, name).unwrap();
@@ -227,6 +262,22 @@ fn lipp_graph_matches_on_cpu_wgpu_and_ash() {
     let g = read_cpu("gbuffer");
     check_gbuffer("cpu/ash", &g, &read_ash(&plain, "gbuffer"));
     check_gbuffer("cpu/wgpu", &g, &read_wgpu("gbuffer"));
+
+    let (dd, dl) = (read_cpu("dom_depth"), read_cpu("dom_layers"));
+    check_dom(
+        "cpu/ash",
+        &dd,
+        &dl,
+        &read_ash(&plain, "dom_depth"),
+        &read_ash(&plain, "dom_layers"),
+    );
+    check_dom(
+        "cpu/wgpu",
+        &dd,
+        &dl,
+        &read_wgpu("dom_depth"),
+        &read_wgpu("dom_layers"),
+    );
 
     let out = read_cpu("output");
     check_flip(&p, "ash", &out, &read_ash(&plain, "output"));

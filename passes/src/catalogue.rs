@@ -128,9 +128,14 @@ pub static KINDS: &[PassKind] = &[
         "Lipp §3.1, Appendix B Code 1",
     ),
     kind(
-        "lipp.dom",
-        "deep opacity map per light, with the LOD depth correction (Eq. 8)",
-        "Lipp §3.2.3, §3.4",
+        "lipp.dom_depth",
+        "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
+        "Lipp §3.4; Yuksel and Keyser 2008",
+    ),
+    kind(
+        "lipp.dom_opacity",
+        "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
+        "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
     ),
     kind(
         "lipp.shade",

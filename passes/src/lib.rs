@@ -50,6 +50,8 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::history::StoreHistory,
     &lipp::lod::Lod,
     &lipp::raster::Raster,
+    &lipp::dom::DomDepth,
+    &lipp::dom::DomOpacity,
     &lipp::shade::Shade,
     &lipp::filter::Filter,
     &bench::AtomicMin32,

@@ -30,6 +30,7 @@ struct LodParams {
 const LOD_GROUP: u32 = 256u;
 
 var<workgroup> sums: array<u32, 256>;
+var<workgroup> full_sums: array<u32, 256>;
 
 // lod::snap_control_points (Lipp Eq. 5).
 fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
@@ -97,7 +98,9 @@ fn lod(@builtin(local_invocation_index) lane: u32) {
     let begin = min(lane * per, count);
     let end = min(begin + per, count);
     var sum = 0u;
+    var full = 0u;
     for (var b = begin; b < end; b++) {
+        full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
         let d = choose(b);
         bundle_lod[b * LOD_WORDS] = d.x;
         bundle_lod[b * LOD_WORDS + 1u] = d.y;
@@ -105,10 +108,13 @@ fn lod(@builtin(local_invocation_index) lane: u32) {
         sum += d.x;
     }
     sums[lane] = sum;
+    full_sums[lane] = full;
     workgroupBarrier();
     if lane == 0u {
         var acc = 0u;
+        var acc_full = 0u;
         for (var i = 0u; i < LOD_GROUP; i++) {
+            acc_full += full_sums[i];
             let s = sums[i];
             sums[i] = acc;
             acc += s;
@@ -117,6 +123,8 @@ fn lod(@builtin(local_invocation_index) lane: u32) {
         raster_args[1] = 1u;
         raster_args[2] = 1u;
         raster_args[3] = acc;
+        // β of Lipp Eq. 8 is word 3 / word 4.
+        raster_args[4] = acc_full;
     }
     workgroupBarrier();
     var first = sums[lane];

@@ -1,4 +1,6 @@
-// lipp.raster: Lipp §3.1 and Appendix B Code 1. One 32-lane workgroup per
+// lipp.raster (entry `raster`) and the deep opacity maps lipp.dom_depth and
+// lipp.dom_opacity (entries `dom_depth`, `dom_opacity`), which share the
+// strand assembly: Lipp §3.1 and Appendix B Code 1. One 32-lane workgroup per
 // strand (indirect; workgroups stride over strands beyond 65535): cooperative
 // strand assembly with subgroup shuffles, DDA rasterization into the centre
 // and conservative 64-bit G-buffer layers with atomicMin.
@@ -8,7 +10,7 @@
 // of shuffled; the bits are the same, so the result does not depend on the
 // subgroup width. Needs SHADER_INT64 and SHADER_INT64_ATOMIC_MIN_MAX.
 
-#import strandgraph::layout::FrameData
+#import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 // RasterParams (booleans as 0/1).
@@ -106,7 +108,7 @@ struct ControlPoint {
 }
 
 // strand::eval_cp over the layers in workgroup memory.
-fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32) -> ControlPoint {
+fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32, styling: bool) -> ControlPoint {
     let n = b.layers;
     let w = f32(k) / f32(c - 1u);
     let f = w * f32(n - 1u);
@@ -126,7 +128,7 @@ fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32) -> ControlPoint {
     let h11 = t3 - t2;
     var pos = (p0 * h00 + t0 * (h10 * len)) + (p1 * h01 + t1 * (h11 * len));
     let ao = sm_ao[i] + (sm_ao[i + 1u] - sm_ao[i]) * t;
-    if params.styling != 0u {
+    if styling {
         let dir = safe_normalize(lerp_vec(t0, t1, t));
         let axis = lerp_vec(sm_axis[i], sm_axis[i + 1u], t);
         let b1 = safe_normalize(axis - dir * dot(axis, dir));
@@ -270,6 +272,173 @@ fn bundle_of_strand(count: u32, s: u32) -> u32 {
     return max(lo, 1u) - 1u;
 }
 
+// One strand's assembly state (Code 1), shared by the raster and the DOM entries.
+struct Strand {
+    bundle: Bundle,
+    id: vec3<f32>,
+    uv: vec2<f32>,
+    k: u32,
+    c: u32,
+    // N / N_LOD of the strand's bundle (the DOM's density compensation).
+    thinning: f32,
+    styling: bool,
+}
+
+fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
+    let bi = bundle_of_strand(count, s);
+    let drawn = max(bundle_lod[bi * LOD_WORDS], 1u);
+    let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
+    let b = load_bundle(bi);
+    let k = s - bundle_lod[bi * LOD_WORDS + 2u];
+    let full = hairmesh_bundles[bi * BUNDLE_WORDS + 2u];
+    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling);
+}
+
+// Whether this lane's shuffle partners are its index neighbours.
+struct Lanes {
+    lane: u32,
+    has_up: bool,
+    has_down: bool,
+}
+
+fn lanes_of(lane: u32, sg_lane: u32, sg_size: u32, coop: bool) -> Lanes {
+    let up_lane = subgroupShuffleUp(lane, 1u);
+    let down_lane = subgroupShuffleDown(lane, 1u);
+    return Lanes(
+        lane,
+        coop && sg_lane > 0u && up_lane + 1u == lane,
+        coop && sg_lane + 1u < sg_size && down_lane == lane + 1u && lane + 1u < RASTER_GROUP,
+    );
+}
+
+// Pass 1 (Code 1 lines 14-28): one layer per lane into smLayer. The caller
+// puts a workgroupBarrier after it.
+fn pass_one(st: Strand, l: Lanes) {
+    let b = st.bundle;
+    let n = b.layers;
+    let lane = l.lane;
+    var mine = LayerPoint(vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
+    if lane < n {
+        mine = layer_point(b, lane, st.uv);
+    }
+    let up_pos = subgroupShuffleUp(mine.pos, 1u);
+    let down_pos = subgroupShuffleDown(mine.pos, 1u);
+    if lane < n {
+        var prev = mine.pos;
+        if lane > 0u {
+            prev = select(layer_point(b, lane - 1u, st.uv).pos, up_pos, l.has_up);
+        }
+        var next = mine.pos;
+        if lane + 1u < n {
+            next = select(layer_point(b, lane + 1u, st.uv).pos, down_pos, l.has_down);
+        }
+        sm_pos[lane] = mine.pos;
+        sm_tangent[lane] = calc_tangent(lane, n, prev, mine.pos, next);
+        sm_axis[lane] = mine.axis;
+        sm_ao[lane] = mine.ao;
+    }
+}
+
+// A lane's strip of control points with final tangents, and the next lane's
+// first point and tangent (Code 1 lines 30-50).
+struct Strip {
+    cps: array<ControlPoint, 4>,
+    tangents: array<vec3<f32>, 4>,
+    have: u32,
+    next: ControlPoint,
+    next_tangent: vec3<f32>,
+    has_next: bool,
+}
+
+fn pass_two(st: Strand, l: Lanes) -> Strip {
+    let b = st.bundle;
+    let id = st.id;
+    let c = st.c;
+    let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
+    let first = l.lane * strip;
+    let have = min(select(0u, c - first, first < c), strip);
+    var cps: array<ControlPoint, 4>;
+    for (var m = 0u; m < have; m++) {
+        cps[m] = eval_cp(b, id, first + m, c, st.styling);
+    }
+    let first_cp = cps[0];
+    let last_cp = cps[max(have, 1u) - 1u];
+    let up_cp_pos = subgroupShuffleUp(last_cp.pos, 1u);
+    let up_cp_w = subgroupShuffleUp(last_cp.w, 1u);
+    let up_cp_ao = subgroupShuffleUp(last_cp.ao, 1u);
+    let down_cp_pos = subgroupShuffleDown(first_cp.pos, 1u);
+    let down_cp_w = subgroupShuffleDown(first_cp.w, 1u);
+    let down_cp_ao = subgroupShuffleDown(first_cp.ao, 1u);
+    let end = first + have;
+    var prev = first_cp;
+    if have > 0u && first > 0u {
+        if l.has_up {
+            prev = ControlPoint(up_cp_pos, up_cp_w, up_cp_ao);
+        } else {
+            prev = eval_cp(b, id, first - 1u, c, st.styling);
+        }
+    }
+    let has_next = have > 0u && end < c;
+    var next = last_cp;
+    if has_next {
+        if l.has_down {
+            next = ControlPoint(down_cp_pos, down_cp_w, down_cp_ao);
+        } else {
+            next = eval_cp(b, id, end, c, st.styling);
+        }
+    }
+    var tangents: array<vec3<f32>, 4>;
+    for (var m = 0u; m < have; m++) {
+        var p = cps[m].pos;
+        if m > 0u {
+            p = cps[m - 1u].pos;
+        } else if first > 0u {
+            p = prev.pos;
+        }
+        var q = cps[m].pos;
+        if m + 1u < have {
+            q = cps[m + 1u].pos;
+        } else if has_next {
+            q = next.pos;
+        }
+        tangents[m] = calc_tangent(first + m, c, p, cps[m].pos, q);
+    }
+    // The next lane's first tangent (Code 1 line 46).
+    let down_t = subgroupShuffleDown(tangents[0], 1u);
+    var tn = vec3<f32>(0.0);
+    if has_next {
+        if l.has_down {
+            tn = down_t;
+        } else {
+            var after = next.pos;
+            if end + 1u < c {
+                after = eval_cp(b, id, end + 1u, c, st.styling).pos;
+            }
+            tn = calc_tangent(end, c, cps[have - 1u].pos, next.pos, after);
+        }
+    }
+    return Strip(cps, tangents, have, next, tn, has_next);
+}
+
+// Segment m of a strip: (a, ta, b, tb); valid for m + 1 < have, or the last with has_next.
+fn strip_segment_end(st: Strip, m: u32) -> ControlPoint {
+    if m + 1u < st.have {
+        return st.cps[m + 1u];
+    }
+    return st.next;
+}
+
+fn strip_segment_tangent(st: Strip, m: u32) -> vec3<f32> {
+    if m + 1u < st.have {
+        return st.tangents[m + 1u];
+    }
+    return st.next_tangent;
+}
+
+fn strip_segments(st: Strip) -> u32 {
+    return select(max(st.have, 1u) - 1u, st.have, st.has_next);
+}
+
 @compute @workgroup_size(32)
 fn raster(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -280,118 +449,259 @@ fn raster(
 ) {
     let total = raster_args[3];
     let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    let coop = params.cooperative_assembly != 0u;
-    // Whether the shuffle partners are this lane's index neighbours.
-    let up_lane = subgroupShuffleUp(lane, 1u);
-    let down_lane = subgroupShuffleDown(lane, 1u);
-    let has_up = coop && sg_lane > 0u && up_lane + 1u == lane;
-    let has_down = coop && sg_lane + 1u < sg_size && down_lane == lane + 1u && lane + 1u < RASTER_GROUP;
+    let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
-        let bi = bundle_of_strand(count, s);
-        let first_strand = bundle_lod[bi * LOD_WORDS + 2u];
-        let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
-        let b = load_bundle(bi);
-        let k = s - first_strand;
-        let uv = strand_uv(k);
-        let id = strand_id(b.seed, k);
-        let n = b.layers;
-
-        // Pass 1 (Code 1 lines 14-28): one layer per lane.
-        var mine = LayerPoint(vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
-        if lane < n {
-            mine = layer_point(b, lane, uv);
-        }
-        let up_pos = subgroupShuffleUp(mine.pos, 1u);
-        let down_pos = subgroupShuffleDown(mine.pos, 1u);
-        if lane < n {
-            var prev = mine.pos;
-            if lane > 0u {
-                prev = select(layer_point(b, lane - 1u, uv).pos, up_pos, has_up);
-            }
-            var next = mine.pos;
-            if lane + 1u < n {
-                next = select(layer_point(b, lane + 1u, uv).pos, down_pos, has_down);
-            }
-            sm_pos[lane] = mine.pos;
-            sm_tangent[lane] = calc_tangent(lane, n, prev, mine.pos, next);
-            sm_axis[lane] = mine.axis;
-            sm_ao[lane] = mine.ao;
-        }
+        let st = load_strand(count, s, params.styling != 0u);
+        pass_one(st, l);
         workgroupBarrier();
-
-        // Pass 2 (Code 1 lines 30-50): a strip of S control points per lane.
-        let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
-        let first = lane * strip;
-        let have = min(select(0u, c - first, first < c), strip);
-        var cps: array<ControlPoint, 4>;
-        for (var m = 0u; m < have; m++) {
-            cps[m] = eval_cp(b, id, first + m, c);
-        }
-        let first_cp = cps[0];
-        let last_cp = cps[max(have, 1u) - 1u];
-        let up_cp_pos = subgroupShuffleUp(last_cp.pos, 1u);
-        let up_cp_w = subgroupShuffleUp(last_cp.w, 1u);
-        let up_cp_ao = subgroupShuffleUp(last_cp.ao, 1u);
-        let down_cp_pos = subgroupShuffleDown(first_cp.pos, 1u);
-        let down_cp_w = subgroupShuffleDown(first_cp.w, 1u);
-        let down_cp_ao = subgroupShuffleDown(first_cp.ao, 1u);
-        let end = first + have;
-        var prev = first_cp;
-        if have > 0u && first > 0u {
-            if has_up {
-                prev = ControlPoint(up_cp_pos, up_cp_w, up_cp_ao);
-            } else {
-                prev = eval_cp(b, id, first - 1u, c);
-            }
-        }
-        let has_next = have > 0u && end < c;
-        var next = last_cp;
-        if has_next {
-            if has_down {
-                next = ControlPoint(down_cp_pos, down_cp_w, down_cp_ao);
-            } else {
-                next = eval_cp(b, id, end, c);
-            }
-        }
-        var tangents: array<vec3<f32>, 4>;
-        for (var m = 0u; m < have; m++) {
-            var p = cps[m].pos;
-            if m > 0u {
-                p = cps[m - 1u].pos;
-            } else if first > 0u {
-                p = prev.pos;
-            }
-            var q = cps[m].pos;
-            if m + 1u < have {
-                q = cps[m + 1u].pos;
-            } else if has_next {
-                q = next.pos;
-            }
-            tangents[m] = calc_tangent(first + m, c, p, cps[m].pos, q);
-        }
-        // The next lane's first tangent (Code 1 line 46).
-        let down_t = subgroupShuffleDown(tangents[0], 1u);
-        var tn = vec3<f32>(0.0);
-        if has_next {
-            if has_down {
-                tn = down_t;
-            } else {
-                var after = next.pos;
-                if end + 1u < c {
-                    after = eval_cp(b, id, end + 1u, c).pos;
-                }
-                tn = calc_tangent(end, c, cps[have - 1u].pos, next.pos, after);
-            }
-        }
-        for (var m = 0u; m < have; m++) {
-            if m + 1u < have {
-                draw(cps[m], tangents[m], cps[m + 1u], tangents[m + 1u], uv);
-            } else if has_next {
-                draw(cps[m], tangents[m], next, tn, uv);
-            }
+        let strip = pass_two(st, l);
+        for (var m = 0u; m < strip_segments(strip); m++) {
+            draw(strip.cps[m], strip.tangents[m], strip_segment_end(strip, m), strip_segment_tangent(strip, m), st.uv);
         }
         // smLayer is rewritten by the next strand.
+        workgroupBarrier();
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Deep opacity maps (passes/src/lipp/dom.rs). Bindings 1-5 are the raster's;
+// 0 and 6.. are the DOM entries' own.
+
+struct DomParams {
+    resolution: u32,
+    layers: u32,
+    layer_thickness: f32,
+    strand_opacity: f32,
+    density_compensation: u32,
+    cooperative_assembly: u32,
+    styling: u32,
+    bundles: u32,
+}
+
+@group(0) @binding(0) var<uniform> dom_params: DomParams;
+@group(0) @binding(6) var<storage, read> models: array<ModelData>;
+@group(0) @binding(7) var<storage, read> lights: array<LightData>;
+@group(0) @binding(8) var<storage, read_write> dom_depth: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read> dom_opacity_pass_dom_depth: array<u32>;
+@group(0) @binding(9) var<storage, read_write> dom_layers: array<atomic<u32>>;
+
+const NO_HIT: u32 = 0xFFFFFFFFu;
+const OPACITY_SCALE: f32 = 1024.0;
+
+struct LightFrame {
+    right: vec3<f32>,
+    up: vec3<f32>,
+    forward: vec3<f32>,
+    lo: vec3<f32>,
+    inv: vec3<f32>,
+    depth_extent: f32,
+}
+
+// dom::LightFrame::new over every model's bounds.
+fn light_frame(l: u32) -> LightFrame {
+    var lo = vec3<f32>(3.40282347e38);
+    var hi = vec3<f32>(-3.40282347e38);
+    let count = min(frame.model_count, arrayLength(&models));
+    for (var m = 0u; m < count; m++) {
+        lo = min(lo, models[m].bounds_min.xyz);
+        hi = max(hi, models[m].bounds_max.xyz);
+    }
+    if count == 0u {
+        lo = vec3<f32>(-1.0);
+        hi = vec3<f32>(1.0);
+    }
+    let pd = lights[l].position_or_direction;
+    var forward = safe_normalize(pd.xyz);
+    if pd.w != 0.0 {
+        forward = safe_normalize((lo + hi) * 0.5 - pd.xyz);
+    }
+    if dot(forward, forward) <= 0.0 {
+        forward = vec3<f32>(0.0, -1.0, 0.0);
+    }
+    var up0 = vec3<f32>(0.0, 1.0, 0.0);
+    if abs(forward.y) > 0.99 {
+        up0 = vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let right = safe_normalize(cross(forward, up0));
+    let up = cross(right, forward);
+    var plo = vec3<f32>(3.40282347e38);
+    var phi = vec3<f32>(-3.40282347e38);
+    for (var i = 0u; i < 8u; i++) {
+        let p = vec3<f32>(
+            select(lo.x, hi.x, (i & 1u) != 0u),
+            select(lo.y, hi.y, (i & 2u) != 0u),
+            select(lo.z, hi.z, (i & 4u) != 0u),
+        );
+        let q = vec3<f32>(dot(p, right), dot(p, up), dot(p, forward));
+        plo = min(plo, q);
+        phi = max(phi, q);
+    }
+    let pad = max((phi - plo) * 0.01, vec3<f32>(1e-3));
+    plo = plo - pad;
+    phi = phi + pad;
+    return LightFrame(right, up, forward, plo, vec3<f32>(1.0) / (phi - plo), phi.z - plo.z);
+}
+
+fn light_project(lf: LightFrame, p: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(
+        (dot(p, lf.right) - lf.lo.x) * lf.inv.x,
+        (dot(p, lf.up) - lf.lo.y) * lf.inv.y,
+        (dot(p, lf.forward) - lf.lo.z) * lf.inv.z,
+    );
+}
+
+// Number of lights the maps have room for (dom::light_frames).
+fn dom_light_count(res: u32, map_words: u32) -> u32 {
+    return min(frame.light_count, min(arrayLength(&lights), map_words / max(res * res, 1u)));
+}
+
+// Light-space segment ends: texel coordinates snapped, normalised depth.
+fn dom_end(lf: LightFrame, p: vec3<f32>, res: u32) -> vec3<f32> {
+    let q = light_project(lf, p);
+    let r = f32(res);
+    return vec3<f32>(snap(q.x * r), snap(q.y * r), q.z);
+}
+
+// One column of dom::walk: (first row, last row, depth), for column `col`.
+fn walk_column(a: vec3<f32>, b: vec3<f32>, x_major: bool, col: f32) -> vec3<f32> {
+    let ma = select(a.y, a.x, x_major);
+    let na = select(a.x, a.y, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let nb = select(b.x, b.y, x_major);
+    let dm = mb - ma;
+    let dn = nb - na;
+    var t0 = 0.0;
+    var t1 = 1.0;
+    if dm != 0.0 {
+        let ta = clamp((col - ma) / dm, 0.0, 1.0);
+        let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
+        t0 = min(ta, tb);
+        t1 = max(ta, tb);
+    }
+    let n0 = na + dn * t0;
+    let n1 = na + dn * t1;
+    let tm = 0.5 * (t0 + t1);
+    return vec3<f32>(floor(min(n0, n1)), floor(max(n0, n1)), a.z + (b.z - a.z) * tm);
+}
+
+// The columns dom::walk visits: (first, last, x_major as 0/1).
+fn walk_columns(a: vec3<f32>, b: vec3<f32>, res: u32) -> vec3<f32> {
+    let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
+    let ma = select(a.y, a.x, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let limit = f32(res);
+    return vec3<f32>(floor(max(min(ma, mb), 0.0)), floor(min(max(ma, mb), limit - 1.0)), select(0.0, 1.0, x_major));
+}
+
+fn dom_amount(st: Strand) -> u32 {
+    var thinning = 1.0;
+    if dom_params.density_compensation != 0u {
+        thinning = st.thinning;
+    }
+    return u32(floor(dom_params.strand_opacity * thinning * OPACITY_SCALE + 0.5));
+}
+
+fn dom_segment_depth(a: ControlPoint, b: ControlPoint) {
+    let res = dom_params.resolution;
+    let n = dom_light_count(res, arrayLength(&dom_depth));
+    for (var l = 0u; l < n; l++) {
+        let lf = light_frame(l);
+        let pa = dom_end(lf, a.pos, res);
+        let pb = dom_end(lf, b.pos, res);
+        let cols = walk_columns(pa, pb, res);
+        let x_major = cols.z != 0.0;
+        for (var col = cols.x; col <= cols.y; col += 1.0) {
+            let span = walk_column(pa, pb, x_major, col);
+            let z = span.z;
+            if !(z >= 0.0 && z <= 1.0) {
+                continue;
+            }
+            for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
+                let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
+                let texel = l * res * res + u32(xy.y) * res + u32(xy.x);
+                atomicMin(&dom_depth[texel], bitcast<u32>(z));
+            }
+        }
+    }
+}
+
+fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32) {
+    let res = dom_params.resolution;
+    let n = dom_light_count(res, arrayLength(&dom_opacity_pass_dom_depth));
+    for (var l = 0u; l < n; l++) {
+        let lf = light_frame(l);
+        let pa = dom_end(lf, a.pos, res);
+        let pb = dom_end(lf, b.pos, res);
+        let cols = walk_columns(pa, pb, res);
+        let x_major = cols.z != 0.0;
+        for (var col = cols.x; col <= cols.y; col += 1.0) {
+            let span = walk_column(pa, pb, x_major, col);
+            let z = span.z;
+            if !(z >= 0.0 && z <= 1.0) {
+                continue;
+            }
+            for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
+                let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
+                let texel = u32(xy.y) * res + u32(xy.x);
+                let first = dom_opacity_pass_dom_depth[l * res * res + texel];
+                if first == NO_HIT {
+                    continue;
+                }
+                // Depth behind the first hit, in layers.
+                let d = (z - bitcast<f32>(first)) * lf.depth_extent / dom_params.layer_thickness;
+                let k = min(u32(max(floor(d), 0.0)), dom_params.layers - 1u);
+                atomicAdd(&dom_layers[(l * dom_params.layers + k) * res * res + texel], amount);
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(32)
+fn dom_depth_pass(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        for (var m = 0u; m < strip_segments(strip); m++) {
+            dom_segment_depth(strip.cps[m], strip_segment_end(strip, m));
+        }
+        workgroupBarrier();
+    }
+}
+
+@compute @workgroup_size(32)
+fn dom_opacity_pass(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        let amount = dom_amount(st);
+        for (var m = 0u; m < strip_segments(strip); m++) {
+            dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount);
+        }
         workgroupBarrier();
     }
 }

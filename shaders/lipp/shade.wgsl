@@ -1,7 +1,7 @@
 // lipp.shade: Lipp §3.4, deferred shading of both G-buffer layers, one
 // invocation per pixel. Port of passes/src/lipp/shade.rs (compact Chiang 2016
-// R/TT/TRT, Kajiya-Kay-like multiple scattering, L2 SH probe lighting with
-// baked AO; no deep opacity maps yet). Writes rgba32f into `shaded`
+// R/TT/TRT, Kajiya-Kay-like multiple scattering, deep-opacity-map shadows
+// with Lipp Eq. 8's depth correction, L2 SH probe lighting with baked AO). Writes rgba32f into `shaded`
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
@@ -16,8 +16,14 @@ struct ShadeParams {
     width: u32,
     height: u32,
     lights: u32,
+    dom_shadows: u32,
+    lod_depth_correction: u32,
+    dom_resolution: u32,
+    dom_layers: u32,
+    dom_layer_thickness: f32,
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
@@ -26,7 +32,108 @@ struct ShadeParams {
 @group(0) @binding(3) var<storage, read> lights: array<LightData>;
 @group(0) @binding(4) var<storage, read> env_sh: array<vec4<f32>, 9>;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
-@group(0) @binding(6) var<storage, read_write> shaded: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> raster_args: array<u32>;
+@group(0) @binding(7) var<storage, read> dom_depth: array<u32>;
+@group(0) @binding(8) var<storage, read> dom_layers: array<u32>;
+@group(0) @binding(9) var<storage, read_write> shaded: array<vec4<f32>>;
+
+const NO_HIT: u32 = 0xFFFFFFFFu;
+const OPACITY_SCALE: f32 = 1024.0;
+
+struct LightFrame {
+    right: vec3<f32>,
+    up: vec3<f32>,
+    forward: vec3<f32>,
+    lo: vec3<f32>,
+    inv: vec3<f32>,
+    depth_extent: f32,
+}
+
+// dom::LightFrame::new over every model's bounds (as in raster.wgsl).
+fn light_frame(l: u32) -> LightFrame {
+    var lo = vec3<f32>(3.40282347e38);
+    var hi = vec3<f32>(-3.40282347e38);
+    let count = min(frame.model_count, arrayLength(&models));
+    for (var m = 0u; m < count; m++) {
+        lo = min(lo, models[m].bounds_min.xyz);
+        hi = max(hi, models[m].bounds_max.xyz);
+    }
+    if count == 0u {
+        lo = vec3<f32>(-1.0);
+        hi = vec3<f32>(1.0);
+    }
+    let pd = lights[l].position_or_direction;
+    var forward = safe_normalize(pd.xyz);
+    if pd.w != 0.0 {
+        forward = safe_normalize((lo + hi) * 0.5 - pd.xyz);
+    }
+    if dot(forward, forward) <= 0.0 {
+        forward = vec3<f32>(0.0, -1.0, 0.0);
+    }
+    var up0 = vec3<f32>(0.0, 1.0, 0.0);
+    if abs(forward.y) > 0.99 {
+        up0 = vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let right = safe_normalize(cross(forward, up0));
+    let up = cross(right, forward);
+    var plo = vec3<f32>(3.40282347e38);
+    var phi = vec3<f32>(-3.40282347e38);
+    for (var i = 0u; i < 8u; i++) {
+        let p = vec3<f32>(
+            select(lo.x, hi.x, (i & 1u) != 0u),
+            select(lo.y, hi.y, (i & 2u) != 0u),
+            select(lo.z, hi.z, (i & 4u) != 0u),
+        );
+        let q = vec3<f32>(dot(p, right), dot(p, up), dot(p, forward));
+        plo = min(plo, q);
+        phi = max(phi, q);
+    }
+    let pad = max((phi - plo) * 0.01, vec3<f32>(1e-3));
+    plo = plo - pad;
+    phi = phi + pad;
+    return LightFrame(right, up, forward, plo, vec3<f32>(1.0) / (phi - plo), phi.z - plo.z);
+}
+
+// shade::depth_correction (Lipp Eq. 8): Δ = −log β.
+fn depth_correction(drawn: u32, all: u32) -> f32 {
+    if drawn == 0u || all == 0u {
+        return 0.0;
+    }
+    return -log(f32(min(drawn, all)) / f32(all));
+}
+
+// shade::Dom::transmittance.
+fn dom_transmittance(l: u32, pos: vec3<f32>, delta: f32) -> f32 {
+    let res = params.dom_resolution;
+    let plane = res * res;
+    if l >= min(frame.light_count, arrayLength(&dom_depth) / max(plane, 1u)) {
+        return 1.0;
+    }
+    let lf = light_frame(l);
+    let q = vec3<f32>(
+        (dot(pos, lf.right) - lf.lo.x) * lf.inv.x,
+        (dot(pos, lf.up) - lf.lo.y) * lf.inv.y,
+        (dot(pos, lf.forward) - lf.lo.z) * lf.inv.z,
+    );
+    let x = floor(q.x * f32(res));
+    let y = floor(q.y * f32(res));
+    if !(x >= 0.0 && y >= 0.0 && x < f32(res) && y < f32(res)) {
+        return 1.0;
+    }
+    let texel = u32(y) * res + u32(x);
+    let first = dom_depth[l * plane + texel];
+    if first == NO_HIT {
+        return 1.0;
+    }
+    let d = (q.z - bitcast<f32>(first)) * lf.depth_extent / params.dom_layer_thickness - delta;
+    var optical = 0.0;
+    for (var k = 0u; k < params.dom_layers; k++) {
+        let part = clamp(d - f32(k), 0.0, 1.0);
+        let o = dom_layers[(l * params.dom_layers + k) * plane + texel];
+        optical += part * f32(o) / OPACITY_SCALE;
+    }
+    return exp(-optical);
+}
 
 const SHADE_GROUP: u32 = 64u;
 
@@ -142,7 +249,15 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
             l = safe_normalize(d);
             atten = 1.0 / max(dot(d, d), 1e-4);
         }
-        let rad = lights[i].radiance.xyz * atten;
+        var shadow = 1.0;
+        if params.dom_shadows != 0u {
+            var delta = 0.0;
+            if params.lod_depth_correction != 0u {
+                delta = depth_correction(raster_args[3], raster_args[4]);
+            }
+            shadow = dom_transmittance(i, pos, delta);
+        }
+        let rad = lights[i].radiance.xyz * atten * shadow;
         var f = chiang(t, l, v, color, roughness) * params.specular;
         if params.multiple_scattering != 0u {
             let sin_tl = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));

@@ -14,6 +14,9 @@ use super::strand::{
 use super::{BundleLod, BundleRecord, MAX_CONTROL_POINTS, RASTER_GROUP};
 use crate::sim::Words;
 
+/// What receives each segment: both ends and their tangents.
+pub type DrawSegment<'a> = dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]) + 'a;
+
 /// How a strand is assembled.
 #[derive(Debug, Clone, Copy)]
 pub struct Assembly {
@@ -33,7 +36,7 @@ pub fn assemble(
     lod: &BundleLod,
     k: u32,
     opts: &Assembly,
-    draw: &mut dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]),
+    draw: &mut DrawSegment<'_>,
 ) -> (u64, u64) {
     let (coop, width) = (opts.cooperative, opts.width);
     let lanes = RASTER_GROUP as usize;
@@ -149,7 +152,7 @@ pub fn assemble(
 /// Draws a lane's segments: consecutive strip points, then the segment to
 /// the next lane's first point.
 fn draw_strip(
-    draw: &mut dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]),
+    draw: &mut DrawSegment<'_>,
     cps: &[ControlPoint],
     tangents: &[[f32; 3]],
     next: Option<(ControlPoint, [f32; 3])>,

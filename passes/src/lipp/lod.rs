@@ -5,7 +5,9 @@
 //! a per-bundle random δ), and the control-point count C (Eq. 4-5, snapped to
 //! 2^k + 1). Bundles whose AABB lies outside the viewport are frustum-culled
 //! (N_LOD = 0). The counts are prefix-summed into each bundle's first strand
-//! and the total goes into the rasterizer's indirect dispatch arguments.
+//! and the total goes into the rasterizer's indirect dispatch arguments
+//! `raster_args` = (min(drawn, 65535), 1, 1, drawn, Σ N), whose last two
+//! words give `lipp.shade` the fraction β of Eq. 8.
 //!
 //! Deviation: the paper runs one thread per bundle and feeds N_LOD to a
 //! per-bundle indirect dispatch. Here the rasterizer is one flat indirect
@@ -226,9 +228,10 @@ impl CpuKernel for LodKernel {
             ctx.words("bundle_lod"),
         );
         let count = bundle_count(ctx).min(bundles.len() / BUNDLE_WORDS);
-        let mut total = 0u32;
+        let (mut total, mut full) = (0u32, 0u32);
         for b in 0..count {
             let rec = BundleRecord::load(&bundles, b);
+            full = full.saturating_add(rec.strands);
             let mut lod = choose(&self.0, &f, &layers, &rec);
             lod.first_strand = total;
             total = total.saturating_add(lod.strands);
@@ -239,6 +242,8 @@ impl CpuKernel for LodKernel {
         args.store(1, 1);
         args.store(2, 1);
         args.store(3, total);
+        // β of Lipp Eq. 8 is word 3 / word 4.
+        args.store(4, full);
     }
 }
 

@@ -71,7 +71,7 @@ fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
         .buffer("hairmesh.bundles", bundles)
         .buffer("hairmesh.layers", layers)
         .buffer("bundle_lod", vec![0; 8])
-        .buffer("raster_args", vec![0; 4])
+        .buffer("raster_args", vec![0; 8])
         .buffer("scene.depth", vec![1.0f32.to_bits(); (W * H) as usize])
         .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
     let lod = Lod

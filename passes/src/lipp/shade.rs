@@ -20,14 +20,17 @@
 //!
 //! Multiple scattering is the Kajiya-Kay-like diffuse term Lipp uses
 //! ("a Lambertian term similar to Kajiya-Kay's"): colour · sin(T, L) / π.
-//! Lights are directional and point lights without shadows: the deep opacity
-//! maps (`lipp.dom`, Lipp §3.2.3 Eq. 8) are not implemented, so
-//! `dom_shadows: true` is refused. Probe lighting uses `env.sh` (L2 SH,
+//! Lights are directional and point lights, shadowed by the deep opacity
+//! maps of `lipp.dom_depth` / `lipp.dom_opacity` (`dom_shadows`), looked up
+//! Δ = −log β layers nearer the light (Lipp Eq. 8, `lod_depth_correction`;
+//! β = drawn / all strands over the whole groom, since a G-buffer pixel does
+//! not know its bundle). The head casts no shadow on the hair. Probe lighting uses `env.sh` (L2 SH,
 //! Ramamoorthi and Hanrahan) at the fibre normal facing the viewer for the
 //! diffuse part, times the baked AO; the specular probe term uses the same
 //! radiance in place of a prefiltered GGX lookup (no environment map is
 //! uploaded, and for the constant environments of our scenes they agree).
 
+use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
@@ -46,6 +49,14 @@ pub struct ShadeParams {
     pub probe_lighting: bool,
     /// Scales the single-scattering lobes (1 = Chiang).
     pub specular: f32,
+    /// Volumetric shadows from the deep opacity maps (`lipp.dom_*`).
+    pub dom_shadows: bool,
+    /// Lipp Eq. 8: look the maps up Δ = −log β layers nearer the light.
+    pub lod_depth_correction: bool,
+    /// The maps' geometry, as the `lipp.dom_*` passes were given it.
+    pub dom_resolution: u32,
+    pub dom_layers: u32,
+    pub dom_layer_thickness: f32,
 }
 
 impl ShadeParams {
@@ -60,17 +71,26 @@ impl ShadeParams {
         if model != "Chiang16" {
             return Err(err("model", "only \"Chiang16\" is implemented"));
         }
-        if p.bool("dom_shadows", false)? {
-            return Err(err(
-                "dom_shadows",
-                "deep opacity maps (lipp.dom) are not implemented; set it to false",
-            ));
-        }
-        Ok(Self {
+        let out = Self {
             multiple_scattering: p.bool("multiple_scattering", true)?,
             probe_lighting: p.bool("probe_lighting", true)?,
             specular: p.f32("specular", 1.0)?,
-        })
+            dom_shadows: p.bool("dom_shadows", true)?,
+            lod_depth_correction: p.bool("lod_depth_correction", true)?,
+            dom_resolution: p.u32("dom_resolution", 512)?,
+            dom_layers: p.u32("dom_layers", 4)?,
+            dom_layer_thickness: p.f32("dom_layer_thickness", 0.02)?,
+        };
+        if !(16..=4096).contains(&out.dom_resolution) || !(1..=8).contains(&out.dom_layers) {
+            return Err(err(
+                "dom_resolution",
+                "dom_resolution 16..=4096, dom_layers 1..=8",
+            ));
+        }
+        if !(out.dom_layer_thickness.is_finite() && out.dom_layer_thickness > 0.0) {
+            return Err(err("dom_layer_thickness", "must be positive"));
+        }
+        Ok(out)
     }
 }
 
@@ -85,6 +105,9 @@ impl PassDef for Shade {
             Binding::read("lights"),
             Binding::read("env.sh"),
             Binding::read("gbuffer"),
+            Binding::read("raster_args"),
+            Binding::read("dom_depth"),
+            Binding::read("dom_layers"),
             Binding::write("shaded"),
         ];
         Some(BINDINGS)
@@ -118,6 +141,12 @@ impl PassDef for Shade {
             q.width,
             q.height,
             crate::contract::count(q.lights),
+            flag(p.dom_shadows),
+            flag(p.lod_depth_correction),
+            p.dom_resolution,
+            p.dom_layers,
+            p.dom_layer_thickness.to_bits(),
+            0,
             0,
             0,
         ])
@@ -240,6 +269,59 @@ pub struct Inputs<'a> {
     pub lights: &'a [LightData],
     pub sh: [[f32; 3]; 9],
     pub params: &'a ShadeParams,
+    /// The deep opacity maps and their light views (one per mapped light).
+    pub dom: Option<Dom<'a>>,
+}
+
+/// Deep opacity maps as `lipp.shade` reads them.
+pub struct Dom<'a> {
+    pub frames: Vec<LightFrame>,
+    pub depth: Words<'a>,
+    pub layers: Words<'a>,
+    /// Lipp Eq. 8's Δ = −log β, in layers (0 without the correction).
+    pub delta: f32,
+}
+
+/// Lipp Eq. 8: Δ = −log β, β = drawn / all strands.
+pub fn depth_correction(drawn: u32, all: u32) -> f32 {
+    if drawn == 0 || all == 0 {
+        return 0.0;
+    }
+    -(drawn.min(all) as f32 / all as f32).ln()
+}
+
+impl Dom<'_> {
+    /// Transmittance towards light `l` at `pos` (Yuksel and Keyser 2008):
+    /// the opacity of the layers in front of the point's depth behind the
+    /// first hit, the layer it is in counted in proportion.
+    pub fn transmittance(&self, p: &ShadeParams, l: usize, pos: [f32; 3]) -> f32 {
+        let Some(lf) = self.frames.get(l) else {
+            return 1.0;
+        };
+        let res = p.dom_resolution;
+        let q = lf.project(pos);
+        let (x, y) = ((q[0] * res as f32).floor(), (q[1] * res as f32).floor());
+        if !(x >= 0.0 && y >= 0.0 && x < res as f32 && y < res as f32) {
+            return 1.0;
+        }
+        let texel = (y as u32 * res + x as u32) as usize;
+        let plane = (res * res) as usize;
+        let first = self.depth.load(l * plane + texel);
+        if first == NO_HIT {
+            return 1.0;
+        }
+        let d =
+            (q[2] - f32::from_bits(first)) * lf.depth_extent / p.dom_layer_thickness - self.delta;
+        let mut optical = 0.0;
+        for k in 0..p.dom_layers {
+            let part = (d - k as f32).clamp(0.0, 1.0);
+            let o = self
+                .layers
+                .load((l * p.dom_layers as usize + k as usize) * plane + texel);
+            optical += part * o as f32 / OPACITY_SCALE;
+        }
+        (-optical).exp()
+    }
 }
 
 /// Radiance towards the camera of one G-buffer sample at pixel (x, y).
@@ -261,7 +343,7 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
         roughness: c[3],
     };
     let mut out = [0.0f32; 3];
-    for light in inp.lights {
+    for (li, light) in inp.lights.iter().enumerate() {
         let pd = light.position_or_direction;
         let (l, atten) = if pd[3] == 0.0 {
             (normalize([-pd[0], -pd[1], -pd[2]]), 1.0)
@@ -273,6 +355,11 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
             [light.radiance[0], light.radiance[1], light.radiance[2]],
             atten,
         );
+        let shadow = match &inp.dom {
+            Some(dom) => dom.transmittance(inp.params, li, pos),
+            None => 1.0,
+        };
+        let rad = scale(rad, shadow);
         let single = scale(chiang(t, l, v, &m), inp.params.specular);
         let mut f = single;
         if inp.params.multiple_scattering {
@@ -323,6 +410,20 @@ impl CpuKernel for ShadeKernel {
             lights: &lights,
             sh: load_sh(&ctx.words("env.sh")),
             params: &self.0,
+            dom: self.0.dom_shadows.then(|| {
+                let depth = ctx.words("dom_depth");
+                let args = ctx.words("raster_args");
+                Dom {
+                    frames: light_frames(ctx, self.0.dom_resolution, depth.len()),
+                    depth,
+                    layers: ctx.words("dom_layers"),
+                    delta: if self.0.lod_depth_correction {
+                        depth_correction(args.load(3), args.load(4))
+                    } else {
+                        0.0
+                    },
+                }
+            }),
         };
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
@@ -373,8 +474,12 @@ mod tests {
     }
 
     #[test]
-    fn dom_shadows_are_refused_not_ignored() {
-        let v: ron::Value = ron::from_str(r#"{"dom_shadows": true}"#).unwrap();
+    fn eq8_shift_is_zero_without_culling_and_grows_as_strands_go() {
+        assert_eq!(depth_correction(100, 100), 0.0);
+        assert!((depth_correction(50, 100) - std::f32::consts::LN_2).abs() < 1e-6);
+        assert!(depth_correction(10, 100) > depth_correction(50, 100));
+        assert_eq!(depth_correction(0, 100), 0.0);
+        let v: ron::Value = ron::from_str(r#"{"dom_layers": 0}"#).unwrap();
         assert!(ShadeParams::from_ron(&v).is_err());
     }
 }

@@ -1,0 +1,423 @@
+//! `lipp.dom_depth` and `lipp.dom_opacity`: deep opacity maps (Yuksel and
+//! Keyser 2008) per light, which Lipp §3.4 uses for volumetric shadows from
+//! point lights, "which we query using the depth-correction described in
+//! Section 3.2" (Eq. 8, applied in `lipp.shade`).
+//!
+//! Both passes rasterize the drawn (LOD-reduced) strands once more, in the
+//! light's view: the strand is assembled once per workgroup (Code 1, shared
+//! with `lipp.raster`) and projected per light ("Strand assembly is performed
+//! only once, while projection is executed per view", Lipp §5). The light's
+//! view is orthographic along its direction (a point light: from the light to
+//! the hair's bounds centre), fitted to the bounds of every model.
+//! 1. `dom_depth`: the first-hit depth per texel (atomicMin on the f32 bits of
+//!    a depth in [0, 1], which order like the floats).
+//! 2. `dom_opacity`: each strand texel adds `strand_opacity` (fixed point,
+//!    1/1024) to the layer its depth behind the first hit falls in; layers
+//!    are `layer_thickness` metres deep.
+//!
+//! Deviation: Lipp's Fig. 4 problem is a depth map built from more strands
+//! than are drawn. Here the maps are built from the drawn strands, each
+//! strand's opacity scaled by N / N_LOD of its bundle (`density_compensation`,
+//! stochastic simplification's "thicken the remaining ones"), so the optical
+//! depth is preserved in expectation; Eq. 8's shift stays available in
+//! `lipp.shade` (`lod_depth_correction`) for the ablation.
+
+use super::assemble::{Assembly, assemble};
+use super::strand::ControlPoint;
+use super::{
+    BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, cross, dot,
+    frame, normalize, scale, sub,
+};
+use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::layout::{LightData, ModelData, read};
+use crate::sim::{Ctx, Words};
+
+/// Fixed-point scale of the opacity layers.
+pub const OPACITY_SCALE: f32 = 1024.0;
+/// A texel no strand reached (the clear value).
+pub const NO_HIT: u32 = u32::MAX;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DomParams {
+    pub resolution: u32,
+    pub layers: u32,
+    /// Metres per opacity layer.
+    pub layer_thickness: f32,
+    /// Opacity one strand adds to a texel it crosses.
+    pub strand_opacity: f32,
+    pub density_compensation: bool,
+    pub cooperative_assembly: bool,
+    pub styling: bool,
+}
+
+impl DomParams {
+    pub fn from_ron(kind: &'static str, v: &ron::Value) -> Result<Self, ParamError> {
+        let p = Params::new(kind, v)?;
+        let out = Self {
+            resolution: p.u32("resolution", 512)?,
+            layers: p.u32("layers", 4)?,
+            layer_thickness: p.f32("layer_thickness", 0.02)?,
+            strand_opacity: p.f32("strand_opacity", 0.02)?,
+            density_compensation: p.bool("density_compensation", true)?,
+            cooperative_assembly: p.bool("cooperative_assembly", true)?,
+            styling: p.bool("styling", true)?,
+        };
+        let bad = |param: &str, message: String| ParamError {
+            kind,
+            param: param.into(),
+            message,
+        };
+        if !(16..=4096).contains(&out.resolution) {
+            return Err(bad(
+                "resolution",
+                format!("{} is outside 16..=4096", out.resolution),
+            ));
+        }
+        if !(1..=8).contains(&out.layers) {
+            return Err(bad("layers", format!("{} is outside 1..=8", out.layers)));
+        }
+        if !(out.layer_thickness.is_finite() && out.layer_thickness > 0.0) {
+            return Err(bad("layer_thickness", "must be positive".into()));
+        }
+        if !(out.strand_opacity.is_finite() && out.strand_opacity >= 0.0) {
+            return Err(bad("strand_opacity", "must be >= 0".into()));
+        }
+        Ok(out)
+    }
+
+    /// The WGSL `DomParams` block.
+    pub fn words(&self, q: &strandgraph_graph::Quantities) -> Vec<u32> {
+        vec![
+            self.resolution,
+            self.layers,
+            self.layer_thickness.to_bits(),
+            self.strand_opacity.to_bits(),
+            flag(self.density_compensation),
+            flag(self.cooperative_assembly),
+            flag(self.styling),
+            crate::contract::count(q.bundles),
+        ]
+    }
+}
+
+/// An orthographic light view fitted to the hair's bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightFrame {
+    pub right: [f32; 3],
+    pub up: [f32; 3],
+    pub forward: [f32; 3],
+    /// Minimum of (u, v, w) over the bounds.
+    pub lo: [f32; 3],
+    /// 1 / extent of (u, v, w).
+    pub inv: [f32; 3],
+    /// Extent of w in metres.
+    pub depth_extent: f32,
+}
+
+impl LightFrame {
+    /// The view of `light` over the union of `models`' bounds.
+    pub fn new(light: &LightData, models: &[ModelData]) -> Self {
+        let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for m in models {
+            for a in 0..3 {
+                lo[a] = lo[a].min(m.bounds_min[a]);
+                hi[a] = hi[a].max(m.bounds_max[a]);
+            }
+        }
+        if models.is_empty() {
+            (lo, hi) = ([-1.0; 3], [1.0; 3]);
+        }
+        let pd = light.position_or_direction;
+        let forward = if pd[3] == 0.0 {
+            normalize([pd[0], pd[1], pd[2]])
+        } else {
+            let c = scale([lo[0] + hi[0], lo[1] + hi[1], lo[2] + hi[2]], 0.5);
+            normalize(sub(c, [pd[0], pd[1], pd[2]]))
+        };
+        let forward = if dot(forward, forward) > 0.0 {
+            forward
+        } else {
+            [0.0, -1.0, 0.0]
+        };
+        let up0 = if forward[1].abs() > 0.99 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let right = normalize(cross(forward, up0));
+        let up = cross(right, forward);
+        let (mut plo, mut phi) = ([f32::MAX; 3], [f32::MIN; 3]);
+        for i in 0..8 {
+            let p = [
+                if i & 1 == 0 { lo[0] } else { hi[0] },
+                if i & 2 == 0 { lo[1] } else { hi[1] },
+                if i & 4 == 0 { lo[2] } else { hi[2] },
+            ];
+            let q = [dot(p, right), dot(p, up), dot(p, forward)];
+            for a in 0..3 {
+                plo[a] = plo[a].min(q[a]);
+                phi[a] = phi[a].max(q[a]);
+            }
+        }
+        let mut inv = [0.0; 3];
+        for a in 0..3 {
+            let pad = ((phi[a] - plo[a]) * 0.01).max(1e-3);
+            plo[a] -= pad;
+            phi[a] += pad;
+            inv[a] = 1.0 / (phi[a] - plo[a]);
+        }
+        Self {
+            right,
+            up,
+            forward,
+            lo: plo,
+            inv,
+            depth_extent: phi[2] - plo[2],
+        }
+    }
+
+    /// (u, v, depth) in [0, 1]³ for points inside the bounds.
+    pub fn project(&self, p: [f32; 3]) -> [f32; 3] {
+        [
+            (dot(p, self.right) - self.lo[0]) * self.inv[0],
+            (dot(p, self.up) - self.lo[1]) * self.inv[1],
+            (dot(p, self.forward) - self.lo[2]) * self.inv[2],
+        ]
+    }
+}
+
+/// Every light's view, for the lights the maps have room for.
+pub fn light_frames(ctx: &Ctx<'_>, res: u32, maps: usize) -> Vec<LightFrame> {
+    let f = frame(ctx);
+    let mw = ctx.words("models");
+    let models: Vec<ModelData> = (0..f.model_count as usize).map(|m| read(&mw, m)).collect();
+    let lw = ctx.words("lights");
+    let per = (res * res) as usize;
+    let n = (f.light_count as usize).min(maps / per.max(1));
+    (0..n)
+        .map(|l| LightFrame::new(&read::<LightData>(&lw, l), &models))
+        .collect()
+}
+
+/// A conservative DDA walk over the texels segment (a, b) crosses (pixel
+/// coordinates, depth), the conservative half of `lipp.raster`'s walk;
+/// `visit(x, y, depth)`.
+pub fn walk(a: [f32; 3], b: [f32; 3], res: u32, visit: &mut dyn FnMut(u32, u32, f32)) {
+    let x_major = (b[0] - a[0]).abs() >= (b[1] - a[1]).abs();
+    let (ma, na, mb, nb) = if x_major {
+        (a[0], a[1], b[0], b[1])
+    } else {
+        (a[1], a[0], b[1], b[0])
+    };
+    let (dm, dn) = (mb - ma, nb - na);
+    let limit = res as f32;
+    let lo = ma.min(mb).max(0.0).floor();
+    let hi = ma.max(mb).min(limit - 1.0).floor();
+    let mut col = lo;
+    while col <= hi {
+        let (t0, t1) = if dm != 0.0 {
+            let ta = ((col - ma) / dm).clamp(0.0, 1.0);
+            let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
+            (ta.min(tb), ta.max(tb))
+        } else {
+            (0.0, 1.0)
+        };
+        let (n0, n1) = (na + dn * t0, na + dn * t1);
+        let (r0, r1) = (n0.min(n1).floor(), n0.max(n1).floor());
+        let tm = 0.5 * (t0 + t1);
+        let z = a[2] + (b[2] - a[2]) * tm;
+        let mut row = r0.max(0.0);
+        while row <= r1.min(limit - 1.0) {
+            let (x, y) = if x_major { (col, row) } else { (row, col) };
+            visit(x as u32, y as u32, z);
+            row += 1.0;
+        }
+        col += 1.0;
+    }
+}
+
+fn snap(v: f32) -> f32 {
+    (v * super::raster::SNAP + 0.5).floor() / super::raster::SNAP
+}
+
+/// Which map a pass writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    Depth,
+    Opacity,
+}
+
+pub struct DomDepth;
+pub struct DomOpacity;
+
+const DEPTH_BINDINGS: &[Binding] = &[
+    Binding::read("frame"),
+    Binding::read("raster_args"),
+    Binding::read("bundle_lod"),
+    Binding::read("hairmesh.bundles"),
+    Binding::read("hairmesh.layers"),
+    Binding::read("models"),
+    Binding::read("lights"),
+    Binding::atomic("dom_depth"),
+];
+
+const OPACITY_BINDINGS: &[Binding] = &[
+    Binding::read("frame"),
+    Binding::read("raster_args"),
+    Binding::read("bundle_lod"),
+    Binding::read("hairmesh.bundles"),
+    Binding::read("hairmesh.layers"),
+    Binding::read("models"),
+    Binding::read("lights"),
+    Binding::read("dom_depth"),
+    Binding::atomic("dom_layers"),
+];
+
+macro_rules! dom_pass {
+    ($ty:ident, $kind:literal, $entry:literal, $bindings:ident, $stage:expr) => {
+        impl PassDef for $ty {
+            fn kind(&self) -> &'static str {
+                $kind
+            }
+            fn bindings(&self) -> Option<&'static [Binding]> {
+                Some($bindings)
+            }
+            fn workgroup_size(&self) -> u32 {
+                RASTER_GROUP
+            }
+            fn dispatch(&self) -> Dispatch {
+                Dispatch::Indirect {
+                    binding: "raster_args",
+                    word: 0,
+                }
+            }
+            fn shader(&self) -> Shader {
+                Shader::compute("lipp/raster.wgsl", $entry)
+            }
+            fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
+                Ok(Box::new(DomKernel {
+                    stage: $stage,
+                    p: DomParams::from_ron($kind, params)?,
+                }))
+            }
+            /// `DomParams` in shaders/lipp/raster.wgsl.
+            fn gpu_params(
+                &self,
+                params: &ron::Value,
+                q: &strandgraph_graph::Quantities,
+            ) -> Result<Vec<u32>, ParamError> {
+                Ok(DomParams::from_ron($kind, params)?.words(q))
+            }
+        }
+    };
+}
+
+dom_pass!(
+    DomDepth,
+    "lipp.dom_depth",
+    "dom_depth_pass",
+    DEPTH_BINDINGS,
+    Stage::Depth
+);
+dom_pass!(
+    DomOpacity,
+    "lipp.dom_opacity",
+    "dom_opacity_pass",
+    OPACITY_BINDINGS,
+    Stage::Opacity
+);
+
+struct DomKernel {
+    stage: Stage,
+    p: DomParams,
+}
+
+impl DomKernel {
+    /// One texel (x, y) of light `l`'s maps at normalised depth `z`.
+    fn visit(
+        &self,
+        maps: (&Words<'_>, &Words<'_>),
+        l: usize,
+        lf: &LightFrame,
+        (x, y, z): (u32, u32, f32),
+        amount: u32,
+    ) {
+        let res = self.p.resolution;
+        let texel = l * (res * res) as usize + (y * res + x) as usize;
+        if !(0.0..=1.0).contains(&z) {
+            return;
+        }
+        match self.stage {
+            Stage::Depth => {
+                maps.0.fetch_min(texel, z.to_bits());
+            }
+            Stage::Opacity => {
+                let first = maps.0.load(texel);
+                if first == NO_HIT {
+                    return;
+                }
+                // Depth behind the first hit, in layers.
+                let d = (z - f32::from_bits(first)) * lf.depth_extent / self.p.layer_thickness;
+                let k = (d.floor().max(0.0) as u32).min(self.p.layers - 1) as usize;
+                let layer = l * self.p.layers as usize + k;
+                maps.1.fetch_add(
+                    layer * (res * res) as usize + (y * res + x) as usize,
+                    amount,
+                );
+            }
+        }
+    }
+}
+
+impl CpuKernel for DomKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let res = self.p.resolution;
+        let depth = ctx.words("dom_depth");
+        let layers_map = match self.stage {
+            Stage::Depth => depth,
+            Stage::Opacity => ctx.words("dom_layers"),
+        };
+        let lights = light_frames(ctx, res, depth.len());
+        if lights.is_empty() {
+            return;
+        }
+        let (lods, bundles, layers) = (
+            ctx.words("bundle_lod"),
+            ctx.words("hairmesh.bundles"),
+            ctx.words("hairmesh.layers"),
+        );
+        let total = ctx.words("raster_args").load(3);
+        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
+        let opts = Assembly {
+            width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
+            cooperative: self.p.cooperative_assembly,
+            styling: self.p.styling,
+        };
+        let stride = ctx.workgroups.max(1);
+        let mut s = group;
+        while s < total {
+            let b = bundle_of_strand(|i| lods.load(i * LOD_WORDS + 2), count, s);
+            let lod = BundleLod::load(&lods, b);
+            let rec = BundleRecord::load(&bundles, b);
+            let thinning = if self.p.density_compensation {
+                rec.strands as f32 / lod.strands.max(1) as f32
+            } else {
+                1.0
+            };
+            let amount = (self.p.strand_opacity * thinning * OPACITY_SCALE + 0.5).floor() as u32;
+            let mut draw = |a: &ControlPoint, _: [f32; 3], b: &ControlPoint, _: [f32; 3]| {
+                for (l, lf) in lights.iter().enumerate() {
+                    let (pa, pb) = (lf.project(a.pos), lf.project(b.pos));
+                    let r = res as f32;
+                    let pa = [snap(pa[0] * r), snap(pa[1] * r), pa[2]];
+                    let pb = [snap(pb[0] * r), snap(pb[1] * r), pb[2]];
+                    walk(pa, pb, res, &mut |x, y, z| {
+                        self.visit((&depth, &layers_map), l, lf, (x, y, z), amount);
+                    });
+                }
+            };
+            assemble(&layers, &rec, &lod, s - lod.first_strand, &opts, &mut draw);
+            s += stride;
+        }
+    }
+}
