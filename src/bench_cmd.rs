@@ -88,10 +88,10 @@ pub const VARIANTS: &[Variant] = &[
         ceiling: "atomic_min32",
     },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
-    // filter (lipp.filter), L = LOD (lipp.lod). `filter.enabled=false`
+    // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
+    // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`
     // composites the centre layer as is; `lod.enabled=false` draws every
-    // strand at C_max control points. The MSAA reference rows (SWR 2/4/8)
-    // need the raster's multi-sample mode, which is not implemented.
+    // strand at C_max control points.
     Variant {
         pipeline: "Lipp",
         name: "SWR 1",
@@ -124,9 +124,58 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 2",
+        graph: LIPP_MSAA,
+        overrides: &["lod.enabled=false", "raster.msaa=2", "filter.msaa=2"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 4",
+        graph: LIPP_MSAA,
+        overrides: &["lod.enabled=false", "raster.msaa=4", "filter.msaa=4"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 8",
+        graph: LIPP_MSAA,
+        overrides: &["lod.enabled=false", "raster.msaa=8", "filter.msaa=8"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 2+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=2", "filter.msaa=2"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 4+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=4", "filter.msaa=4"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 8+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=8", "filter.msaa=8"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
 ];
 
 const LIPP: &str = "scenes/graphs/lipp.ron";
+const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";
 
 const VIEWS: [&str; 3] = [
     "scenes/distances/close.ron",

@@ -43,7 +43,7 @@ fn out_dir() -> PathBuf {
 }
 
 /// The mid view with a small groom, written next to the other outputs.
-fn small_scene() -> PathBuf {
+fn small_scene(tag: &str) -> PathBuf {
     let graph = root().join("scenes/graphs/lipp.ron");
     let text = format!(
         r#"Scene(
@@ -63,7 +63,8 @@ fn small_scene() -> PathBuf {
 )
 "#
     );
-    let path = out_dir().join("small.ron");
+    // One file per test: tests run in parallel.
+    let path = out_dir().join(format!("small_{tag}.ron"));
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -94,32 +95,34 @@ fn read_ash(s: &Session, name: &str) -> Vec<u32> {
 
 /// Per G-buffer layer: (covered by exactly one side, covered by either,
 /// covered by both, both covered with depth within 1e-4, bit-identical).
-fn gbuffer_agreement(a: &[u32], b: &[u32]) -> [(usize, usize, usize, usize, usize); 2] {
+fn gbuffer_agreement(a: &[u32], b: &[u32]) -> Vec<(usize, usize, usize, usize, usize)> {
     let pixels = (W * H) as usize;
-    assert_eq!(a.len(), 4 * pixels);
-    assert_eq!(b.len(), 4 * pixels);
-    std::array::from_fn(|layer| {
-        let (mut one, mut either, mut both, mut close, mut exact) = (0, 0, 0, 0, 0);
-        for i in 0..pixels {
-            let slot = layer * pixels + i;
-            let pa = u64::from(a[2 * slot]) | (u64::from(a[2 * slot + 1]) << 32);
-            let pb = u64::from(b[2 * slot]) | (u64::from(b[2 * slot + 1]) << 32);
-            let (ca, cb) = (pa != u64::MAX, pb != u64::MAX);
-            if !(ca || cb) {
-                continue;
+    let layers = a.len() / (2 * pixels);
+    assert_eq!(a.len(), b.len());
+    (0..layers)
+        .map(|layer| {
+            let (mut one, mut either, mut both, mut close, mut exact) = (0, 0, 0, 0, 0);
+            for i in 0..pixels {
+                let slot = layer * pixels + i;
+                let pa = u64::from(a[2 * slot]) | (u64::from(a[2 * slot + 1]) << 32);
+                let pb = u64::from(b[2 * slot]) | (u64::from(b[2 * slot + 1]) << 32);
+                let (ca, cb) = (pa != u64::MAX, pb != u64::MAX);
+                if !(ca || cb) {
+                    continue;
+                }
+                either += 1;
+                if ca != cb {
+                    one += 1;
+                    continue;
+                }
+                both += 1;
+                let depth = |p: u64| (p >> 40) as f64 / 16_777_215.0;
+                close += usize::from((depth(pa) - depth(pb)).abs() <= 1e-4);
+                exact += usize::from(pa == pb);
             }
-            either += 1;
-            if ca != cb {
-                one += 1;
-                continue;
-            }
-            both += 1;
-            let depth = |p: u64| (p >> 40) as f64 / 16_777_215.0;
-            close += usize::from((depth(pa) - depth(pb)).abs() <= 1e-4);
-            exact += usize::from(pa == pb);
-        }
-        (one, either, both, close, exact)
-    })
+            (one, either, both, close, exact)
+        })
+        .collect()
 }
 
 fn check_gbuffer(label: &str, reference: &[u32], test: &[u32]) {
@@ -186,6 +189,7 @@ fn check_lod(label: &str, p: &Prepared, reference: &[u32], test: &[u32]) {
 }
 
 fn check_flip(p: &Prepared, label: &str, reference: &[u32], test: &[u32]) {
+    let label = &format!("{}.{label}", p.plan.graph.name);
     let name = "output.final";
     let r = p.plan.graph.resource_id(name).unwrap();
     let a = to_picture(&p.plan, r, reference, W, H).unwrap();
@@ -212,7 +216,23 @@ fn check_flip(p: &Prepared, label: &str, reference: &[u32], test: &[u32]) {
 
 #[test]
 fn lipp_graph_matches_on_cpu_wgpu_and_ash() {
-    let p = prepare(&small_scene(), None, Some((W, H))).unwrap_or_else(|e| panic!("{e:?}"));
+    run(None);
+}
+
+/// The MSAA reference mode (`scenes/graphs/lipp_msaa.ron`, 8 sample layers).
+#[test]
+fn lipp_msaa_graph_matches_on_cpu_wgpu_and_ash() {
+    run(Some("scenes/graphs/lipp_msaa.ron"));
+}
+
+fn run(graph: Option<&str>) {
+    let tag = graph.map_or(
+        "lipp",
+        |g| if g.contains("msaa") { "msaa" } else { "other" },
+    );
+    let graph = graph.map(|g| root().join(g));
+    let p = prepare(&small_scene(tag), graph.as_deref(), Some((W, H)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
     assert_eq!(p.upload.quantities.bundles, 128);
     let plain = ash(&p, false);
     let aliased = ash(&p, true);

@@ -21,6 +21,9 @@ struct FilterParams {
     // Scene quantities.
     width: u32,
     height: u32,
+    // MSAA reference resolve (0: the single-sample filter).
+    msaa: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -33,8 +36,14 @@ fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
 }
 
+// lipp::gbuffer_layers.
+fn layer_count() -> u32 {
+    let pixels = max(params.width * params.height, 1u);
+    return max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / pixels, 2u);
+}
+
 fn color(layer: u32, i: u32) -> vec4<f32> {
-    return shaded[2u * i + layer];
+    return shaded[layer_count() * i + layer];
 }
 
 fn lin(z: f32) -> f32 {
@@ -136,7 +145,21 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
     let cons = !is_empty(a);
     let scene = textureLoad(output, vec2<u32>(x, y));
     var out = vec4<f32>(0.0);
-    if params.enabled == 0u {
+    if params.msaa > 1u {
+        // MSAA reference resolve (Lipp Fig. 5, "MSAA 8").
+        var sum = vec3<f32>(0.0);
+        var hits = 0u;
+        for (var s = 0u; s < min(params.msaa, layer_count()); s++) {
+            if !is_empty(payload(s, i)) {
+                sum += color(s, i).xyz;
+                hits += 1u;
+            }
+        }
+        if hits == 0u {
+            return;
+        }
+        out = vec4<f32>(sum / f32(hits), f32(hits) / f32(params.msaa));
+    } else if params.enabled == 0u {
         if !centre {
             return;
         }

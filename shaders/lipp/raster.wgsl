@@ -23,7 +23,8 @@ struct RasterParams {
     bundles: u32,
     width: u32,
     height: u32,
-    _pad: u32,
+    // MSAA reference mode: 2, 4 or 8 sample layers (0 or 1: off).
+    msaa: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
@@ -249,11 +250,73 @@ fn draw_segment(a: End, b: End, uv: vec2<f32>) {
     }
 }
 
+// raster::sample_positions: Direct3D's standard sample positions.
+fn sample_offset(n: u32, s: u32) -> vec2<f32> {
+    var two = array<vec2<i32>, 2>(vec2<i32>(4, 4), vec2<i32>(-4, -4));
+    var four = array<vec2<i32>, 4>(vec2<i32>(-2, -6), vec2<i32>(6, -2), vec2<i32>(-6, 2), vec2<i32>(2, 6));
+    var eight = array<vec2<i32>, 8>(
+        vec2<i32>(1, -3), vec2<i32>(-1, 3), vec2<i32>(5, 1), vec2<i32>(-3, -5),
+        vec2<i32>(-5, 5), vec2<i32>(-7, -1), vec2<i32>(3, 7), vec2<i32>(7, -7),
+    );
+    var g = vec2<i32>(0, 0);
+    if n == 2u {
+        g = two[s];
+    } else if n == 4u {
+        g = four[s];
+    } else if n == 8u {
+        g = eight[s];
+    }
+    return vec2<f32>(f32(g.x) / 16.0, f32(g.y) / 16.0);
+}
+
+// Target::segment_msaa: every sample within centre_diameter / 2 of the
+// segment, in every pixel the segment touches.
+fn draw_segment_msaa(a: End, b: End, uv: vec2<f32>) {
+    let n = params.msaa;
+    let layers = min(n, arrayLength(&gbuffer) / max(params.width * params.height, 1u));
+    let half = params.centre_diameter * 0.5;
+    let dx = b.x - a.x;
+    let dy = b.y - a.y;
+    let len2 = dx * dx + dy * dy;
+    let x_major = abs(dx) >= abs(dy);
+    let ma = select(a.y, a.x, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let limit = f32(select(params.height, params.width, x_major));
+    let lo = floor(max(min(ma, mb), 0.0));
+    let hi = floor(min(max(ma, mb), limit - 1.0));
+    let pa = vec3<f32>(a.x, a.y, 0.0);
+    let pb = vec3<f32>(b.x, b.y, 0.0);
+    for (var col = lo; col <= hi; col += 1.0) {
+        let span = walk_column(pa, pb, x_major, col);
+        for (var row = i32(span.x); row <= i32(span.y); row++) {
+            let p = pixel_of(x_major, i32(col), row);
+            for (var s = 0u; s < layers; s++) {
+                let o = sample_offset(n, s);
+                let px = f32(p.x) + 0.5 + o.x;
+                let py = f32(p.y) + 0.5 + o.y;
+                var t = 0.0;
+                if len2 > 0.0 {
+                    t = clamp(((px - a.x) * dx + (py - a.y) * dy) / len2, 0.0, 1.0);
+                }
+                let ex = a.x + dx * t - px;
+                let ey = a.y + dy * t - py;
+                if ex * ex + ey * ey <= half * half {
+                    write_sample(a, b, t, p.x, p.y, s, uv);
+                }
+            }
+        }
+    }
+}
+
 fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>) {
     let pa = project(a, ta);
     let pb = project(b, tb);
     if pa.ok && pb.ok {
-        draw_segment(pa, pb, uv);
+        if params.msaa > 1u {
+            draw_segment_msaa(pa, pb, uv);
+        } else {
+            draw_segment(pa, pb, uv);
+        }
     }
 }
 

@@ -287,12 +287,14 @@ fn shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let x = i % params.width;
     let y = i / params.width;
-    for (var layer = 0u; layer < 2u; layer++) {
+    // lipp::gbuffer_layers.
+    let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
+    for (var layer = 0u; layer < layers; layer++) {
         let p = gbuffer[layer * pixels + i];
         var c = vec4<f32>(0.0);
         if !is_empty(p) {
             c = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
         }
-        shaded[2u * i + layer] = c;
+        shaded[layers * i + layer] = c;
     }
 }

@@ -23,7 +23,9 @@
 //! 5e-4 are in an unstated depth space. Code 2 counts strip hits with P's own
 //! flags (`isCenter`), which the text contradicts; we count Q's. A promoted
 //! pixel with no centre-hit neighbour keeps its own conservative shading.
-//! With `enabled: false` the centre layer is composited as is (SWR 1).
+//! With `enabled: false` the centre layer is composited as is (SWR 1); with
+//! `msaa` N the N sample layers of the raster's MSAA reference mode are
+//! averaged, α = hits / N (SWR 2/4/8).
 
 use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::shade::world_position;
@@ -51,6 +53,9 @@ pub struct FilterParams {
     pub strip_width: f32,
     pub depth_threshold: f32,
     pub front_threshold: f32,
+    /// MSAA reference resolve: average the N sample layers, α = hits / N
+    /// (0: the single-sample filter above).
+    pub msaa: u32,
 }
 
 impl FilterParams {
@@ -67,12 +72,16 @@ impl FilterParams {
             strip_width: p.f32("strip_width", 0.5)?,
             depth_threshold: p.f32("depth_threshold", 0.05)?,
             front_threshold: p.f32("front_threshold", 0.01)?,
+            msaa: p.u32("msaa", 0)?,
         };
         let bad = |param: &str, message: String| ParamError {
             kind: "lipp.filter",
             param: param.into(),
             message,
         };
+        if ![0, 1, 2, 4, 8].contains(&out.msaa) {
+            return Err(bad("msaa", format!("{} is not 0, 1, 2, 4 or 8", out.msaa)));
+        }
         if !(1..=MAX_RADIUS).contains(&out.radius) {
             return Err(bad(
                 "radius",
@@ -140,6 +149,8 @@ impl PassDef for Filter {
             p.front_threshold.to_bits(),
             q.width,
             q.height,
+            p.msaa,
+            0,
         ])
     }
 }
@@ -174,6 +185,8 @@ pub fn screen_tangent(f: &FrameData, x: u32, y: u32, s: &Sample) -> [f32; 2] {
 /// The two layers and shaded colours of every pixel, read through words.
 pub struct View<'a> {
     pub f: &'a FrameData,
+    /// G-buffer layers ([`super::gbuffer_layers`]).
+    pub layers: u32,
     pub width: u32,
     pub height: u32,
     pub gbuffer: Words<'a>,
@@ -186,7 +199,7 @@ impl View<'_> {
         from_words(self.gbuffer.load(2 * slot), self.gbuffer.load(2 * slot + 1))
     }
     pub fn color(&self, layer: u32, i: u32) -> [f32; 4] {
-        self.shaded.load_vec4((2 * i + layer) as usize)
+        self.shaded.load_vec4((self.layers * i + layer) as usize)
     }
 }
 
@@ -304,6 +317,24 @@ pub fn filter_pixel(
             scene[3],
         ])
     };
+    if p.msaa > 1 {
+        // MSAA reference resolve (Lipp Fig. 5, "MSAA 8").
+        let (mut sum, mut hits) = ([0.0f32; 3], 0u32);
+        for s in 0..p.msaa.min(v.layers) {
+            if v.payload(s, i) != EMPTY {
+                let c = v.color(s, i);
+                for k in 0..3 {
+                    sum[k] += c[k];
+                }
+                hits += 1;
+            }
+        }
+        if hits == 0 {
+            return None;
+        }
+        let n = hits as f32;
+        return over([sum[0] / n, sum[1] / n, sum[2] / n], n / p.msaa as f32);
+    }
     if !p.enabled {
         if !centre {
             return None;
@@ -346,12 +377,14 @@ impl CpuKernel for FilterKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let (gbuffer, shaded) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let v = View {
             f: &f,
+            layers: super::gbuffer_layers(&gbuffer, &shaded, w * h),
             width: w,
             height: h,
-            gbuffer: ctx.words("gbuffer"),
-            shaded: ctx.words("shaded"),
+            gbuffer,
+            shaded,
         };
         let out = ctx.words("output");
         for i in group * FILTER_GROUP..((group + 1) * FILTER_GROUP).min(w * h) {

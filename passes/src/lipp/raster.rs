@@ -27,7 +27,13 @@
 //! `centre_diameter / 2` of the line. Depth is tested against `scene.depth`.
 //! "we rasterize them as single-pixel-wide lines" (§3.1.2).
 //!
-//! Not implemented: the MSAA reference mode (`msaa` > 1 is refused).
+//! MSAA reference mode (Lipp §3.3: "recording samples into multiple layers
+//! of a uint64 image and resolving them later ... only as a reference"):
+//! with `msaa` N in {2, 4, 8}, layer s < N of the G-buffer holds sample s at
+//! the Direct3D standard sample position of that count, written where the
+//! segment passes within `centre_diameter / 2` of the sample point; there is
+//! no conservative layer. The graph must size the G-buffer for N layers
+//! (`scenes/graphs/lipp_msaa.ron`); samples beyond its layers are dropped.
 
 use super::assemble::{Assembly, assemble};
 use super::payload::{Sample, pack};
@@ -76,11 +82,8 @@ impl RasterParams {
                 "expected a diameter in (0, 2] pixels",
             ));
         }
-        if out.msaa > 1 {
-            return Err(err(
-                "msaa",
-                "the multi-sample reference mode (Lipp §3.3) is not implemented; use 0 or 1",
-            ));
+        if ![0, 1, 2, 4, 8].contains(&out.msaa) {
+            return Err(err("msaa", "expected 0 or 1 (off), 2, 4 or 8 samples"));
         }
         Ok(out)
     }
@@ -132,7 +135,7 @@ impl PassDef for Raster {
             crate::contract::count(q.bundles),
             q.width,
             q.height,
-            0,
+            p.msaa,
         ])
     }
 }
@@ -206,8 +209,40 @@ impl Target<'_> {
         self.local.pixels_written += 1;
     }
 
+    /// MSAA reference mode: every sample of every pixel the segment touches
+    /// within `centre_diameter / 2` of the segment goes to its sample layer.
+    fn segment_msaa(&mut self, a: &End, b: &End, n: u32, layers: usize) {
+        let samples = sample_positions(n);
+        let half = self.params.centre_diameter * 0.5;
+        let (dx, dy) = (b.x - a.x, b.y - a.y);
+        let len2 = dx * dx + dy * dy;
+        let mut pixels = Vec::new();
+        walk_pixels(a, b, self.width, self.height, &mut |x, y| {
+            pixels.push((x, y))
+        });
+        for (x, y) in pixels {
+            for (s, o) in samples.iter().enumerate().take(layers) {
+                let (px, py) = (x as f32 + 0.5 + o[0], y as f32 + 0.5 + o[1]);
+                let t = if len2 > 0.0 {
+                    (((px - a.x) * dx + (py - a.y) * dy) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let (ex, ey) = (a.x + dx * t - px, a.y + dy * t - py);
+                if ex * ex + ey * ey <= half * half {
+                    self.write(a, b, t, x, y, s);
+                }
+            }
+        }
+    }
+
     /// DDA over the segment's major axis, one pixel column (or row) at a time.
     fn segment(&mut self, a: &End, b: &End) {
+        if self.params.msaa > 1 {
+            let layers = self.gbuffer.len_u64() / (self.width * self.height).max(1) as usize;
+            self.segment_msaa(a, b, self.params.msaa, layers);
+            return;
+        }
         let x_major = (b.x - a.x).abs() >= (b.y - a.y).abs();
         // (major, minor) coordinates.
         let (ma, na, mb, nb) = if x_major {
@@ -264,6 +299,62 @@ impl Target<'_> {
             }
             col += 1.0;
         }
+    }
+}
+
+/// Direct3D's standard sample positions for 2, 4 and 8 samples, in pixels
+/// from the pixel centre (1/16-pixel grid).
+pub fn sample_positions(n: u32) -> Vec<[f32; 2]> {
+    let grid: &[[i32; 2]] = match n {
+        2 => &[[4, 4], [-4, -4]],
+        4 => &[[-2, -6], [6, -2], [-6, 2], [2, 6]],
+        8 => &[
+            [1, -3],
+            [-1, 3],
+            [5, 1],
+            [-3, -5],
+            [-5, 5],
+            [-7, -1],
+            [3, 7],
+            [7, -7],
+        ],
+        _ => &[[0, 0]],
+    };
+    grid.iter()
+        .map(|g| [g[0] as f32 / 16.0, g[1] as f32 / 16.0])
+        .collect()
+}
+
+/// The pixels a segment touches (the conservative walk), clipped to the screen.
+fn walk_pixels(a: &End, b: &End, width: u32, height: u32, visit: &mut dyn FnMut(i32, i32)) {
+    let x_major = (b.x - a.x).abs() >= (b.y - a.y).abs();
+    let (ma, na, mb, nb) = if x_major {
+        (a.x, a.y, b.x, b.y)
+    } else {
+        (a.y, a.x, b.y, b.x)
+    };
+    let (dm, dn) = (mb - ma, nb - na);
+    let limit = if x_major { width } else { height } as f32;
+    let lo = ma.min(mb).max(0.0).floor();
+    let hi = ma.max(mb).min(limit - 1.0).floor();
+    let mut col = lo;
+    while col <= hi {
+        let (t0, t1) = if dm != 0.0 {
+            let ta = ((col - ma) / dm).clamp(0.0, 1.0);
+            let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
+            (ta.min(tb), ta.max(tb))
+        } else {
+            (0.0, 1.0)
+        };
+        let (n0, n1) = (na + dn * t0, na + dn * t1);
+        for row in n0.min(n1).floor() as i32..=n0.max(n1).floor() as i32 {
+            if x_major {
+                visit(col as i32, row);
+            } else {
+                visit(row, col as i32);
+            }
+        }
+        col += 1.0;
     }
 }
 

@@ -148,7 +148,7 @@ fn depth_test_against_the_scene_rejects_hidden_strands() {
 #[test]
 fn bad_params_are_errors() {
     for bad in [
-        r#"{"msaa": 4}"#,
+        r#"{"msaa": 3}"#,
         r#"{"centre_diameter": 0.0}"#,
         r#"{"styling": 1}"#,
     ] {
@@ -157,4 +157,26 @@ fn bad_params_are_errors() {
             "{bad}"
         );
     }
+}
+
+#[test]
+fn msaa_reference_mode_fills_one_layer_per_sample() {
+    let (mut h, groups) = harness("{}", 32);
+    let layers = 4usize;
+    h.buffer("gbuffer", vec![u32::MAX; 2 * layers * (W * H) as usize]);
+    let k = Raster
+        .cpu_kernel(&ron::from_str(r#"{"msaa": 4}"#).unwrap())
+        .unwrap();
+    h.run(k.as_ref(), groups, RASTER_GROUP);
+    assert_eq!(h.out_of_bounds(), 0);
+    let p = payloads(&h);
+    let hits: Vec<usize> = p
+        .chunks((W * H) as usize)
+        .map(|l| l.iter().filter(|&&x| x != EMPTY).count())
+        .collect();
+    assert_eq!(hits.len(), layers);
+    // Four sample positions see about as many strand pixels each.
+    let (lo, hi) = (*hits.iter().min().unwrap(), *hits.iter().max().unwrap());
+    assert!(lo > 100 && hi < 2 * lo, "{hits:?}");
+    assert_eq!(super::sample_positions(8).len(), 8);
 }

@@ -426,9 +426,10 @@ impl CpuKernel for ShadeKernel {
             }),
         };
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
+        let layers = super::gbuffer_layers(&g, &out, pixels);
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
-            for layer in 0..2u32 {
+            for layer in 0..layers {
                 let slot = (layer * pixels + i) as usize;
                 let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
                 let c = if p == EMPTY {
@@ -437,7 +438,7 @@ impl CpuKernel for ShadeKernel {
                     let c = shade_sample(&inp, &unpack(p), x, y);
                     [c[0], c[1], c[2], 1.0]
                 };
-                out.store_vec4((2 * i + layer) as usize, c);
+                out.store_vec4((layers * i + layer) as usize, c);
             }
         }
     }
