@@ -421,3 +421,56 @@ impl CpuKernel for DomKernel {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bytemuck::Zeroable;
+
+    #[test]
+    fn light_frame_maps_the_bounds_into_the_unit_cube_along_the_light() {
+        let mut m = ModelData::zeroed();
+        m.bounds_min = [-0.2, 1.0, -0.1, 0.0];
+        m.bounds_max = [0.2, 1.8, 0.1, 0.0];
+        let mut light = LightData::zeroed();
+        light.position_or_direction = [0.0, -1.0, 0.0, 0.0];
+        let lf = LightFrame::new(&light, &[m]);
+        // Straight down: depth grows downwards, the top is nearest the light.
+        let top = lf.project([0.0, 1.8, 0.0]);
+        let bottom = lf.project([0.0, 1.0, 0.0]);
+        assert!(top[2] < bottom[2] && top[2] > 0.0 && bottom[2] < 1.0);
+        assert!(
+            (lf.depth_extent - 0.8 * 1.02).abs() < 1e-3,
+            "{}",
+            lf.depth_extent
+        );
+        for c in [[-0.2, 1.0, -0.1], [0.2, 1.8, 0.1]] {
+            let q = lf.project(c);
+            assert!(q.iter().all(|v| (0.0..=1.0).contains(v)), "{q:?}");
+        }
+    }
+
+    #[test]
+    fn walk_visits_every_crossed_texel_once() {
+        let mut seen = Vec::new();
+        walk([0.5, 0.5, 0.0], [3.5, 1.5, 1.0], 8, &mut |x, y, _| {
+            seen.push((x, y))
+        });
+        assert_eq!(seen, vec![(0, 0), (1, 0), (1, 1), (2, 1), (3, 1)]);
+        let mut n = 0;
+        walk([-5.0, 2.0, 0.0], [20.0, 2.0, 0.0], 8, &mut |_, _, _| n += 1);
+        assert_eq!(n, 8, "clipped to the map");
+    }
+
+    #[test]
+    fn bad_params_are_errors() {
+        for bad in [
+            r#"{"resolution": 8}"#,
+            r#"{"layers": 0}"#,
+            r#"{"layer_thickness": 0.0}"#,
+        ] {
+            let v: ron::Value = ron::from_str(bad).unwrap();
+            assert!(DomParams::from_ron("lipp.dom_depth", &v).is_err(), "{bad}");
+        }
+    }
+}
