@@ -63,9 +63,13 @@ fn write_images(p: &Prepared, cpu: &[u32], gpu: &[u32]) -> PathBuf {
     dir
 }
 
+/// `STRANDGRAPH_DIFF_PARAMS` (comma-separated `pass.key=value`) adds
+/// overrides, to bisect a disagreement on a new device by ablation.
 #[test]
 fn showcase_visibility_matches_cpu_on_wgpu() {
-    compare_visibility("default", &[]);
+    let extra = std::env::var("STRANDGRAPH_DIFF_PARAMS").unwrap_or_default();
+    let overrides: Vec<&str> = extra.split(',').filter(|s| !s.is_empty()).collect();
+    compare_visibility(&format!("default {extra}"), &overrides);
 }
 
 /// Every ablation changes how the raster works, never what it writes: each
@@ -153,6 +157,43 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
         ulps.iter().filter(|&&u| u > 0).count(),
         ulps.len(),
         ulps.iter().max().unwrap_or(&0)
+    );
+    let bucket = |lo: u32, hi: u32| ulps.iter().filter(|&&u| u >= lo && u < hi).count();
+    eprintln!(
+        "  by ulp: 1: {}, 2-15: {}, 16-1023: {}, >= 1024: {}",
+        bucket(1, 2),
+        bucket(2, 16),
+        bucket(16, 1024),
+        bucket(1024, u32::MAX)
+    );
+    if let Some((i, _)) = ulps.iter().enumerate().max_by_key(|(_, u)| **u) {
+        let v = i / 4 * 4;
+        let f = |w: &[u32]| {
+            w[v..v + 4]
+                .iter()
+                .map(|&x| f32::from_bits(x))
+                .collect::<Vec<_>>()
+        };
+        eprintln!(
+            "  worst: vertex {} cpu {:?} wgpu {:?}",
+            v / 4,
+            f(&cc),
+            f(&gc)
+        );
+    }
+
+    // The head's depth (hardware raster on the GPU) and the cull's decisions
+    // (occlusion against it) feed the raster too: report where they differ.
+    let (cd, gd) = (read_cpu("scene.depth"), read_gpu("scene.depth"));
+    let depth_words = cd.iter().zip(&gd).filter(|(a, b)| a != b).count();
+    let (cs, gs) = (
+        read_cpu("segment_visibility"),
+        read_gpu("segment_visibility"),
+    );
+    let culled_bits: u32 = cs.iter().zip(&gs).map(|(a, b)| (a ^ b).count_ones()).sum();
+    eprintln!(
+        "scene.depth: {depth_words} of {} words differ; segment_visibility: {culled_bits} segments decided differently",
+        cd.len()
     );
 
     let (cv, gv) = (read_cpu("vis_atlas"), read_gpu("vis_atlas"));
