@@ -103,6 +103,18 @@ pub fn depth_to_view(
     Rgb32FImage::from_raw(width, height, data)
 }
 
+/// Per-pixel motion (two f32 per pixel, x and y in pixels) as RGB with
+/// R = x, G = y, B = 0, for EXR.
+pub fn motion_image(words: &[u32], width: u32, height: u32) -> Option<Rgb32FImage> {
+    let texels = (width * height) as usize;
+    let data = words
+        .get(..2 * texels)?
+        .chunks(2)
+        .flat_map(|m| [f32::from_bits(m[0]), f32::from_bits(m[1]), 0.0])
+        .collect();
+    Rgb32FImage::from_raw(width, height, data)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

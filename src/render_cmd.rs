@@ -4,7 +4,7 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
-use strandgraph::images::{depth_to_view, to_linear, to_picture};
+use strandgraph::images::{depth_to_view, motion_image, to_linear, to_picture};
 use strandgraph_cpu::{CpuBackend, PassTiming};
 use strandgraph_graph::Plan;
 use strandgraph_wgpu::WgpuBackend;
@@ -30,6 +30,11 @@ pub struct Args {
     /// Also write the view depth (metres, EXR) of `scene.depth` here.
     #[arg(long, value_name = "FILE.exr")]
     pub depth: Option<PathBuf>,
+    /// Also write the per-pixel motion (pixels, y down; EXR: R = x, G = y)
+    /// of `pixel_motion` here. One frame has no previous one: run a
+    /// session for motion that is not zero (tests/motion.rs does).
+    #[arg(long, value_name = "FILE.exr")]
+    pub motion: Option<PathBuf>,
     /// Run this graph instead of the scene's (A/B-test pipelines on one scene).
     #[arg(long)]
     pub graph: Option<PathBuf>,
@@ -91,16 +96,19 @@ pub fn run(args: Args) -> Result<()> {
     // With several backends the CPU's files keep their names and the others
     // are tagged: showcase.png, showcase.wgpu.png, showcase.ash.png.
     let gpu = if matches!(args.backend, Backend::Wgpu | Backend::All) {
-        let tag = |p: &Path| tagged(p, cpu.is_some().then_some("wgpu"));
-        let depth = args.depth.as_deref().map(tag);
-        Some(run_wgpu(&p, &tag(&main), depth.as_deref())?)
+        let tag = cpu.is_some().then_some("wgpu");
+        Some(run_wgpu(&p, &tagged(&main, tag), &Extras::of(&args, tag))?)
     } else {
         None
     };
     let ash = if matches!(args.backend, Backend::Ash | Backend::All) {
-        let tag = |p: &Path| tagged(p, (cpu.is_some() || gpu.is_some()).then_some("ash"));
-        let depth = args.depth.as_deref().map(tag);
-        Some(run_ash(&args, &p, &tag(&main), depth.as_deref())?)
+        let tag = (cpu.is_some() || gpu.is_some()).then_some("ash");
+        Some(run_ash(
+            &args,
+            &p,
+            &tagged(&main, tag),
+            &Extras::of(&args, tag),
+        )?)
     } else {
         None
     };
@@ -110,6 +118,21 @@ pub fn run(args: Args) -> Result<()> {
         print_side_by_side(&p.plan, cpu, gpu);
     }
     Ok(())
+}
+
+/// The images written beside the main one, named for one backend.
+struct Extras {
+    depth: Option<PathBuf>,
+    motion: Option<PathBuf>,
+}
+
+impl Extras {
+    fn of(args: &Args, tag: Option<&str>) -> Self {
+        Self {
+            depth: args.depth.as_deref().map(|p| tagged(p, tag)),
+            motion: args.motion.as_deref().map(|p| tagged(p, tag)),
+        }
+    }
 }
 
 /// `path` with `.tag` before its extension (`a.png` → `a.wgpu.png`).
@@ -152,7 +175,7 @@ fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
     if oob > 0 {
         tracing::warn!(oob, "kernels accessed memory out of range");
     }
-    write_outputs(p, main, args.depth.as_deref(), |name| {
+    write_outputs(p, main, &Extras::of(args, None), |name| {
         Ok(frame.read(&p.plan, name))
     })?;
     Ok(frame.timings)
@@ -161,7 +184,7 @@ fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
 fn run_wgpu(
     p: &Prepared,
     main: &Path,
-    depth: Option<&Path>,
+    extras: &Extras,
 ) -> Result<Vec<strandgraph_wgpu::PassTiming>> {
     let t1 = Instant::now();
     let frame = WgpuBackend::default()
@@ -188,7 +211,7 @@ fn run_wgpu(
     for note in &frame.notes {
         println!("  {note}");
     }
-    write_outputs(p, main, depth, |name| {
+    write_outputs(p, main, extras, |name| {
         frame.read(&p.plan, name).into_diagnostic()
     })?;
     Ok(frame.timings)
@@ -201,7 +224,7 @@ fn run_ash(
     args: &Args,
     p: &Prepared,
     main: &Path,
-    depth: Option<&Path>,
+    extras: &Extras,
 ) -> Result<Vec<strandgraph_ash::PassTiming>> {
     let backend = strandgraph_ash::AshBackend {
         alias: !args.no_alias,
@@ -236,7 +259,7 @@ fn run_ash(
     for note in &session.notes {
         println!("  {note}");
     }
-    write_outputs(p, main, depth, |name| session.read(name).into_diagnostic())?;
+    write_outputs(p, main, extras, |name| session.read(name).into_diagnostic())?;
     Ok(frame.timings)
 }
 
@@ -276,11 +299,13 @@ fn print_three_way(
 /// The scene depth every graph keeps (all its versions share the memory, so
 /// this reads the last one: with hair depth after `kulikov.compose`).
 const DEPTH: &str = "scene.depth";
+/// Per-pixel motion (kulikov.pixel_motion).
+const MOTION: &str = "pixel_motion";
 
 fn write_outputs(
     p: &Prepared,
     main: &Path,
-    depth: Option<&Path>,
+    extras: &Extras,
     read: impl Fn(&str) -> Result<Option<Vec<u32>>>,
 ) -> Result<()> {
     let q = p.upload.quantities;
@@ -314,7 +339,22 @@ fn write_outputs(
         println!("wrote {} ({name})", path.display());
         wrote_main = true;
     }
-    if let Some(depth_path) = depth {
+    if let Some(motion_path) = &extras.motion {
+        let words = read(MOTION)?.ok_or_else(|| {
+            miette::miette!("--motion: graph `{}` has no `{MOTION}`", p.plan.graph.name)
+        })?;
+        let img = motion_image(&words, q.width, q.height).ok_or_else(|| {
+            miette::miette!("--motion: `{MOTION}` does not hold two floats per pixel")
+        })?;
+        img.save(motion_path)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("writing {}", motion_path.display()))?;
+        println!(
+            "wrote {} (motion in pixels, from {MOTION})",
+            motion_path.display()
+        );
+    }
+    if let Some(depth_path) = &extras.depth {
         let (near, far) = p
             .upload
             .frame

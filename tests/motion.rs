@@ -69,6 +69,11 @@ fn motion_vectors_follow_a_known_camera_move() {
     let mut session = backend.open(&Registry, &plan, &instance).unwrap();
     session.run(&far).unwrap();
     let clip_far = floats(&session.read(&plan, "clip_positions").unwrap());
+    // The first frame has no history: nothing moved.
+    for name in ["vertex_motion", "pixel_motion"] {
+        let first = floats(&session.read(&plan, name).unwrap());
+        assert!(first.iter().all(|&m| m == 0.0), "{name} on the first frame");
+    }
     session.run(&near).unwrap();
     let clip_near = floats(&session.read(&plan, "clip_positions").unwrap());
     let motion = floats(&session.read(&plan, "vertex_motion").unwrap());
@@ -156,4 +161,113 @@ fn motion_vectors_agree_on_wgpu() {
     // One UNORM16 step is 2/65534 NDC (0.0024 px at 160 px); float division differs by ulps.
     assert!(worst < 0.01, "motion differs by {worst} px");
     assert!(same_zeros as f64 >= 0.999 * c.len() as f64);
+}
+
+/// Frame `C`: the near view moved 5 cm sideways.
+fn third_frame() -> Upload {
+    let mut scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
+    look_from(&mut scene, [0.05, 1.65, 0.9]);
+    upload(&scene, W, H)
+}
+
+/// Per-pixel motion after a pure camera move is the motion of the surface
+/// point under each pixel. Hair pixels take the front segment's vertex
+/// motion, opaque ones reproject their depth; both must agree with the two
+/// cameras. After the 10 m → 0.9 m cut, hair whose vertices the far frame
+/// skipped has none, which a reprojection would never give.
+#[test]
+fn pixel_motion_follows_the_camera_and_the_vertex_history() {
+    let (plan, instance, far, near) = two_frames();
+    let sideways = third_frame();
+    let mut session = CpuBackend {
+        alias: false,
+        ..CpuBackend::default()
+    }
+    .open(&Registry, &plan, &instance)
+    .unwrap();
+    let reprojection = |now: &Upload, prev: &Upload, i: usize, z: f32| {
+        let (f, p) = (now.frame.unwrap(), prev.frame.unwrap());
+        let (x, y) = ((i as u32 % W) as f32 + 0.5, (i as u32 / W) as f32 + 0.5);
+        let ndc = Vec4::new(x / W as f32 * 2.0 - 1.0, 1.0 - y / H as f32 * 2.0, z, 1.0);
+        let world = Mat4::from_cols_array(&f.inv_view_proj) * ndc;
+        let c = Mat4::from_cols_array(&p.view_proj) * (world / world.w);
+        [
+            (ndc.x - c.x / c.w) * 0.5 * W as f32,
+            (c.y / c.w - ndc.y) * 0.5 * H as f32,
+        ]
+    };
+
+    session.run(&far).unwrap();
+    session.run(&near).unwrap();
+    let depth = floats(&session.read(&plan, "scene.depth").unwrap());
+    let motion = floats(&session.read(&plan, "pixel_motion").unwrap());
+    let unmoved_hair = (0..depth.len())
+        .filter(|&i| depth[i] < 1.0 && motion[2 * i] == 0.0 && motion[2 * i + 1] == 0.0)
+        .filter(|&i| {
+            let r = reprojection(&near, &far, i, depth[i]);
+            r[0].hypot(r[1]) > 5.0
+        })
+        .count();
+    assert!(
+        unmoved_hair > 50,
+        "{unmoved_hair} pixels of LOD-skipped hair"
+    );
+
+    session.run(&sideways).unwrap();
+    let depth = floats(&session.read(&plan, "scene.depth").unwrap());
+    let motion = floats(&session.read(&plan, "pixel_motion").unwrap());
+    let (mut with_depth, mut agree, mut largest) = (0, 0, 0.0f32);
+    for i in 0..depth.len() {
+        if depth[i] >= 1.0 {
+            assert_eq!([motion[2 * i], motion[2 * i + 1]], [0.0, 0.0], "background");
+            continue;
+        }
+        with_depth += 1;
+        let r = reprojection(&sideways, &near, i, depth[i]);
+        let m = [motion[2 * i], motion[2 * i + 1]];
+        largest = largest.max(r[0].hypot(r[1]));
+        // UNORM16 history steps, and the segment's screen-linear interpolation.
+        if (m[0] - r[0]).hypot(m[1] - r[1]) < 0.25 {
+            agree += 1;
+        }
+    }
+    eprintln!("{agree}/{with_depth} pixels move as the cameras say (up to {largest:.2} px)");
+    assert!(with_depth > 1000, "{with_depth} pixels with depth");
+    assert!(largest > 2.0, "the camera move should move pixels");
+    assert!(
+        agree as f64 >= 0.99 * with_depth as f64,
+        "{agree}/{with_depth}"
+    );
+}
+
+/// The per-pixel motion of the same three frames on wgpu agrees with the CPU.
+#[test]
+fn pixel_motion_agrees_on_wgpu() {
+    let (plan, instance, far, near) = two_frames();
+    let sideways = third_frame();
+    let mut cpu = CpuBackend::default()
+        .open(&Registry, &plan, &instance)
+        .unwrap();
+    let mut gpu = WgpuBackend::default()
+        .open(&Registry, &plan, &instance)
+        .unwrap_or_else(|e| panic!("wgpu: {e} (scripts/test.sh installs lavapipe)"));
+    for frame in [&far, &near, &sideways] {
+        cpu.run(frame).unwrap();
+        gpu.run(frame).unwrap();
+    }
+    let c = floats(&cpu.read(&plan, "pixel_motion").unwrap());
+    let g = floats(&gpu.read(&plan, "pixel_motion").unwrap().unwrap());
+    assert_eq!(c.len(), g.len());
+    let close = c
+        .chunks(2)
+        .zip(g.chunks(2))
+        .filter(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]) < 0.05)
+        .count();
+    let moving = c.chunks(2).filter(|m| m[0] != 0.0 || m[1] != 0.0).count();
+    eprintln!(
+        "{close}/{} pixels within 0.05 px; {moving} moving",
+        c.len() / 2
+    );
+    assert!(moving > 1000, "only {moving} moving pixels");
+    assert!(close as f64 >= 0.995 * (c.len() / 2) as f64);
 }

@@ -175,6 +175,48 @@ fn render_command_writes_linear_exr_and_depth() {
     assert!(far > 100.0, "background depth {far} m");
 }
 
+/// `--motion` writes the per-pixel motion EXR (zero on a single frame:
+/// nothing came before it), and names the missing resource on a graph
+/// without motion.
+#[test]
+fn render_command_writes_motion_or_says_why_not() {
+    let dir = std::env::temp_dir().join(format!("strandgraph-motion-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let motion = dir.join("motion.exr");
+    let render = |graph: &str, params: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+            .current_dir(root())
+            .args([
+                "render",
+                "scenes/showcase.ron",
+                "--size",
+                "96x54",
+                "--graph",
+                graph,
+            ])
+            .args(params)
+            .arg("-o")
+            .arg(dir.join("m.png"))
+            .arg("--motion")
+            .arg(&motion)
+            .output()
+            .unwrap()
+    };
+    // No self-shadowing: this test is about motion, not the bake.
+    let o = render(
+        "scenes/graphs/kulikov.ron",
+        &["--param", "shade.self_shadow=\"None\""],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m = image::open(&motion).unwrap().into_rgb32f();
+    assert_eq!(m.dimensions(), (96, 54));
+    assert!(m.pixels().all(|p| p[0] == 0.0 && p[1] == 0.0));
+    let o = render("scenes/graphs/kulikov_visibility.ron", &[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("pixel_motion"), "{err}");
+}
+
 #[test]
 fn render_rejects_a_bad_parameter_by_name() {
     let o = Command::new(env!("CARGO_BIN_EXE_strandgraph"))

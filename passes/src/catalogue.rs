@@ -98,7 +98,12 @@ pub static KINDS: &[PassKind] = &[
     ),
     kind(
         "kulikov.compose",
-        "per-model quad, back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion vectors not yet)",
+        "per-model quad, back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion: kulikov.pixel_motion)",
+        "Kulikov 2025, 'Composition', 'Motion vectors'",
+    ),
+    kind(
+        "kulikov.pixel_motion",
+        "per-pixel motion: the front hair segment's interpolated vertex motion where composition wrote its depth, else the depth reprojected with last frame's camera",
         "Kulikov 2025, 'Composition', 'Motion vectors'",
     ),
     kind(

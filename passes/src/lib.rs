@@ -48,6 +48,7 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &kulikov::compose::Compose,
     &kulikov::history::Motion,
     &kulikov::history::StoreHistory,
+    &kulikov::pixel_motion::PixelMotion,
     &lipp::lod::Lod,
     &lipp::raster::Raster,
     &lipp::dom::DomDepth,

@@ -3,7 +3,8 @@
 // passes/src/kulikov/history.rs, which documents the packing.
 //
 // Bindings (group 0): 0 = HistoryParams, then the pass's bindings() in
-// order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions.
+// order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions,
+// 4 = prev_frame.
 // motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions, 4 = vertex_motion.
 #import strandgraph::layout::FrameData
 
@@ -15,7 +16,9 @@ struct HistoryParams {
 }
 
 const UNORM_MAX: f32 = 65534.0;
-const NOT_TRANSFORMED: u32 = 0xFFFFFFFFu;
+// Codes are stored plus one; 0 (a History buffer's first contents) is
+// "not transformed" (history::NOT_TRANSFORMED).
+const NOT_TRANSFORMED: u32 = 0u;
 
 @group(0) @binding(0) var<uniform> params: HistoryParams;
 @group(0) @binding(1) var<storage, read> frame: FrameData;
@@ -23,6 +26,7 @@ const NOT_TRANSFORMED: u32 = 0xFFFFFFFFu;
 @group(0) @binding(3) var<storage, read_write> store_history_prev_clip_positions: array<u32>;
 @group(0) @binding(3) var<storage, read> motion_prev_clip_positions: array<u32>;
 @group(0) @binding(4) var<storage, read_write> vertex_motion: array<vec2<f32>>;
+@group(0) @binding(4) var<storage, read_write> prev_frame: FrameData;
 
 // Rust's f32::round: halves away from zero.
 fn round_away(x: f32) -> f32 {
@@ -41,13 +45,16 @@ fn decompress(code: u32) -> f32 {
 @compute @workgroup_size(256)
 fn store_history(@builtin(global_invocation_id) id: vec3<u32>) {
     let v = id.x;
+    if v == 0u {
+        prev_frame = frame;
+    }
     if v >= params.vertices {
         return;
     }
     let c = clip_positions[v];
     var packed = NOT_TRANSFORMED;
     if c.w > frame.near {
-        packed = compress(c.x / c.w) | (compress(c.y / c.w) << 16u);
+        packed = (compress(c.x / c.w) + 1u) | ((compress(c.y / c.w) + 1u) << 16u);
     }
     store_history_prev_clip_positions[v] = packed;
 }
@@ -62,7 +69,7 @@ fn motion(@builtin(global_invocation_id) id: vec3<u32>) {
     let prev = motion_prev_clip_positions[v];
     var m = vec2<f32>(0.0);
     if prev != NOT_TRANSFORMED && c.w > frame.near {
-        let p = vec2<f32>(decompress(prev & 0xFFFFu), decompress(prev >> 16u));
+        let p = vec2<f32>(decompress((prev & 0xFFFFu) - 1u), decompress((prev >> 16u) - 1u));
         let n = vec2<f32>(c.x / c.w, c.y / c.w);
         m = vec2<f32>((n.x - p.x) * 0.5 * frame.screen.x, (p.y - n.y) * 0.5 * frame.screen.y);
     }

@@ -8,7 +8,8 @@
 //!   for it) and this frame's `clip_positions`, and writes each vertex's
 //!   screen motion in pixels (now − previous, y down) to `vertex_motion`.
 //! - `kulikov.store_history` compresses this frame's NDC into
-//!   `prev_clip_positions` for the next frame.
+//!   `prev_clip_positions` for the next frame, and keeps this frame's camera
+//!   (`frame`) as `prev_frame` for `kulikov.pixel_motion`'s reprojection.
 //!
 //! A vertex was transformed this frame when its clip w is in front of the
 //! near plane: the graph clears `clip_positions` before skinning, so a
@@ -21,10 +22,13 @@ use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
 const GROUP: u32 = 256;
-/// Largest UNORM16 code used for NDC; the one above marks "not transformed".
+/// Largest UNORM16 code used for NDC. Codes are stored plus one, so that
+/// the word 0 is free to mean "not transformed".
 const UNORM_MAX: f32 = 65534.0;
-/// `prev_clip_positions` of a vertex that was not transformed.
-pub const NOT_TRANSFORMED: u32 = u32::MAX;
+/// `prev_clip_positions` of a vertex that was not transformed: 0, which is
+/// also what a History buffer holds before its first frame, so the first
+/// frame has no motion.
+pub const NOT_TRANSFORMED: u32 = 0;
 
 /// NDC in [−1, 1] (clamped) to the UNORM16 code, and back.
 pub fn compress(ndc: f32) -> u32 {
@@ -39,7 +43,7 @@ pub fn pack(c: [f32; 4], near: f32) -> u32 {
     if !(c[3] > near) {
         return NOT_TRANSFORMED;
     }
-    compress(c[0] / c[3]) | compress(c[1] / c[3]) << 16
+    (compress(c[0] / c[3]) + 1) | (compress(c[1] / c[3]) + 1) << 16
 }
 
 /// Screen motion in pixels (y down) from a history word to clip position
@@ -48,7 +52,10 @@ pub fn motion(prev: u32, c: [f32; 4], near: f32, width: f32, height: f32) -> [f3
     if prev == NOT_TRANSFORMED || !(c[3] > near) {
         return [0.0, 0.0];
     }
-    let (px, py) = (decompress(prev & 0xFFFF), decompress(prev >> 16));
+    let (px, py) = (
+        decompress((prev & 0xFFFF).saturating_sub(1)),
+        decompress((prev >> 16).saturating_sub(1)),
+    );
     let (nx, ny) = (c[0] / c[3], c[1] / c[3]);
     [(nx - px) * 0.5 * width, (py - ny) * 0.5 * height]
 }
@@ -77,6 +84,7 @@ impl PassDef for StoreHistory {
             Binding::read("frame"),
             Binding::read("clip_positions"),
             Binding::write("prev_clip_positions"),
+            Binding::write("prev_frame"),
         ];
         Some(B)
     }
@@ -116,6 +124,12 @@ impl CpuKernel for StoreKernel {
         );
         for v in vertices(group, ctx) {
             out.store(v, pack(clip.load_vec4(v), frame.near));
+        }
+        if group == 0 {
+            let (now, prev) = (ctx.words("frame"), ctx.words("prev_frame"));
+            for k in 0..std::mem::size_of::<FrameData>() / 4 {
+                prev.store(k, now.load(k));
+            }
         }
     }
 }
@@ -196,6 +210,8 @@ mod tests {
     fn untransformed_vertices_have_no_motion() {
         let c = [0.2, -0.1, 0.5, 2.0];
         assert_eq!(pack([0.0; 4], 0.02), NOT_TRANSFORMED);
+        // The most negative NDC corner still packs to a word other than 0.
+        assert_ne!(pack([-1.0, -1.0, 0.0, 1.0], 0.02), NOT_TRANSFORMED);
         assert_eq!(motion(NOT_TRANSFORMED, c, 0.02, 100.0, 100.0), [0.0, 0.0]);
         assert_eq!(
             motion(pack(c, 0.02), [0.0; 4], 0.02, 100.0, 100.0),

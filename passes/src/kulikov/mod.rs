@@ -10,6 +10,7 @@ pub mod history;
 pub mod hiz;
 pub mod lod;
 pub mod payload;
+pub mod pixel_motion;
 pub mod raster;
 pub mod shade;
 pub mod shade_sort;

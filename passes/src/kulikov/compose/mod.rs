@@ -267,41 +267,52 @@ struct Model<'a> {
     _w: std::marker::PhantomData<&'a ()>,
 }
 
-impl ComposeKernel {
-    /// The layer's trapezoid in the model's raster grid, as `kulikov.raster` built it.
-    fn trapezoid(
-        &self,
-        scene: &Scene,
-        ctx: &Ctx<'_>,
-        md: &Model<'_>,
-        v0: u32,
-        v1: u32,
-    ) -> Option<Trapezoid> {
-        let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
-        let f = &scene.frame;
-        let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
-        let t = &md.tiles;
-        let d = t.downscale as f32;
-        let (ox, oy) = ((t.origin_x * TILE) as f32, (t.origin_y * TILE) as f32);
-        let to_raster = |c: [f32; 4]| {
-            let s = clip_to_screen(c, f.screen[0], f.screen[1]);
-            [s[0] / d - ox, s[1] / d - oy]
-        };
-        let half = |v: u32, w: f32| {
-            0.5 * verts.load_f32(4 * v as usize + 3) * md.lod.thickness_scale * f.pixels_per_unit
-                / w
-                / d
-        };
-        Trapezoid::new(
-            to_raster(c0),
-            to_raster(c1),
-            half(v0, c0[3]),
-            half(v1, c1[3]),
-            c0[3],
-            c1[3],
-        )
-    }
+/// Segment `v0`–`v1`'s trapezoid in its model's raster grid, exactly as
+/// `kulikov.raster` built it (composition and `kulikov.pixel_motion` need
+/// the same geometry the raster measured).
+pub(crate) fn segment_trapezoid(
+    scene: &Scene,
+    ctx: &Ctx<'_>,
+    tiles: &ModelTiles,
+    lod: &super::ModelLod,
+    v0: u32,
+    v1: u32,
+) -> Option<Trapezoid> {
+    let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
+    let f = &scene.frame;
+    let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
+    let d = tiles.downscale as f32;
+    let (ox, oy) = (
+        (tiles.origin_x * TILE) as f32,
+        (tiles.origin_y * TILE) as f32,
+    );
+    let to_raster = |c: [f32; 4]| {
+        let s = clip_to_screen(c, f.screen[0], f.screen[1]);
+        [s[0] / d - ox, s[1] / d - oy]
+    };
+    let half = |v: u32, w: f32| {
+        0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit / w / d
+    };
+    Trapezoid::new(
+        to_raster(c0),
+        to_raster(c1),
+        half(v0, c0[3]),
+        half(v1, c1[3]),
+        c0[3],
+        c1[3],
+    )
+}
 
+/// Where raster texel `(u, v)`'s centre projects on the segment's axis, in
+/// [0, 1] from `a` to `b`: the weight lighting and motion interpolate with.
+pub(crate) fn axis_t(trap: &Trapezoid, u: i32, v: i32) -> f32 {
+    let c = [u as f32 + 0.5, v as f32 + 0.5];
+    let d = [trap.b[0] - trap.a[0], trap.b[1] - trap.a[1]];
+    (((c[0] - trap.a[0]) * d[0] + (c[1] - trap.a[1]) * d[1]) / (d[0] * d[0] + d[1] * d[1]))
+        .clamp(0.0, 1.0)
+}
+
+impl ComposeKernel {
     /// The up-to-3 layers of one texel: coverage, lighting and view depth.
     #[allow(clippy::too_many_arguments)]
     fn layers(
@@ -326,14 +337,11 @@ impl ComposeKernel {
             let Some(seg) = drawn_segment(scene, lods, id) else {
                 continue;
             };
-            let Some(trap) = self.trapezoid(scene, ctx, md, seg.v0, seg.v1) else {
+            let Some(trap) = segment_trapezoid(scene, ctx, &md.tiles, &md.lod, seg.v0, seg.v1)
+            else {
                 continue;
             };
-            let c = [u as f32 + 0.5, v as f32 + 0.5];
-            let d = [trap.b[0] - trap.a[0], trap.b[1] - trap.a[1]];
-            let t = (((c[0] - trap.a[0]) * d[0] + (c[1] - trap.a[1]) * d[1])
-                / (d[0] * d[0] + d[1] * d[1]))
-                .clamp(0.0, 1.0);
+            let t = axis_t(&trap, u, v);
             let coverage = if self.0.width_coverage {
                 let pts = trap.quad.points();
                 let w0 = ((pts[0][0] - pts[3][0]).powi(2) + (pts[0][1] - pts[3][1]).powi(2)).sqrt();
