@@ -551,6 +551,8 @@ struct DomParams {
 
 const NO_HIT: u32 = 0xFFFFFFFFu;
 const OPACITY_SCALE: f32 = 1024.0;
+// dom::MAX_DOM_LIGHTS: light views computed once per invocation.
+const MAX_DOM_LIGHTS: u32 = 4u;
 
 struct LightFrame {
     right: vec3<f32>,
@@ -616,7 +618,21 @@ fn light_project(lf: LightFrame, p: vec3<f32>) -> vec3<f32> {
 
 // Number of lights the maps have room for (dom::light_frames).
 fn dom_light_count(res: u32, map_words: u32) -> u32 {
-    return min(frame.light_count, min(arrayLength(&lights), map_words / max(res * res, 1u)));
+    return min(min(frame.light_count, MAX_DOM_LIGHTS), min(arrayLength(&lights), map_words / max(res * res, 1u)));
+}
+
+struct LightFrames {
+    frames: array<LightFrame, 4>,
+    count: u32,
+}
+
+fn light_frames(map_words: u32) -> LightFrames {
+    var out: LightFrames;
+    out.count = dom_light_count(dom_params.resolution, map_words);
+    for (var l = 0u; l < out.count; l++) {
+        out.frames[l] = light_frame(l);
+    }
+    return out;
 }
 
 // Light-space segment ends: texel coordinates snapped, normalised depth.
@@ -665,11 +681,10 @@ fn dom_amount(st: Strand) -> u32 {
     return u32(floor(dom_params.strand_opacity * thinning * OPACITY_SCALE + 0.5));
 }
 
-fn dom_segment_depth(a: ControlPoint, b: ControlPoint) {
+fn dom_segment_depth(a: ControlPoint, b: ControlPoint, lfs: LightFrames) {
     let res = dom_params.resolution;
-    let n = dom_light_count(res, arrayLength(&dom_depth));
-    for (var l = 0u; l < n; l++) {
-        let lf = light_frame(l);
+    for (var l = 0u; l < lfs.count; l++) {
+        let lf = lfs.frames[l];
         let pa = dom_end(lf, a.pos, res);
         let pb = dom_end(lf, b.pos, res);
         let cols = walk_columns(pa, pb, res);
@@ -683,17 +698,20 @@ fn dom_segment_depth(a: ControlPoint, b: ControlPoint) {
             for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
                 let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
                 let texel = l * res * res + u32(xy.y) * res + u32(xy.x);
-                atomicMin(&dom_depth[texel], bitcast<u32>(z));
+                // A plain load first (see dom.rs): skips most atomics.
+                let bits = bitcast<u32>(z);
+                if bits < atomicLoad(&dom_depth[texel]) {
+                    atomicMin(&dom_depth[texel], bits);
+                }
             }
         }
     }
 }
 
-fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32) {
+fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32, lfs: LightFrames) {
     let res = dom_params.resolution;
-    let n = dom_light_count(res, arrayLength(&dom_opacity_pass_dom_depth));
-    for (var l = 0u; l < n; l++) {
-        let lf = light_frame(l);
+    for (var l = 0u; l < lfs.count; l++) {
+        let lf = lfs.frames[l];
         let pa = dom_end(lf, a.pos, res);
         let pb = dom_end(lf, b.pos, res);
         let cols = walk_columns(pa, pb, res);
@@ -731,6 +749,7 @@ fn dom_depth_pass(
     let total = raster_args[3];
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lfs = light_frames(arrayLength(&dom_depth));
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
@@ -738,7 +757,7 @@ fn dom_depth_pass(
         workgroupBarrier();
         let strip = pass_two(st, l);
         for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_depth(strip.cps[m], strip_segment_end(strip, m));
+            dom_segment_depth(strip.cps[m], strip_segment_end(strip, m), lfs);
         }
         workgroupBarrier();
     }
@@ -755,6 +774,7 @@ fn dom_opacity_pass(
     let total = raster_args[3];
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lfs = light_frames(arrayLength(&dom_opacity_pass_dom_depth));
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
@@ -763,7 +783,7 @@ fn dom_opacity_pass(
         let strip = pass_two(st, l);
         let amount = dom_amount(st);
         for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount);
+            dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount, lfs);
         }
         workgroupBarrier();
     }

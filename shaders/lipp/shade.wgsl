@@ -106,7 +106,8 @@ fn depth_correction(drawn: u32, all: u32) -> f32 {
 fn dom_transmittance(l: u32, pos: vec3<f32>, delta: f32) -> f32 {
     let res = params.dom_resolution;
     let plane = res * res;
-    if l >= min(frame.light_count, arrayLength(&dom_depth) / max(plane, 1u)) {
+    // dom::light_frames: at most MAX_DOM_LIGHTS (4) lights have maps.
+    if l >= min(min(frame.light_count, 4u), arrayLength(&dom_depth) / max(plane, 1u)) {
         return 1.0;
     }
     let lf = light_frame(l);

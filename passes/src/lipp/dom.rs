@@ -36,6 +36,9 @@ use crate::sim::{Ctx, Words};
 pub const OPACITY_SCALE: f32 = 1024.0;
 /// A texel no strand reached (the clear value).
 pub const NO_HIT: u32 = u32::MAX;
+/// Lights with a deep opacity map (the rest are unshadowed); the WGSL keeps
+/// their views in registers.
+pub const MAX_DOM_LIGHTS: usize = 4;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DomParams {
@@ -193,7 +196,9 @@ pub fn light_frames(ctx: &Ctx<'_>, res: u32, maps: usize) -> Vec<LightFrame> {
     let models: Vec<ModelData> = (0..f.model_count as usize).map(|m| read(&mw, m)).collect();
     let lw = ctx.words("lights");
     let per = (res * res) as usize;
-    let n = (f.light_count as usize).min(maps / per.max(1));
+    let n = (f.light_count as usize)
+        .min(maps / per.max(1))
+        .min(MAX_DOM_LIGHTS);
     (0..n)
         .map(|l| LightFrame::new(&read::<LightData>(&lw, l), &models))
         .collect()
@@ -349,7 +354,13 @@ impl DomKernel {
         }
         match self.stage {
             Stage::Depth => {
-                maps.0.fetch_min(texel, z.to_bits());
+                // A plain load first: most strand texels lie behind the
+                // current first hit, and skipping their atomics cuts the
+                // contention on the small map (a standard atomicMin filter).
+                let bits = z.to_bits();
+                if bits < maps.0.load(texel) {
+                    maps.0.fetch_min(texel, bits);
+                }
             }
             Stage::Opacity => {
                 let first = maps.0.load(texel);
