@@ -129,6 +129,10 @@ impl Runner {
                 })
             }
             Backend::Wgpu => {
+                // NVIDIA's driver fails after some thirty reloads in one
+                // process; hold it loaded (strandgraph_ash::keep_driver_loaded
+                // says why). Without a loader wgpu reports its own error.
+                let _ = strandgraph_ash::keep_driver_loaded();
                 let session = strandgraph_wgpu::WgpuBackend::default()
                     .open(&Registry, plan, instance)
                     .into_diagnostic()?;

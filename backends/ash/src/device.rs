@@ -91,8 +91,8 @@ fn name_of(props: &vk::PhysicalDeviceProperties) -> String {
 
 impl Gpu {
     pub fn new(backend: &AshBackend, needs: &Needs) -> Result<Gpu, AshError> {
-        // SAFETY: loading the system Vulkan loader; failure is an error value.
-        let entry = unsafe { ash::Entry::load() }.map_err(|e| AshError::Loader(e.to_string()))?;
+        crate::loader::keep_driver_loaded()?;
+        let entry = crate::loader::entry()?;
         let validate = backend.validation == Validation::Sync;
         let mut layers = Vec::new();
         let mut extensions = Vec::new();

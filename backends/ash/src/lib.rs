@@ -48,6 +48,7 @@
 mod barriers;
 mod device;
 mod error;
+mod loader;
 mod memory;
 mod pipelines;
 mod prepare;
@@ -59,6 +60,7 @@ mod submit;
 mod timing;
 
 pub use error::AshError;
+pub use loader::keep_driver_loaded;
 pub use session::{Frame, Session};
 pub use timing::PassTiming;
 
