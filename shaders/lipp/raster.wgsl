@@ -551,7 +551,7 @@ struct DomParams {
 
 const NO_HIT: u32 = 0xFFFFFFFFu;
 const OPACITY_SCALE: f32 = 1024.0;
-// dom::MAX_DOM_LIGHTS: light views computed once per invocation.
+// dom::MAX_DOM_LIGHTS.
 const MAX_DOM_LIGHTS: u32 = 4u;
 
 struct LightFrame {
@@ -621,19 +621,7 @@ fn dom_light_count(res: u32, map_words: u32) -> u32 {
     return min(min(frame.light_count, MAX_DOM_LIGHTS), min(arrayLength(&lights), map_words / max(res * res, 1u)));
 }
 
-struct LightFrames {
-    frames: array<LightFrame, 4>,
-    count: u32,
-}
 
-fn light_frames(map_words: u32) -> LightFrames {
-    var out: LightFrames;
-    out.count = dom_light_count(dom_params.resolution, map_words);
-    for (var l = 0u; l < out.count; l++) {
-        out.frames[l] = light_frame(l);
-    }
-    return out;
-}
 
 // Light-space segment ends: texel coordinates snapped, normalised depth.
 fn dom_end(lf: LightFrame, p: vec3<f32>, res: u32) -> vec3<f32> {
@@ -681,10 +669,9 @@ fn dom_amount(st: Strand) -> u32 {
     return u32(floor(dom_params.strand_opacity * thinning * OPACITY_SCALE + 0.5));
 }
 
-fn dom_segment_depth(a: ControlPoint, b: ControlPoint, lfs: LightFrames) {
+fn dom_segment_depth(a: ControlPoint, b: ControlPoint, l: u32, lf: LightFrame) {
     let res = dom_params.resolution;
-    for (var l = 0u; l < lfs.count; l++) {
-        let lf = lfs.frames[l];
+    {
         let pa = dom_end(lf, a.pos, res);
         let pb = dom_end(lf, b.pos, res);
         let cols = walk_columns(pa, pb, res);
@@ -708,10 +695,9 @@ fn dom_segment_depth(a: ControlPoint, b: ControlPoint, lfs: LightFrames) {
     }
 }
 
-fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32, lfs: LightFrames) {
+fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32, l: u32, lf: LightFrame) {
     let res = dom_params.resolution;
-    for (var l = 0u; l < lfs.count; l++) {
-        let lf = lfs.frames[l];
+    {
         let pa = dom_end(lf, a.pos, res);
         let pb = dom_end(lf, b.pos, res);
         let cols = walk_columns(pa, pb, res);
@@ -749,15 +735,19 @@ fn dom_depth_pass(
     let total = raster_args[3];
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
-    let lfs = light_frames(arrayLength(&dom_depth));
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_depth));
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_depth(strip.cps[m], strip_segment_end(strip, m), lfs);
+        // Each light's view once per strand, the strip's segments in it.
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_depth(strip.cps[m], strip_segment_end(strip, m), li, lf);
+            }
         }
         workgroupBarrier();
     }
@@ -774,7 +764,7 @@ fn dom_opacity_pass(
     let total = raster_args[3];
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
-    let lfs = light_frames(arrayLength(&dom_opacity_pass_dom_depth));
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_opacity_pass_dom_depth));
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
@@ -782,8 +772,11 @@ fn dom_opacity_pass(
         workgroupBarrier();
         let strip = pass_two(st, l);
         let amount = dom_amount(st);
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount, lfs);
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount, li, lf);
+            }
         }
         workgroupBarrier();
     }

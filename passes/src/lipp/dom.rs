@@ -36,8 +36,7 @@ use crate::sim::{Ctx, Words};
 pub const OPACITY_SCALE: f32 = 1024.0;
 /// A texel no strand reached (the clear value).
 pub const NO_HIT: u32 = u32::MAX;
-/// Lights with a deep opacity map (the rest are unshadowed); the WGSL keeps
-/// their views in registers.
+/// Lights with a deep opacity map (the rest are unshadowed).
 pub const MAX_DOM_LIGHTS: usize = 4;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
