@@ -267,6 +267,53 @@ fn trapezoid_column(quad: Poly, x: i32) -> Poly {
     return poly_strip(quad, 0u, f32(x), f32(x) + 1.0);
 }
 
+// raster::geometry::edge_area: one edge's clamped height integrated over
+// the pixel column, signed by its direction in x.
+fn clamped_mean(ya: f32, yb: f32) -> f32 {
+    var t0 = 0.0;
+    var t1 = 1.0;
+    if yb != ya {
+        let c0 = clamp(-ya / (yb - ya), 0.0, 1.0);
+        let c1 = clamp((1.0 - ya) / (yb - ya), 0.0, 1.0);
+        t0 = min(c0, c1);
+        t1 = max(c0, c1);
+    }
+    let d = yb - ya;
+    return t0 * clamp(ya + 0.5 * t0 * d, 0.0, 1.0)
+        + (t1 - t0) * clamp(ya + 0.5 * (t0 + t1) * d, 0.0, 1.0)
+        + (1.0 - t1) * clamp(ya + 0.5 * (t1 + 1.0) * d, 0.0, 1.0);
+}
+
+fn edge_area(a: vec2<f32>, b: vec2<f32>, x0: f32, y0: f32) -> f32 {
+    var p = a;
+    var q = b;
+    var sign = 1.0;
+    if !(a.x < b.x) {
+        p = b;
+        q = a;
+        sign = -1.0;
+    }
+    let lo = max(p.x, x0);
+    let hi = min(q.x, x0 + 1.0);
+    if !(hi > lo) {
+        return 0.0;
+    }
+    let slope = (q.y - p.y) / (q.x - p.x);
+    let ya = p.y + slope * (lo - p.x) - y0;
+    let yb = p.y + slope * (hi - p.x) - y0;
+    return sign * (hi - lo) * clamped_mean(ya, yb);
+}
+
+// Trapezoid::pixel_coverage: the quad's exact area inside pixel (x, y) by
+// edge integration, in registers (composition's three layers per pixel).
+fn quad_pixel_coverage(quad: Poly, x: i32, y: i32) -> f32 {
+    let x0 = f32(x);
+    let y0 = f32(y);
+    let s = edge_area(quad.pts[0], quad.pts[1], x0, y0) + edge_area(quad.pts[1], quad.pts[2], x0, y0)
+        + edge_area(quad.pts[2], quad.pts[3], x0, y0) + edge_area(quad.pts[3], quad.pts[0], x0, y0);
+    return min(abs(s), 1.0);
+}
+
 // Trapezoid::coverage: exact area inside pixel (x, y) of a column slice.
 fn column_coverage(column: Poly, y: i32) -> f32 {
     return min(poly_area(poly_strip(column, 1u, f32(y), f32(y) + 1.0)), 1.0);

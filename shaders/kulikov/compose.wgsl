@@ -10,7 +10,7 @@
 // loops over pixels and models in the order vs_main draws the quads.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
-#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, trapezoid_new, trapezoid_column, column_coverage, trapezoid_depth_at, clip_to_screen, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, trapezoid_new, quad_pixel_coverage, trapezoid_depth_at, clip_to_screen, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
 
 struct ComposeParams {
     poisson_samples: u32,
@@ -190,7 +190,7 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
             let w1 = length(trap.quad.pts[1] - trap.quad.pts[2]);
             coverage = clamp(w0 + tt * (w1 - w0), 0.0, 1.0);
         } else {
-            coverage = column_coverage(trapezoid_column(trap.quad, u), v);
+            coverage = quad_pixel_coverage(trap.quad, u, v);
         }
         if n == 0u {
             out.front_w = trapezoid_depth_at(trap.a, trap.b, trap.wa, trap.wb, u, v);

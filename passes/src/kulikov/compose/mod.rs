@@ -18,7 +18,8 @@
 //!   shipped fit; `"Exponential"`, 1 − e^−x, the random-lines limit];
 //! - per layer: the segment from the payload, its coverage of this texel
 //!   [`layer_coverage`: `"Exact"`, the area of the segment's trapezoid in the
-//!   texel, exactly as `kulikov.raster` measured it; `"Width"`, the projected
+//!   texel, as `kulikov.raster` measured it (by edge integration rather than
+//!   the raster's clipping, [`Trapezoid::pixel_coverage`] says why); `"Width"`, the projected
 //!   strand width in texels, clamped to 1: a strand crossing the pixel covers
 //!   about its width of it], and its lighting interpolated along the segment
 //!   from `vertex_lighting` at the pixel centre's projection;
@@ -348,7 +349,7 @@ impl ComposeKernel {
                 let w1 = ((pts[1][0] - pts[2][0]).powi(2) + (pts[1][1] - pts[2][1]).powi(2)).sqrt();
                 (w0 + t * (w1 - w0)).clamp(0.0, 1.0)
             } else {
-                Trapezoid::coverage(&trap.column(u), v)
+                trap.pixel_coverage(u, v)
             };
             let (l0, l1) = (
                 load_rgba16f(&light, seg.v0 as usize),
