@@ -81,11 +81,11 @@ impl ShadeParams {
             dom_layers: p.u32("dom_layers", 4)?,
             dom_layer_thickness: p.f32("dom_layer_thickness", 0.02)?,
         };
-        if !(16..=4096).contains(&out.dom_resolution) || !(1..=8).contains(&out.dom_layers) {
-            return Err(err(
-                "dom_resolution",
-                "dom_resolution 16..=4096, dom_layers 1..=8",
-            ));
+        if !(16..=4096).contains(&out.dom_resolution) {
+            return Err(err("dom_resolution", "expected 16..=4096 texels"));
+        }
+        if !(1..=8).contains(&out.dom_layers) {
+            return Err(err("dom_layers", "expected 1..=8 layers"));
         }
         if !(out.dom_layer_thickness.is_finite() && out.dom_layer_thickness > 0.0) {
             return Err(err("dom_layer_thickness", "must be positive"));
