@@ -262,6 +262,20 @@ fn trapezoid_new(a_in: vec2<f32>, b_in: vec2<f32>, half_a: f32, half_b: f32, wa:
     return t;
 }
 
+// compose::segment_trapezoid (and RasterKernel's setup): the segment from
+// clip position c0 to c1 as a trapezoid in its model's raster grid, in the
+// CPU's operation order, so raster, composition and motion see one shape.
+fn model_trapezoid(t: ModelTiles, lod: ModelLod, c0: vec4<f32>, c1: vec4<f32>, thick_a: f32, thick_b: f32, screen: vec2<f32>, pixels_per_unit: f32) -> Trapezoid {
+    let d = f32(t.downscale);
+    let origin = vec2<f32>(f32(t.origin_x * TILE), f32(t.origin_y * TILE));
+    let sa = clip_to_screen(c0, screen.x, screen.y);
+    let sb = clip_to_screen(c1, screen.x, screen.y);
+    // Strand width in raster pixels: thickness x LOD compensation x projection.
+    let ha = 0.5 * thick_a * lod.thickness_scale * pixels_per_unit / c0.w / d;
+    let hb = 0.5 * thick_b * lod.thickness_scale * pixels_per_unit / c1.w / d;
+    return trapezoid_new(sa.xy / d - origin, sb.xy / d - origin, ha, hb, c0.w, c1.w);
+}
+
 // Trapezoid::column: the part over pixel column x (Kulikov's TrapezoidSlice).
 fn trapezoid_column(quad: Poly, x: i32) -> Poly {
     return poly_strip(quad, 0u, f32(x), f32(x) + 1.0);

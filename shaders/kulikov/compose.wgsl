@@ -10,7 +10,7 @@
 // loops over pixels and models in the order vs_main draws the quads.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
-#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, trapezoid_new, quad_pixel_coverage, trapezoid_depth_at, clip_to_screen, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
 
 struct ComposeParams {
     poisson_samples: u32,
@@ -153,8 +153,6 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
     let md = models[m];
     let lod = load_lod(lod_models[m]);
     let stride = arrayLength(&vis_atlas) / LAYERS;
-    let dd = f32(d);
-    let origin = vec2<f32>(f32(t.origin_x * TILE), f32(t.origin_y * TILE));
     var cov = array<f32, 3>(0.0, 0.0, 0.0);
     var lit = array<vec3<f32>, 3>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     var n = 0u;
@@ -171,13 +169,8 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
         if !seg.valid {
             continue;
         }
-        let c0 = clip_positions[seg.va];
-        let c1 = clip_positions[seg.vb];
-        let s0 = clip_to_screen(c0, frame.screen.x, frame.screen.y);
-        let s1 = clip_to_screen(c1, frame.screen.x, frame.screen.y);
-        let k = 0.5 * lod.thickness_scale * frame.pixels_per_unit;
-        let trap = trapezoid_new(s0.xy / dd - origin, s1.xy / dd - origin,
-            groom_vertices[seg.va].w * k / c0.w / dd, groom_vertices[seg.vb].w * k / c1.w / dd, c0.w, c1.w);
+        let trap = model_trapezoid(t, lod, clip_positions[seg.va], clip_positions[seg.vb],
+            groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit);
         if !trap.valid {
             continue;
         }

@@ -5,7 +5,7 @@
 // its depth, else the depth reprojected with last frame's camera.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles}
-#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, segment_in_model, drawn_in_model, clip_to_screen, trapezoid_new, trapezoid_depth_at, EMPTY, LAYERS, TILE, SEGMENT_MASK}
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, segment_in_model, drawn_in_model, model_trapezoid, trapezoid_depth_at, EMPTY, LAYERS, TILE, SEGMENT_MASK}
 
 struct PixelMotionParams {
     width: u32,
@@ -61,15 +61,8 @@ fn front_layer(m: u32, x: u32, y: u32, z: f32) -> Front {
         return out;
     }
     let d = t.downscale;
-    let dd = f32(d);
-    let origin = vec2<f32>(f32(t.origin_x * TILE), f32(t.origin_y * TILE));
-    let c0 = clip_positions[seg.va];
-    let c1 = clip_positions[seg.vb];
-    let s0 = clip_to_screen(c0, frame.screen.x, frame.screen.y);
-    let s1 = clip_to_screen(c1, frame.screen.x, frame.screen.y);
-    let k = 0.5 * lod.thickness_scale * frame.pixels_per_unit;
-    let trap = trapezoid_new(s0.xy / dd - origin, s1.xy / dd - origin,
-        groom_vertices[seg.va].w * k / c0.w / dd, groom_vertices[seg.vb].w * k / c1.w / dd, c0.w, c1.w);
+    let trap = model_trapezoid(t, lod, clip_positions[seg.va], clip_positions[seg.vb],
+        groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit);
     if !trap.valid {
         return out;
     }

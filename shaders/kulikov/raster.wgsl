@@ -29,7 +29,7 @@
 // None of them changes which writes happen: results are the CPU kernel's.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles}
-#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, clip_to_screen, load_lod, load_tiles, segment_in_model, drawn_in_model, DrawnSegment, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_new, trapezoid_column, column_coverage, trapezoid_depth_at, morton_code}
+#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, segment_in_model, drawn_in_model, DrawnSegment, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, trapezoid_depth_at, morton_code}
 
 struct RasterParams {
     loop_flattening: u32,
@@ -133,15 +133,8 @@ fn project(index: u32) -> Segment {
     if c0.w <= frame.near || c1.w <= frame.near || tiles.valid == 0u {
         return out;
     }
-    let d = f32(tiles.downscale);
-    let ox = f32(tiles.origin_x * TILE);
-    let oy = f32(tiles.origin_y * TILE);
-    let sa = clip_to_screen(c0, frame.screen.x, frame.screen.y);
-    let sb = clip_to_screen(c1, frame.screen.x, frame.screen.y);
-    // Strand width in raster pixels: thickness x LOD compensation x projection.
-    let ha = 0.5 * groom_vertices[seg.va].w * lod.thickness_scale * frame.pixels_per_unit / c0.w / d;
-    let hb = 0.5 * groom_vertices[seg.vb].w * lod.thickness_scale * frame.pixels_per_unit / c1.w / d;
-    let trap = trapezoid_new(vec2<f32>(sa.x / d - ox, sa.y / d - oy), vec2<f32>(sb.x / d - ox, sb.y / d - oy), ha, hb, c0.w, c1.w);
+    let trap = model_trapezoid(tiles, lod, c0, c1, groom_vertices[seg.va].w, groom_vertices[seg.vb].w,
+        frame.screen.xy, frame.pixels_per_unit);
     if !trap.valid {
         return out;
     }
