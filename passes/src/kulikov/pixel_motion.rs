@@ -23,10 +23,10 @@
 //! motion takes the pixel's own texel (a jittered sample's segment would
 //! rarely be the one whose depth composition wrote).
 
-use super::compose::{axis_t, ndc_depth, segment_trapezoid};
+use super::compose::{axis_t, ndc_depth};
 use super::cull::drawn_segment;
 use super::payload::{EMPTY, segment_of};
-use super::raster::LAYERS;
+use super::raster::{LAYERS, segment_trapezoid};
 use super::{Scene, TILE};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::layout::{FrameData, read};

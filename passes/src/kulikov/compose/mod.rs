@@ -38,10 +38,10 @@ mod tests;
 use super::cull::drawn_segment;
 use super::debug_resolve::{load_rgba16f, store_rgba16f};
 use super::payload::{COVERAGE_SCALE, EMPTY, segment_of, total_coverage};
-use super::raster::LAYERS;
 use super::raster::geometry::Trapezoid;
+use super::raster::{LAYERS, segment_trapezoid};
 use super::tiles::ModelTiles;
-use super::{Scene, TILE, clip_to_screen};
+use super::{Scene, TILE};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
 use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::layout::MODEL_FACIAL_HAIR;
@@ -266,42 +266,6 @@ struct Model<'a> {
     seg_first: u32,
     lod: super::ModelLod,
     _w: std::marker::PhantomData<&'a ()>,
-}
-
-/// Segment `v0`–`v1`'s trapezoid in its model's raster grid, exactly as
-/// `kulikov.raster` built it (composition and `kulikov.pixel_motion` need
-/// the same geometry the raster measured).
-pub(crate) fn segment_trapezoid(
-    scene: &Scene,
-    ctx: &Ctx<'_>,
-    tiles: &ModelTiles,
-    lod: &super::ModelLod,
-    v0: u32,
-    v1: u32,
-) -> Option<Trapezoid> {
-    let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
-    let f = &scene.frame;
-    let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
-    let d = tiles.downscale as f32;
-    let (ox, oy) = (
-        (tiles.origin_x * TILE) as f32,
-        (tiles.origin_y * TILE) as f32,
-    );
-    let to_raster = |c: [f32; 4]| {
-        let s = clip_to_screen(c, f.screen[0], f.screen[1]);
-        [s[0] / d - ox, s[1] / d - oy]
-    };
-    let half = |v: u32, w: f32| {
-        0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit / w / d
-    };
-    Trapezoid::new(
-        to_raster(c0),
-        to_raster(c1),
-        half(v0, c0[3]),
-        half(v1, c1[3]),
-        c0[3],
-        c1[3],
-    )
 }
 
 /// Where raster texel `(u, v)`'s centre projects on the segment's axis, in

@@ -161,6 +161,43 @@ struct Targets<'a> {
     height: u32,
 }
 
+/// Segment `v0`–`v1`'s trapezoid in its model's raster grid: the shape the
+/// raster measures, and that composition and `kulikov.pixel_motion`
+/// evaluate again per pixel.
+pub(crate) fn segment_trapezoid(
+    scene: &Scene,
+    ctx: &Ctx<'_>,
+    tiles: &ModelTiles,
+    lod: &ModelLod,
+    v0: u32,
+    v1: u32,
+) -> Option<Trapezoid> {
+    let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
+    let f = &scene.frame;
+    let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
+    let d = tiles.downscale as f32;
+    let (ox, oy) = (
+        (tiles.origin_x * TILE) as f32,
+        (tiles.origin_y * TILE) as f32,
+    );
+    let to_raster = |c: [f32; 4]| {
+        let s = super::clip_to_screen(c, f.screen[0], f.screen[1]);
+        [s[0] / d - ox, s[1] / d - oy]
+    };
+    // Strand width in raster pixels: world thickness × LOD compensation × projection.
+    let half = |v: u32, w: f32| {
+        0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit / w / d
+    };
+    Trapezoid::new(
+        to_raster(c0),
+        to_raster(c1),
+        half(v0, c0[3]),
+        half(v1, c1[3]),
+        c0[3],
+        c1[3],
+    )
+}
+
 impl RasterKernel {
     fn project(
         &self,
@@ -170,38 +207,16 @@ impl RasterKernel {
         lod: ModelLod,
         tiles: ModelTiles,
     ) -> Option<Lane> {
-        let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
-        let f = &scene.frame;
+        let clip = ctx.words("clip_positions");
+        let near = scene.frame.near;
         let (c0, c1) = (
             clip.load_vec4(seg.v0 as usize),
             clip.load_vec4(seg.v1 as usize),
         );
-        if c0[3] <= f.near || c1[3] <= f.near || tiles.valid == 0 {
+        if c0[3] <= near || c1[3] <= near || tiles.valid == 0 {
             return None;
         }
-        let d = tiles.downscale as f32;
-        let (ox, oy) = (
-            (tiles.origin_x * TILE) as f32,
-            (tiles.origin_y * TILE) as f32,
-        );
-        let to_raster = |c: [f32; 4]| {
-            let s = super::clip_to_screen(c, f.screen[0], f.screen[1]);
-            [s[0] / d - ox, s[1] / d - oy]
-        };
-        // Strand width in raster pixels: world thickness × LOD compensation × projection.
-        let half = |v: u32, w: f32| {
-            0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit
-                / w
-                / d
-        };
-        let trap = Trapezoid::new(
-            to_raster(c0),
-            to_raster(c1),
-            half(seg.v0, c0[3]),
-            half(seg.v1, c1[3]),
-            c0[3],
-            c1[3],
-        )?;
+        let trap = segment_trapezoid(scene, ctx, &tiles, &lod, seg.v0, seg.v1)?;
         let mid = [0.5 * (trap.a[0] + trap.b[0]), 0.5 * (trap.a[1] + trap.b[1])];
         let morton = morton(mid[0].max(0.0) as u32, mid[1].max(0.0) as u32);
         Some(Lane {

@@ -257,6 +257,7 @@ pub fn march(
 }
 
 impl ShadeKernel {
+    #[allow(clippy::too_many_arguments)]
     fn shade_vertex(
         &self,
         scene: &Scene,
