@@ -28,8 +28,10 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 
 cargo fmt --all -- --check
 cargo test --workspace --release --locked
+# The Table-1 bench on every backend that opens here (cpu, and wgpu and
+# ash on lavapipe): 320x180, 2 frames per cell. The binary `cargo test`
+# built for the CLI tests (`cargo run` would rebuild the workspace with
+# the root package's features alone).
+target/release/strandgraph bench --quick --backend all
 # Benches report, they do not assert; --quick keeps this to seconds.
 cargo bench --locked --bench graph_compile -- --quick
-# The Table-1 bench on every backend that opens here (cpu, and wgpu on
-# lavapipe): 320x180, 2 frames per cell; about a minute on 2 cores.
-cargo run --release --locked -- bench --quick --backend all

@@ -215,7 +215,8 @@ pub struct Args {
     /// Write bench.csv, bench.json and bench.txt here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// CI smoke run: 320x180, 2 frames, no warm-up (unless given), VoxelMarch shadows.
+    /// CI smoke run: 320x180, 2 frames, no warm-up (unless given), VoxelMarch
+    /// shadows, four rows (each pipeline as published and one ablation).
     #[arg(long)]
     pub quick: bool,
     /// Emulated subgroup width of the CPU backend (timed and counting runs).
@@ -309,6 +310,16 @@ fn prepare_graph(
     })
 }
 
+/// The rows `--quick` times unless `--row` picks others: each pipeline as
+/// published and one ablation of each, so CI exercises both without the
+/// multi-sample rows (minutes on lavapipe).
+const QUICK_ROWS: &[&str] = &[
+    "Kulikov: all optimisations",
+    "Kulikov: no loop flattening",
+    "Lipp: SWR 1+L",
+    "Lipp: SWR 1+F+L (as published)",
+];
+
 /// What `--quick` sets on every `kulikov.shade` pass.
 const QUICK_SHADOW: &str = "self_shadow=\"VoxelMarch\"";
 
@@ -335,7 +346,11 @@ pub fn run(mut args: Args) -> Result<()> {
         .iter()
         .filter(|v| {
             let label = format!("{}: {}", v.pipeline, v.name);
-            args.rows.is_empty() || args.rows.iter().any(|r| label.contains(r.as_str()))
+            match (args.rows.is_empty(), args.quick) {
+                (false, _) => args.rows.iter().any(|r| label.contains(r.as_str())),
+                (true, true) => QUICK_ROWS.contains(&label.as_str()),
+                (true, false) => true,
+            }
         })
         .collect();
     let cpu = CpuOptions {
@@ -562,4 +577,21 @@ fn roofline(
             copy: (copy_bytes, median("copy")),
         },
     })
+}
+
+#[cfg(test)]
+mod quick_tests {
+    use super::{QUICK_ROWS, VARIANTS};
+
+    #[test]
+    fn quick_rows_name_real_variants() {
+        for row in QUICK_ROWS {
+            assert!(
+                VARIANTS
+                    .iter()
+                    .any(|v| format!("{}: {}", v.pipeline, v.name) == *row),
+                "--quick row {row:?} is not a variant"
+            );
+        }
+    }
 }
