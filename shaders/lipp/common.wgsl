@@ -166,3 +166,55 @@ fn world_position(inv_view_proj: mat4x4<f32>, screen: vec4<f32>, x: u32, y: u32,
     let p = transform(inv_view_proj, vec4<f32>(ndc_x, ndc_y, z, 1.0));
     return vec3<f32>(p.x / p.w, p.y / p.w, p.z / p.w);
 }
+
+struct LightFrame {
+    right: vec3<f32>,
+    up: vec3<f32>,
+    forward: vec3<f32>,
+    lo: vec3<f32>,
+    inv: vec3<f32>,
+    depth_extent: f32,
+}
+
+// dom::LightFrame::new: a light's orthographic frame around the bounds
+// lo..hi, for a light with position_or_direction `pd`.
+fn light_frame_of(lo: vec3<f32>, hi: vec3<f32>, pd: vec4<f32>) -> LightFrame {
+    var forward = safe_normalize(pd.xyz);
+    if pd.w != 0.0 {
+        forward = safe_normalize((lo + hi) * 0.5 - pd.xyz);
+    }
+    if dot(forward, forward) <= 0.0 {
+        forward = vec3<f32>(0.0, -1.0, 0.0);
+    }
+    var up0 = vec3<f32>(0.0, 1.0, 0.0);
+    if abs(forward.y) > 0.99 {
+        up0 = vec3<f32>(1.0, 0.0, 0.0);
+    }
+    let right = safe_normalize(cross(forward, up0));
+    let up = cross(right, forward);
+    var plo = vec3<f32>(3.40282347e38);
+    var phi = vec3<f32>(-3.40282347e38);
+    for (var i = 0u; i < 8u; i++) {
+        let p = vec3<f32>(
+            select(lo.x, hi.x, (i & 1u) != 0u),
+            select(lo.y, hi.y, (i & 2u) != 0u),
+            select(lo.z, hi.z, (i & 4u) != 0u),
+        );
+        let q = vec3<f32>(dot(p, right), dot(p, up), dot(p, forward));
+        plo = min(plo, q);
+        phi = max(phi, q);
+    }
+    let pad = max((phi - plo) * 0.01, vec3<f32>(1e-3));
+    plo = plo - pad;
+    phi = phi + pad;
+    return LightFrame(right, up, forward, plo, vec3<f32>(1.0) / (phi - plo), phi.z - plo.z);
+}
+
+// dom::LightFrame::project: world point to the map's [0, 1]^3.
+fn light_project(lf: LightFrame, p: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(
+        (dot(p, lf.right) - lf.lo.x) * lf.inv.x,
+        (dot(p, lf.up) - lf.lo.y) * lf.inv.y,
+        (dot(p, lf.forward) - lf.lo.z) * lf.inv.z,
+    );
+}

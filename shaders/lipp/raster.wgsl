@@ -11,7 +11,7 @@
 // subgroup width. Needs SHADER_INT64 and SHADER_INT64_ATOMIC_MIN_MAX.
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -554,15 +554,6 @@ const OPACITY_SCALE: f32 = 1024.0;
 // dom::MAX_DOM_LIGHTS.
 const MAX_DOM_LIGHTS: u32 = 4u;
 
-struct LightFrame {
-    right: vec3<f32>,
-    up: vec3<f32>,
-    forward: vec3<f32>,
-    lo: vec3<f32>,
-    inv: vec3<f32>,
-    depth_extent: f32,
-}
-
 // dom::LightFrame::new over every model's bounds.
 fn light_frame(l: u32) -> LightFrame {
     var lo = vec3<f32>(3.40282347e38);
@@ -576,44 +567,7 @@ fn light_frame(l: u32) -> LightFrame {
         lo = vec3<f32>(-1.0);
         hi = vec3<f32>(1.0);
     }
-    let pd = lights[l].position_or_direction;
-    var forward = safe_normalize(pd.xyz);
-    if pd.w != 0.0 {
-        forward = safe_normalize((lo + hi) * 0.5 - pd.xyz);
-    }
-    if dot(forward, forward) <= 0.0 {
-        forward = vec3<f32>(0.0, -1.0, 0.0);
-    }
-    var up0 = vec3<f32>(0.0, 1.0, 0.0);
-    if abs(forward.y) > 0.99 {
-        up0 = vec3<f32>(1.0, 0.0, 0.0);
-    }
-    let right = safe_normalize(cross(forward, up0));
-    let up = cross(right, forward);
-    var plo = vec3<f32>(3.40282347e38);
-    var phi = vec3<f32>(-3.40282347e38);
-    for (var i = 0u; i < 8u; i++) {
-        let p = vec3<f32>(
-            select(lo.x, hi.x, (i & 1u) != 0u),
-            select(lo.y, hi.y, (i & 2u) != 0u),
-            select(lo.z, hi.z, (i & 4u) != 0u),
-        );
-        let q = vec3<f32>(dot(p, right), dot(p, up), dot(p, forward));
-        plo = min(plo, q);
-        phi = max(phi, q);
-    }
-    let pad = max((phi - plo) * 0.01, vec3<f32>(1e-3));
-    plo = plo - pad;
-    phi = phi + pad;
-    return LightFrame(right, up, forward, plo, vec3<f32>(1.0) / (phi - plo), phi.z - plo.z);
-}
-
-fn light_project(lf: LightFrame, p: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(
-        (dot(p, lf.right) - lf.lo.x) * lf.inv.x,
-        (dot(p, lf.up) - lf.lo.y) * lf.inv.y,
-        (dot(p, lf.forward) - lf.lo.z) * lf.inv.z,
-    );
+    return light_frame_of(lo, hi, lights[l].position_or_direction);
 }
 
 // Number of lights the maps have room for (dom::light_frames).

@@ -5,7 +5,7 @@
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
 
 // ShadeParams (booleans as 0/1).
 struct ShadeParams {
@@ -40,16 +40,7 @@ struct ShadeParams {
 const NO_HIT: u32 = 0xFFFFFFFFu;
 const OPACITY_SCALE: f32 = 1024.0;
 
-struct LightFrame {
-    right: vec3<f32>,
-    up: vec3<f32>,
-    forward: vec3<f32>,
-    lo: vec3<f32>,
-    inv: vec3<f32>,
-    depth_extent: f32,
-}
-
-// dom::LightFrame::new over every model's bounds (as in raster.wgsl).
+// dom::LightFrame::new over every model's bounds.
 fn light_frame(l: u32) -> LightFrame {
     var lo = vec3<f32>(3.40282347e38);
     var hi = vec3<f32>(-3.40282347e38);
@@ -62,36 +53,7 @@ fn light_frame(l: u32) -> LightFrame {
         lo = vec3<f32>(-1.0);
         hi = vec3<f32>(1.0);
     }
-    let pd = lights[l].position_or_direction;
-    var forward = safe_normalize(pd.xyz);
-    if pd.w != 0.0 {
-        forward = safe_normalize((lo + hi) * 0.5 - pd.xyz);
-    }
-    if dot(forward, forward) <= 0.0 {
-        forward = vec3<f32>(0.0, -1.0, 0.0);
-    }
-    var up0 = vec3<f32>(0.0, 1.0, 0.0);
-    if abs(forward.y) > 0.99 {
-        up0 = vec3<f32>(1.0, 0.0, 0.0);
-    }
-    let right = safe_normalize(cross(forward, up0));
-    let up = cross(right, forward);
-    var plo = vec3<f32>(3.40282347e38);
-    var phi = vec3<f32>(-3.40282347e38);
-    for (var i = 0u; i < 8u; i++) {
-        let p = vec3<f32>(
-            select(lo.x, hi.x, (i & 1u) != 0u),
-            select(lo.y, hi.y, (i & 2u) != 0u),
-            select(lo.z, hi.z, (i & 4u) != 0u),
-        );
-        let q = vec3<f32>(dot(p, right), dot(p, up), dot(p, forward));
-        plo = min(plo, q);
-        phi = max(phi, q);
-    }
-    let pad = max((phi - plo) * 0.01, vec3<f32>(1e-3));
-    plo = plo - pad;
-    phi = phi + pad;
-    return LightFrame(right, up, forward, plo, vec3<f32>(1.0) / (phi - plo), phi.z - plo.z);
+    return light_frame_of(lo, hi, lights[l].position_or_direction);
 }
 
 // shade::depth_correction (Lipp Eq. 8): Δ = −log β.
@@ -111,11 +73,7 @@ fn dom_transmittance(l: u32, pos: vec3<f32>, delta: f32) -> f32 {
         return 1.0;
     }
     let lf = light_frame(l);
-    let q = vec3<f32>(
-        (dot(pos, lf.right) - lf.lo.x) * lf.inv.x,
-        (dot(pos, lf.up) - lf.lo.y) * lf.inv.y,
-        (dot(pos, lf.forward) - lf.lo.z) * lf.inv.z,
-    );
+    let q = light_project(lf, pos);
     let x = floor(q.x * f32(res));
     let y = floor(q.y * f32(res));
     if !(x >= 0.0 && y >= 0.0 && x < f32(res) && y < f32(res)) {
