@@ -59,8 +59,8 @@ static DEFINITIONS: &[&dyn PassDef] = &[
     &lipp::dom::DomOpacity,
     &lipp::shade::Shade,
     &lipp::filter::Filter,
-    &bench::AtomicMin32,
-    &bench::AtomicMin64,
+    &bench::ATOMIC_MIN32,
+    &bench::ATOMIC_MIN64,
     &bench::Copy,
 ];
 

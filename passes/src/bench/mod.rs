@@ -15,4 +15,4 @@
 
 mod roofline;
 
-pub use roofline::{AtomicMin32, AtomicMin64, Copy, pcg};
+pub use roofline::{ATOMIC_MIN32, ATOMIC_MIN64, AtomicMin, Copy, pcg};

@@ -61,15 +61,35 @@ fn invocations(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<u32> {
     start..start.saturating_add(GROUP).min(pixels)
 }
 
-pub struct AtomicMin32;
+/// `bench.atomic_min32` and `bench.atomic_min64`: one definition, two widths.
+pub struct AtomicMin {
+    kind: &'static str,
+    bindings: &'static [Binding],
+    shader: Shader,
+    /// 64-bit atomics ([`Min64`]) rather than 32-bit ([`Min32`]).
+    wide: bool,
+}
 
-impl PassDef for AtomicMin32 {
+pub static ATOMIC_MIN32: AtomicMin = AtomicMin {
+    kind: "bench.atomic_min32",
+    bindings: &[Binding::atomic("atomics_u32")],
+    shader: Shader::compute("bench/atomic_min32.wgsl", "atomic_min32"),
+    wide: false,
+};
+
+pub static ATOMIC_MIN64: AtomicMin = AtomicMin {
+    kind: "bench.atomic_min64",
+    bindings: &[Binding::atomic("atomics_u64")],
+    shader: Shader::compute("bench/atomic_min64.wgsl", "atomic_min64"),
+    wide: true,
+};
+
+impl PassDef for AtomicMin {
     fn kind(&self) -> &'static str {
-        "bench.atomic_min32"
+        self.kind
     }
     fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[Binding::atomic("atomics_u32")];
-        Some(B)
+        Some(self.bindings)
     }
     fn workgroup_size(&self) -> u32 {
         GROUP
@@ -78,17 +98,20 @@ impl PassDef for AtomicMin32 {
         PER_PIXEL
     }
     fn shader(&self) -> Shader {
-        Shader::compute("bench/atomic_min32.wgsl", "atomic_min32")
+        self.shader
     }
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(Min32 {
-            ops: ops(self.kind(), params)?,
-        }))
+        let ops = ops(self.kind, params)?;
+        Ok(if self.wide {
+            Box::new(Min64 { ops })
+        } else {
+            Box::new(Min32 { ops })
+        })
     }
     /// `RooflineParams`: ops per invocation, invocations (pixels).
     fn gpu_params(&self, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
         Ok(vec![
-            ops(self.kind(), params)?,
+            ops(self.kind, params)?,
             count(q.count(Quantity::Pixels)),
         ])
     }
@@ -114,39 +137,6 @@ impl CpuKernel for Min32 {
             }
         }
         count_atomics(ctx, n);
-    }
-}
-
-pub struct AtomicMin64;
-
-impl PassDef for AtomicMin64 {
-    fn kind(&self) -> &'static str {
-        "bench.atomic_min64"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[Binding::atomic("atomics_u64")];
-        Some(B)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        PER_PIXEL
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("bench/atomic_min64.wgsl", "atomic_min64")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(Min64 {
-            ops: ops(self.kind(), params)?,
-        }))
-    }
-    /// `RooflineParams`: ops per invocation, invocations (pixels).
-    fn gpu_params(&self, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![
-            ops(self.kind(), params)?,
-            count(q.count(Quantity::Pixels)),
-        ])
     }
 }
 
@@ -287,7 +277,7 @@ mod tests {
     #[test]
     fn ops_out_of_range_is_refused() {
         let v: ron::Value = ron::from_str(r#"{"ops_per_invocation": 0}"#).unwrap();
-        let e = AtomicMin32.cpu_kernel(&v).err().expect("0 ops refused");
+        let e = ATOMIC_MIN32.cpu_kernel(&v).err().expect("0 ops refused");
         assert!(e.to_string().contains("ops_per_invocation"), "{e}");
     }
 }
