@@ -51,6 +51,26 @@ pub enum Dispatch {
     CoverWrites { words_per_group: u32 },
 }
 
+impl Dispatch {
+    /// The workgroups of a direct dispatch, the same on every backend;
+    /// `None` for [`Dispatch::Indirect`], whose count an earlier pass wrote.
+    /// `largest_words` is the size of the pass's largest bound buffer (what
+    /// [`Dispatch::CoverWrites`] covers).
+    pub fn direct_groups(&self, q: &Quantities, largest_words: u64) -> Option<u64> {
+        match *self {
+            Dispatch::Fixed(n) => Some(u64::from(n)),
+            Dispatch::PerElement {
+                quantity,
+                per_group,
+            } => Some(q.count(quantity).div_ceil(u64::from(per_group.max(1)))),
+            Dispatch::Indirect { .. } => None,
+            Dispatch::CoverWrites { words_per_group } => {
+                Some(largest_words.div_ceil(u64::from(words_per_group.max(1))))
+            }
+        }
+    }
+}
+
 /// WGSL entry points in `shaders/`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Shader {
@@ -223,6 +243,30 @@ impl<'a> Params<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn direct_dispatches_count_their_workgroups() {
+        let q = Quantities {
+            width: 10,
+            height: 10,
+            ..Quantities::default()
+        };
+        let per_pixel = Dispatch::PerElement {
+            quantity: Quantity::Pixels,
+            per_group: 64,
+        };
+        assert_eq!(per_pixel.direct_groups(&q, 0), Some(2));
+        assert_eq!(Dispatch::Fixed(7).direct_groups(&q, 0), Some(7));
+        let cover = Dispatch::CoverWrites {
+            words_per_group: 256,
+        };
+        assert_eq!(cover.direct_groups(&q, 257), Some(2));
+        let indirect = Dispatch::Indirect {
+            binding: "args",
+            word: 0,
+        };
+        assert_eq!(indirect.direct_groups(&q, 1000), None);
+    }
 
     #[test]
     fn typed_params_with_defaults_and_errors() {

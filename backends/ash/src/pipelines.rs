@@ -426,15 +426,17 @@ fn build_into(
                 });
             }
         } else {
-            let launch = match prep.def.dispatch() {
-                Dispatch::Fixed(n) => Launch::Direct(check_groups(u64::from(n))?),
-                Dispatch::PerElement {
-                    quantity,
-                    per_group,
-                } => Launch::Direct(check_groups(
-                    q.count(quantity).div_ceil(u64::from(per_group.max(1))),
-                )?),
-                Dispatch::Indirect { binding, word } => {
+            let most = prep
+                .bindings
+                .iter()
+                .filter(|(_, r, _)| is_buffer(*r))
+                .map(|(_, r, _)| words_of(*r))
+                .max()
+                .unwrap_or(0);
+            let dispatch = prep.def.dispatch();
+            let launch = match (dispatch.direct_groups(q, most), dispatch) {
+                (Some(n), _) => Launch::Direct(check_groups(n)?),
+                (None, Dispatch::Indirect { binding, word }) => {
                     let r = prep
                         .bindings
                         .iter()
@@ -443,18 +445,7 @@ fn build_into(
                         .ok_or_else(|| pass_error(format!("indirect `{binding}` is not bound")))?;
                     Launch::Indirect(r, word as u64 * 4)
                 }
-                Dispatch::CoverWrites { words_per_group } => {
-                    let most = prep
-                        .bindings
-                        .iter()
-                        .filter(|(_, r, _)| is_buffer(*r))
-                        .map(|(_, r, _)| words_of(*r))
-                        .max()
-                        .unwrap_or(0);
-                    Launch::Direct(check_groups(
-                        most.div_ceil(u64::from(words_per_group.max(1))),
-                    )?)
-                }
+                (None, _) => unreachable!("only indirect dispatches have no direct count"),
             };
             launches.push(launch);
             sets.push(SetPlan {

@@ -278,25 +278,16 @@ impl CpuBackend {
                 )
             })
             .collect();
-        let groups = match prep.def.dispatch() {
-            Dispatch::Fixed(n) => n,
-            Dispatch::PerElement {
-                quantity,
-                per_group,
-            } => u32::try_from(
-                instance
-                    .quantities
-                    .count(quantity)
-                    .div_ceil(u64::from(per_group.max(1))),
-            )
-            .unwrap_or(u32::MAX),
-            Dispatch::Indirect { binding, word } => {
-                bindings.get(binding).map_or(0, |w| w.load(word))
-            }
-            Dispatch::CoverWrites { words_per_group } => {
-                let most = bindings.values().map(Words::len).max().unwrap_or(0);
-                u32::try_from(most.div_ceil(words_per_group.max(1) as usize)).unwrap_or(u32::MAX)
-            }
+        let dispatch = prep.def.dispatch();
+        let most = bindings.values().map(Words::len).max().unwrap_or(0) as u64;
+        let groups = match dispatch.direct_groups(&instance.quantities, most) {
+            Some(n) => u32::try_from(n).unwrap_or(u32::MAX),
+            None => match dispatch {
+                Dispatch::Indirect { binding, word } => {
+                    bindings.get(binding).map_or(0, |w| w.load(word))
+                }
+                _ => unreachable!("only indirect dispatches have no direct count"),
+            },
         };
         let counters = Counters::default();
         let ctx = Ctx {
