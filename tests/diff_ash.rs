@@ -14,57 +14,20 @@
 //! No device or no validation layer is a failure, not a skip: CI installs
 //! lavapipe and `vulkan-validationlayers` (`scripts/test.sh`).
 
-use std::path::{Path, PathBuf};
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
 use strandgraph::images::to_picture;
-use strandgraph_ash::{AshBackend, Session, Validation};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
+
+mod common;
+use common::{ash, out_dir, read_ash, root};
 
 // Rows of 250 texels: not a multiple of any copy alignment.
 const W: u32 = 250;
 const H: u32 = 140;
 const MAX_MEAN_FLIP: f32 = 0.01;
 const MAX_PIXEL_FLIP: f32 = 0.5;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn out_dir() -> PathBuf {
-    let dir = std::env::var_os("STRANDGRAPH_DIFF_OUT")
-        .map_or_else(|| root().join("target/diff_ash"), PathBuf::from);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn ash(p: &Prepared, alias: bool) -> Session {
-    let backend = AshBackend {
-        validation: Validation::Sync,
-        alias,
-        ..AshBackend::default()
-    };
-    let (session, frame) = backend
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| {
-            panic!(
-                "ash backend failed: {e}\n(no device or layer? apt-get install mesa-vulkan-drivers \
-                 libvulkan1 vulkan-validationlayers, or run scripts/test.sh)"
-            )
-        });
-    for n in &session.notes {
-        eprintln!("ash: {n}");
-    }
-    assert_eq!(frame.timings.len(), p.plan.order.len());
-    session
-}
-
-fn read(s: &Session, name: &str) -> Vec<u32> {
-    s.read(name)
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
-        .unwrap_or_else(|| panic!("{name}: no memory on ash"))
-}
 
 /// Identical covered texels of the three visibility layers, over texels
 /// either side covers; `(same, covered)`.
@@ -108,7 +71,7 @@ fn assert_flip(
         reference.0, test.0, d.mean, d.max, d.max_at
     );
     if d.mean > MAX_MEAN_FLIP || d.max > MAX_PIXEL_FLIP {
-        let dir = out_dir();
+        let dir = out_dir("diff_ash");
         a.save(dir.join(format!("{name}.{}.png", reference.0)))
             .unwrap();
         b.save(dir.join(format!("{name}.{}.png", test.0))).unwrap();
@@ -172,12 +135,15 @@ fn showcase_visibility_matches_cpu_and_wgpu_on_ash() {
     for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
         assert_eq!(
             read_cpu(name),
-            read(&plain, name),
+            read_ash(&plain, name),
             "{name} differs (cpu vs ash)"
         );
     }
     let (cv, cc) = (read_cpu("vis_atlas"), read_cpu("coverage_atlas"));
-    let (av, ac) = (read(&plain, "vis_atlas"), read(&plain, "coverage_atlas"));
+    let (av, ac) = (
+        read_ash(&plain, "vis_atlas"),
+        read_ash(&plain, "coverage_atlas"),
+    );
     let (gv, gc) = (read_wgpu("vis_atlas"), read_wgpu("coverage_atlas"));
     let (same, covered) = layer_agreement(&cv, &cc, &av, &ac);
     let (same_w, covered_w) = layer_agreement(&gv, &gc, &av, &ac);
@@ -204,7 +170,7 @@ fn showcase_visibility_matches_cpu_and_wgpu_on_ash() {
     let (cd, gd, ad) = (
         read_cpu("debug_layers"),
         read_wgpu("debug_layers"),
-        read(&plain, "debug_layers"),
+        read_ash(&plain, "debug_layers"),
     );
     let (cpu_same, wgpu_same) = (identical(&cd, &ad), identical(&gd, &ad));
     eprintln!(
@@ -213,14 +179,14 @@ fn showcase_visibility_matches_cpu_and_wgpu_on_ash() {
         wgpu_same * 100.0
     );
     assert!(cpu_same >= 0.999 && wgpu_same >= 0.999);
-    let (co, ao) = (read_cpu("output"), read(&plain, "output"));
+    let (co, ao) = (read_cpu("output"), read_ash(&plain, "output"));
     assert_flip(&p, "output", ("cpu", &co), ("ash", &ao), W, H);
 
     // Aliasing changes where transients live, never what the frame computes.
     for name in ["debug_layers", "output"] {
         assert_eq!(
-            read(&plain, name),
-            read(&aliased, name),
+            read_ash(&plain, name),
+            read_ash(&aliased, name),
             "{name}: aliased run differs"
         );
     }
@@ -249,10 +215,10 @@ fn showcase_composed_matches_cpu_on_ash() {
     .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
     let name = "output.composed";
     let c = cpu.read(&p.plan, name).unwrap();
-    let a = read(&session, name);
+    let a = read_ash(&session, name);
     assert_flip(&p, name, ("cpu", &c), ("ash", &a), w, h);
     let cd = cpu.read(&p.plan, "scene.depth.hair").unwrap();
-    let ad = read(&session, "scene.depth.hair");
+    let ad = read_ash(&session, "scene.depth.hair");
     let depth_close = cd
         .iter()
         .zip(&ad)
@@ -264,5 +230,5 @@ fn showcase_composed_matches_cpu_on_ash() {
     session
         .run(&p.upload)
         .unwrap_or_else(|e| panic!("second frame: {e}"));
-    assert_eq!(read(&session, name), a, "the second frame differs");
+    assert_eq!(read_ash(&session, name), a, "the second frame differs");
 }

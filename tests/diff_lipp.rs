@@ -19,28 +19,19 @@
 //!
 //! No device or no validation layer is a failure, not a skip.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
 use strandgraph::images::to_picture;
-use strandgraph_ash::{AshBackend, Session, Validation};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
+
+mod common;
+use common::{ash, out_dir, read_ash, root};
 
 const W: u32 = 200;
 const H: u32 = 120;
 const MAX_MEAN_FLIP: f32 = 0.02;
-
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn out_dir() -> PathBuf {
-    let dir = std::env::var_os("STRANDGRAPH_DIFF_OUT")
-        .map_or_else(|| root().join("target/diff_lipp"), PathBuf::from);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// The mid view with a small groom, written next to the other outputs.
 fn small_scene(tag: &str) -> PathBuf {
@@ -64,33 +55,9 @@ fn small_scene(tag: &str) -> PathBuf {
 "#
     );
     // One file per test: tests run in parallel.
-    let path = out_dir().join(format!("small_{tag}.ron"));
+    let path = out_dir("diff_lipp").join(format!("small_{tag}.ron"));
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn ash(p: &Prepared, alias: bool) -> Session {
-    let backend = AshBackend {
-        validation: Validation::Sync,
-        alias,
-        ..AshBackend::default()
-    };
-    let (session, frame) = backend
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| {
-            panic!(
-                "ash backend failed: {e}\n(no device or layer? apt-get install mesa-vulkan-drivers \
-                 libvulkan1 vulkan-validationlayers, or run scripts/test.sh)"
-            )
-        });
-    assert_eq!(frame.timings.len(), p.plan.order.len());
-    session
-}
-
-fn read_ash(s: &Session, name: &str) -> Vec<u32> {
-    s.read(name)
-        .unwrap_or_else(|e| panic!("{name}: {e}"))
-        .unwrap_or_else(|| panic!("{name}: no memory on ash"))
 }
 
 /// Per G-buffer layer: (covered by exactly one side, covered by either,
@@ -200,7 +167,7 @@ fn check_flip(p: &Prepared, label: &str, reference: &[u32], test: &[u32]) {
         d.mean, d.max, d.max_at
     );
     if d.mean > MAX_MEAN_FLIP {
-        let dir = out_dir();
+        let dir = out_dir("diff_lipp");
         a.save(dir.join("output.cpu.png")).unwrap();
         b.save(dir.join(format!("output.{label}.png"))).unwrap();
         d.error_map
