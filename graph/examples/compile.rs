@@ -11,7 +11,7 @@ fn main() {
     let path = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "scenes/graphs/kulikov.ron".into());
-    let plan = match compile_file(path.as_ref(), &AnyKind) {
+    let plan = match compile_file(path.as_ref(), &AnyKind, 1) {
         Ok(plan) => plan,
         Err(e) => {
             eprintln!("{:?}", miette::Report::new(e));

@@ -172,7 +172,7 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
         }
         // An in-place write (`a -> b`) is the last use of version `a`: every
         // other reader of `a` runs first, and only one pass may consume it.
-        let consumers: Vec<(PassId, Access)> = u
+        let mut consumers: Vec<(PassId, Access)> = u
             .readers
             .iter()
             .filter(|(p, _)| {
@@ -182,6 +182,8 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
             })
             .copied()
             .collect();
+        // A pass that lists `a` in `reads` as well as in `a -> b` consumes it once.
+        consumers.dedup_by_key(|(p, _)| *p);
         if let [(a, _), (b, acc_b), ..] = consumers.as_slice() {
             errors.push(GraphError::new(
                 ErrorKind::UnorderedWriters,

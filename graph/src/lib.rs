@@ -5,6 +5,7 @@
 //!
 //! The compiler runs in stages, one module each:
 //! 1. [`resolve`]: names, usages, queues and pass kinds (against a [`PassRegistry`]);
+//!    then [`unroll`]: the per-model block, once per hair model;
 //! 2. [`deps`]: data-flow dependencies, read-before-write, cycles, unordered writers;
 //! 3. [`cull`]: passes that reach no output;
 //! 4. [`schedule`]: a lane per queue and the fewest cross-queue sync points;
@@ -32,9 +33,11 @@ pub mod schema;
 pub mod source;
 pub mod sync;
 pub mod synthetic;
+pub mod unroll;
 
 pub use error::{ErrorKind, GraphError, GraphErrors};
 pub use instance::{Instance, Quantities};
 pub use plan::{Plan, compile_file, compile_str};
 pub use registry::{AnyKind, KindList, PassRegistry};
-pub use schema::{AccessMode, GraphDesc, LifetimeClass, Queue, Usage};
+pub use schema::{AccessMode, GraphDesc, LifetimeClass, Queue, Repeat, Usage};
+pub use unroll::base_name;

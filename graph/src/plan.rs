@@ -10,6 +10,7 @@ use crate::schedule::{Lane, SyncPoint, schedule};
 use crate::schema::GraphDesc;
 use crate::source::{Locator, Source, Span};
 use crate::sync::{Dependency, dependencies};
+use crate::unroll::unroll;
 use serde::Serialize;
 use std::path::Path;
 
@@ -48,20 +49,27 @@ impl Plan {
     }
 }
 
-/// Compiles graph text; `name` is used in diagnostics.
+/// Compiles graph text; `name` is used in diagnostics. `models` is the
+/// scene's hair model count, which the per-model block is unrolled for
+/// ([`crate::unroll`]); graphs without one ignore it.
 pub fn compile_str(
     name: &str,
     text: &str,
     registry: &dyn PassRegistry,
+    models: u32,
 ) -> Result<Plan, GraphErrors> {
     let src = Source::new(name, text);
     let desc: GraphDesc = ron::from_str(text).map_err(|e| syntax_error(&src, &e))?;
     let loc = Locator::new(text);
-    compile(&desc, &src, &loc, registry)
+    compile(&desc, &src, &loc, registry, models)
 }
 
-/// Reads and compiles a graph file.
-pub fn compile_file(path: &Path, registry: &dyn PassRegistry) -> Result<Plan, GraphErrors> {
+/// Reads and compiles a graph file (see [`compile_str`]).
+pub fn compile_file(
+    path: &Path,
+    registry: &dyn PassRegistry,
+    models: u32,
+) -> Result<Plan, GraphErrors> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| {
         GraphError::new(
@@ -71,7 +79,7 @@ pub fn compile_file(path: &Path, registry: &dyn PassRegistry) -> Result<Plan, Gr
             format!("cannot read: {e}"),
         )
     })?;
-    compile_str(&name, &text, registry)
+    compile_str(&name, &text, registry, models)
 }
 
 fn compile(
@@ -79,8 +87,9 @@ fn compile(
     src: &Source,
     loc: &Locator,
     registry: &dyn PassRegistry,
+    models: u32,
 ) -> Result<Plan, GraphErrors> {
-    let graph = resolve(desc, src, loc, registry)?;
+    let graph = unroll(resolve(desc, src, loc, registry)?, models)?;
     let deps = analyse(&graph)?;
     let (live, culled) = cull(&graph, &deps);
     let sched = schedule(&graph, &deps, &live);

@@ -3,7 +3,9 @@
 
 use crate::error::{ErrorKind, GraphError, GraphErrors};
 use crate::registry::{PassRegistry, suggest};
-use crate::schema::{AccessMode, GraphDesc, ImageFormat, PassDecl, Queue, ResourceDecl, Usage};
+use crate::schema::{
+    AccessMode, GraphDesc, ImageFormat, PassDecl, Queue, Repeat, ResourceDecl, Usage,
+};
 use crate::source::{Locator, Source, Span};
 use serde::Serialize;
 use std::collections::HashMap;
@@ -42,6 +44,9 @@ pub struct Pass {
     pub accesses: Vec<Access>,
     /// Span of the pass's name.
     pub span: Span,
+    pub repeat: Repeat,
+    /// For a copy made by [`crate::unroll`]: the model it runs for.
+    pub model_index: Option<u32>,
 }
 
 impl Pass {
@@ -161,6 +166,8 @@ pub fn resolve(
             params: decl.params.clone(),
             accesses,
             span,
+            repeat: decl.repeat,
+            model_index: None,
         });
     }
 

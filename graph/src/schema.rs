@@ -217,6 +217,26 @@ pub struct PassDecl {
     /// Read-modify-write with commutative atomics (`atomicMin`, `atomicAdd`).
     #[serde(default)]
     pub atomics: Vec<String>,
+    /// Run this pass once per hair model (see [`Repeat`]).
+    #[serde(default)]
+    pub repeat: Repeat,
+}
+
+/// How often a pass runs per frame.
+///
+/// Consecutive `PerModel` passes form one block that runs once per hair
+/// model, model after model (Lipp §3.5 "Multiple Grooms": "each groom is
+/// processed sequentially through the same rasterization and filtering
+/// pipeline"). The compiler unrolls the block for the scene's model count
+/// ([`crate::unroll`]): each copy gets the param `model_index`, transients
+/// only the block uses get one copy per model (which the memory plan
+/// aliases), and an in-place write `a -> b` in the block chains from one
+/// model to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+pub enum Repeat {
+    #[default]
+    Once,
+    PerModel,
 }
 
 fn empty_map() -> ron::Value {

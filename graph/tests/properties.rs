@@ -54,7 +54,7 @@ fn spec() -> impl Strategy<Value = Spec> {
 }
 
 fn compile(spec: &Spec) -> Plan {
-    compile_str("synthetic.ron", &spec.to_ron(), &Spec::kinds())
+    compile_str("synthetic.ron", &spec.to_ron(), &Spec::kinds(), 1)
         .unwrap_or_else(|e| panic!("{e}\n{}", spec.to_ron()))
 }
 

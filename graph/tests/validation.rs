@@ -16,7 +16,7 @@ fn marker_line(src: &str) -> usize {
 }
 
 fn expect_error(src: &str, kind: ErrorKind, names: &[&str]) -> GraphError {
-    let errors = match compile_str("bad.ron", src, &registry()) {
+    let errors = match compile_str("bad.ron", src, &registry(), 1) {
         Ok(_) => panic!("expected {kind:?}, but the graph compiled"),
         Err(e) => e,
     };
@@ -246,7 +246,7 @@ fn ordered_writers_are_accepted() {
     ],
     outputs: ["out"],
 )"#;
-    let plan = compile_str("ok.ron", src, &registry()).unwrap();
+    let plan = compile_str("ok.ron", src, &registry(), 1).unwrap();
     assert!(
         plan.dependencies
             .iter()
@@ -371,7 +371,7 @@ fn zero_sized_resource_is_reported_at_instantiation() {
     ],
     outputs: ["out"],
 )"#;
-    let plan = compile_str("bad.ron", src, &registry()).unwrap();
+    let plan = compile_str("bad.ron", src, &registry(), 1).unwrap();
     let q = Quantities {
         strands: 0,
         ..Quantities::example()
@@ -397,7 +397,7 @@ fn several_errors_are_reported_together() {
     ],
     outputs: ["out"],
 )"#;
-    let errors = compile_str("bad.ron", src, &registry()).unwrap_err();
+    let errors = compile_str("bad.ron", src, &registry(), 1).unwrap_err();
     assert_eq!(
         errors.kinds(),
         vec![ErrorKind::UnknownPassKind, ErrorKind::UnknownResource]
@@ -421,7 +421,7 @@ fn versions_order_old_readers_before_the_in_place_writer() {
     ],
     outputs: ["out.fogged"],
 )"#;
-    let plan = compile_str("ok.ron", src, &registry()).unwrap();
+    let plan = compile_str("ok.ron", src, &registry(), 1).unwrap();
     let order: Vec<&str> = plan.order.iter().map(|&p| plan.pass_name(p)).collect();
     assert_eq!(order, ["prepass", "downsample", "hair", "fog"]);
     // Versions share their resource's memory: one lifetime, one placement.

@@ -2,6 +2,7 @@
 //! every error carries a byte offset or a line.
 
 pub mod cyhair;
+pub mod envmap;
 pub mod obj;
 pub mod reader;
 pub mod tfx2;

@@ -8,6 +8,7 @@ use super::{GroomDesc, GroomSource, LodSettings, Material, MeshSource, SceneDesc
 use crate::error::AssetError;
 use crate::groom::Groom;
 use crate::hairmesh::HairMesh;
+use crate::loaders::envmap::{self, EnvMap};
 use crate::loaders::{self, LoadOptions};
 use crate::mesh::TriMesh;
 use crate::procedural::surface::{Shape, Surface};
@@ -56,6 +57,9 @@ pub struct Scene {
     pub grooms: Vec<SceneGroom>,
     /// The render graph file, resolved against the scene's folder.
     pub graph: PathBuf,
+    /// The environment's map (`environment.map`), as loaded: radiance not yet
+    /// scaled by the environment's `color × intensity`.
+    pub environment_map: Option<EnvMap>,
 }
 
 /// Totals the render-graph CLI maps into graph quantities.
@@ -162,6 +166,13 @@ impl Scene {
             })
             .collect::<Result<_, _>>()?;
 
+        let environment_map = match desc.environment.as_ref().and_then(|e| e.map.as_ref()) {
+            Some(p) => Some(
+                envmap::load(&dir.join(p)).map_err(|e| err(p, format!("environment map: {e}")))?,
+            ),
+            None => None,
+        };
+
         // Grooms, one after another (each is parallel inside).
         let mut grooms = Vec::with_capacity(desc.grooms.len());
         for g in &desc.grooms {
@@ -175,6 +186,7 @@ impl Scene {
             desc,
             meshes,
             grooms,
+            environment_map,
         })
     }
 
@@ -424,5 +436,34 @@ mod tests {
         );
         let e = load_err(&p).to_string();
         assert!(e.contains("nope.obj") && e.contains(":10:"), "{e}");
+    }
+
+    #[test]
+    fn environment_maps_load_relative_to_the_scene_and_errors_name_them() {
+        let d = tmp("envmap");
+        let with =
+            |map: &str| MINI.replace("intensity: 0.3)", &format!("intensity: 0.3, map: {map:?})"));
+        let p = write(&d, "missing.ron", &with("env/none.exr"));
+        let e = load_err(&p).to_string();
+        assert!(
+            e.contains(":8:") && e.contains("environment map") && e.contains("env/none.exr"),
+            "{e}"
+        );
+        std::fs::create_dir_all(d.join("env")).unwrap();
+        std::fs::write(d.join("env/bad.hdr"), b"#?RADIANCE\n\n-Y 10 +X 10\n").unwrap();
+        let p = write(&d, "bad.ron", &with("env/bad.hdr"));
+        let e = load_err(&p).to_string();
+        assert!(e.contains("bad.hdr") && e.contains("twice as wide"), "{e}");
+        let studio = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/env/studio.exr");
+        let p = write(&d, "good.ron", &with(&studio.display().to_string()));
+        let s = Scene::load(&p).unwrap();
+        let m = s.environment_map.expect("the map is loaded");
+        assert_eq!((m.width, m.height), (128, 64));
+        assert!(
+            Scene::load(&write(&d, "none.ron", MINI))
+                .unwrap()
+                .environment_map
+                .is_none()
+        );
     }
 }
