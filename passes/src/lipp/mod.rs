@@ -7,6 +7,7 @@
 //! `shaders/lipp/` ports the CPU kernels operation for operation.
 
 pub mod assemble;
+pub mod chiang;
 pub mod dom;
 pub mod filter;
 pub mod lod;
