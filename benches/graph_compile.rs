@@ -12,11 +12,11 @@ fn compile_benches(c: &mut Criterion) {
     let kinds = Spec::kinds();
     c.bench_function("compile/synthetic_1000_passes", |b| {
         b.iter(|| {
-            compile_str("synthetic.ron", black_box(&text), &kinds)
+            compile_str("synthetic.ron", black_box(&text), &kinds, 1)
                 .expect("synthetic graph compiles")
         })
     });
-    let plan = compile_str("synthetic.ron", &text, &kinds).expect("synthetic graph compiles");
+    let plan = compile_str("synthetic.ron", &text, &kinds, 1).expect("synthetic graph compiles");
     let q = Quantities::example();
     c.bench_function("instantiate/synthetic_1000_passes", |b| {
         b.iter(|| plan.instantiate(black_box(&q)).expect("sizes resolve"))
@@ -26,7 +26,7 @@ fn compile_benches(c: &mut Criterion) {
     let kulikov = std::fs::read_to_string(path).expect("kulikov.ron is shipped");
     c.bench_function("compile/kulikov", |b| {
         b.iter(|| {
-            compile_str(path, black_box(&kulikov), &strandgraph_passes::Registry)
+            compile_str(path, black_box(&kulikov), &strandgraph_passes::Registry, 1)
                 .expect("kulikov compiles")
         })
     });

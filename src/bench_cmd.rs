@@ -260,7 +260,8 @@ fn backends(args: &Args) -> Vec<(Backend, bool)> {
 
 /// Why `graph` cannot run yet: the first live pass kind without a definition.
 fn missing_kernel(graph: &Path) -> Result<Option<String>> {
-    let plan = strandgraph_graph::compile_file(graph, &Registry)?;
+    // Which kinds a graph uses does not depend on the model count.
+    let plan = strandgraph_graph::compile_file(graph, &Registry, 1)?;
     Ok(plan
         .order
         .iter()
@@ -288,7 +289,7 @@ fn prepare_graph(
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(miette!("--size {w}x{h} is outside 1..=16384"));
     }
-    let mut plan = strandgraph_graph::compile_file(graph, &Registry)?;
+    let mut plan = strandgraph_graph::compile_file(graph, &Registry, scene.grooms.len() as u32)?;
     let shade: Vec<String> = plan
         .graph
         .passes
@@ -537,7 +538,7 @@ fn roofline(
     cpu: CpuOptions,
     counting: CpuOptions,
 ) -> Result<Roofline> {
-    let plan = strandgraph_graph::compile_file(&locate(ROOFLINE), &Registry)?;
+    let plan = strandgraph_graph::compile_file(&locate(ROOFLINE), &Registry, 1)?;
     let instance = plan.instantiate(&first.upload.quantities)?;
     let upload = Upload {
         quantities: first.upload.quantities,

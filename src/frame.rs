@@ -33,7 +33,7 @@ pub fn prepare(
         ));
     }
     let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
-    let plan = compile_file(&graph_path, &Registry)?;
+    let plan = compile_file(&graph_path, &Registry, scene.grooms.len() as u32)?;
     let mut upload = upload(&scene, w, h);
     bake_shadows(&plan, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
@@ -103,18 +103,28 @@ pub fn override_param(plan: &mut Plan, spec: &str) -> Result<()> {
     let (pass, param) = target.split_once('.').ok_or_else(bad)?;
     let value: ron::Value = ron::from_str(value.trim())
         .map_err(|e| miette::miette!("--param {spec}: value is not RON: {e}"))?;
-    let p = plan.graph.pass_id(pass.trim()).ok_or_else(|| {
-        miette::miette!(
+    // `raster.x=…` sets every per-model copy (`raster[0]`, `raster[1]`, …).
+    let pass = pass.trim();
+    let targets: Vec<usize> = (0..plan.graph.passes.len())
+        .filter(|&p| {
+            let name = &plan.graph.passes[p].name;
+            name == pass || strandgraph_graph::base_name(name) == pass
+        })
+        .collect();
+    if targets.is_empty() {
+        return Err(miette::miette!(
             "--param {spec}: graph `{}` has no pass `{pass}`",
             plan.graph.name
-        )
-    })?;
-    let params = &mut plan.graph.passes[p].params;
-    if !matches!(params, ron::Value::Map(_)) {
-        *params = ron::Value::Map(ron::Map::new());
+        ));
     }
-    if let ron::Value::Map(m) = params {
-        m.insert(ron::Value::String(param.trim().to_string()), value);
+    for p in targets {
+        let params = &mut plan.graph.passes[p].params;
+        if !matches!(params, ron::Value::Map(_)) {
+            *params = ron::Value::Map(ron::Map::new());
+        }
+        if let ron::Value::Map(m) = params {
+            m.insert(ron::Value::String(param.trim().to_string()), value.clone());
+        }
     }
     Ok(())
 }

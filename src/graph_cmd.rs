@@ -41,11 +41,12 @@ pub fn run(args: Args) -> Result<()> {
         (None, Some(scene)) => scene.graph.clone(),
         (None, None) => return Err(miette::miette!("give a graph file or --scene")),
     };
-    let plan = compile_file(&file, &Registry)?;
     let base = scene
         .as_ref()
         .map_or_else(Quantities::example, |s| from_scene(s.counts()));
     let quantities = quantities(base, &args.set)?;
+    let models = u32::try_from(quantities.models).unwrap_or(u32::MAX);
+    let plan = compile_file(&file, &Registry, models)?;
     let instance = plan.instantiate(&quantities)?;
     tracing::info!(
         passes = plan.order.len(),

@@ -45,7 +45,12 @@ fn floats(words: &[u32]) -> Vec<f32> {
 /// The Kulikov graph and the showcase seen from 10 m, then from 0.9 m.
 fn two_frames() -> (Plan, Instance, Upload, Upload) {
     let mut scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
-    let mut plan = compile_file(&root().join("scenes/graphs/kulikov.ron"), &Registry).unwrap();
+    let mut plan = compile_file(
+        &root().join("scenes/graphs/kulikov.ron"),
+        &Registry,
+        scene.grooms.len() as u32,
+    )
+    .unwrap();
     // Shading does not matter here; skip the self-shadowing bake.
     override_param(&mut plan, "shade.self_shadow=\"None\"").unwrap();
     look_from(&mut scene, [0.0, 1.6, 10.0]);

@@ -36,7 +36,8 @@ pub fn view(name: &str) -> PathBuf {
 
 /// Why `graph` cannot run yet (a live pass kind without kernels), if so.
 pub fn missing_kernel(graph: &std::path::Path) -> Option<String> {
-    let plan = match strandgraph_graph::compile_file(graph, &Registry) {
+    // Which kinds a graph uses does not depend on the model count.
+    let plan = match strandgraph_graph::compile_file(graph, &Registry, 1) {
         Ok(p) => p,
         Err(e) => return Some(format!("{e}")),
     };

@@ -65,7 +65,9 @@ pub fn unroll(mut g: Graph, models: u32) -> Result<Graph, GraphErrors> {
     let roles = classify(&g, first, last, &mut errors);
     for &p in &block {
         let params_ok = match &g.passes[p].params {
-            ron::Value::Map(m) => !m.iter().any(|(k, _)| *k == ron::Value::String(MODEL_INDEX.into())),
+            ron::Value::Map(m) => !m
+                .iter()
+                .any(|(k, _)| *k == ron::Value::String(MODEL_INDEX.into())),
             _ => false,
         };
         if !params_ok {
@@ -338,7 +340,11 @@ mod tests {
                 .iter()
                 .any(|a| a.mode.writes() && g.resources[a.resource].name == "out.hair")
         );
-        assert!(plan.dependencies.iter().any(|d| d.from == pass(&plan, "filter[2]") && d.to == pass(&plan, "post")));
+        assert!(
+            plan.dependencies
+                .iter()
+                .any(|d| d.from == pass(&plan, "filter[2]") && d.to == pass(&plan, "post"))
+        );
     }
 
     #[test]
@@ -373,7 +379,10 @@ mod tests {
         let err = compile_str("bad.ron", &src, &kinds(), 2).unwrap_err();
         let e = err.first();
         assert_eq!(e.kind, ErrorKind::UnorderedWriters, "{err}");
-        assert!(e.message.contains("clear") && e.message.contains("gbuffer"), "{e}");
+        assert!(
+            e.message.contains("clear") && e.message.contains("gbuffer"),
+            "{e}"
+        );
         assert_eq!(e.line, 11, "points at the access: {e}");
     }
 
@@ -388,6 +397,9 @@ mod tests {
             r#"Pass(name: "clear_depth", kind: "common.clear", repeat: PerModel,"#,
         );
         let err = compile_str("bad.ron", &src, &kinds(), 2).unwrap_err();
-        assert!(err.first().message.contains("`clear` sits between"), "{err}");
+        assert!(
+            err.first().message.contains("`clear` sits between"),
+            "{err}"
+        );
     }
 }

@@ -143,7 +143,11 @@ mod tests {
         for entry in std::fs::read_dir(dir).expect("scenes/graphs exists") {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "ron") {
-                strandgraph_graph::compile_file(&path, &Registry).unwrap_or_else(|e| panic!("{e}"));
+                // One model, and three: every per-model block unrolls cleanly.
+                for models in [1, 3] {
+                    strandgraph_graph::compile_file(&path, &Registry, models)
+                        .unwrap_or_else(|e| panic!("{e}"));
+                }
                 seen += 1;
             }
         }

@@ -22,6 +22,7 @@ fn a_missing_validation_layer_is_an_error() {
             outputs: ["out"],
         )"#,
         &Registry,
+        1,
     )
     .unwrap();
     let instance = plan.instantiate(&Default::default()).unwrap();

@@ -28,6 +28,7 @@ fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
     let plan = compile_file(
         &root().join("scenes/graphs/kulikov_visibility.ron"),
         &Registry,
+        scene.counts().models as u32,
     )
     .unwrap();
     let up = upload(&scene, 96, 54);
@@ -76,6 +77,7 @@ fn a_clear_pass_writes_its_value() {
             outputs: ["out"],
         )"#,
         &Registry,
+        1,
     )
     .unwrap();
     let instance = plan.instantiate(&Default::default()).unwrap();
@@ -98,7 +100,7 @@ fn a_clear_pass_writes_its_value() {
 /// SPIR-V capabilities, enabled only because that pass needs them.
 #[test]
 fn int64_atomics_are_enabled_for_the_pass_that_needs_them() {
-    let plan = compile_file(&root().join("scenes/graphs/roofline.ron"), &Registry).unwrap();
+    let plan = compile_file(&root().join("scenes/graphs/roofline.ron"), &Registry, 1).unwrap();
     let q = strandgraph_graph::Quantities {
         width: 64,
         height: 32,

@@ -216,7 +216,7 @@ const CHAIN: &str = r#"Graph(
 )"#;
 
 fn chain_plan() -> Plan {
-    compile_str("chain.ron", CHAIN, &kinds()).unwrap_or_else(|e| panic!("{e}"))
+    compile_str("chain.ron", CHAIN, &kinds(), 1).unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -276,7 +276,7 @@ const CROSS_QUEUE: &str = r#"Graph(
 
 #[test]
 fn queues_wait_at_sync_points_and_a_missing_one_is_a_race() {
-    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds()).unwrap();
+    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds(), 1).unwrap();
     assert_eq!(plan.sync_points.len(), 1);
     let inst = plan.instantiate(&quantities()).unwrap();
     let backend = CpuBackend::default();
@@ -301,7 +301,7 @@ fn queues_wait_at_sync_points_and_a_missing_one_is_a_race() {
 
 #[test]
 fn a_sync_point_that_is_never_signalled_times_out() {
-    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds()).unwrap();
+    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds(), 1).unwrap();
     let inst = plan.instantiate(&quantities()).unwrap();
     let mut broken = plan.clone();
     broken.sync_points[0].value = 99;
@@ -324,7 +324,7 @@ fn kinds_without_kernels_are_refused_by_name() {
         resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
         passes: [Pass(name: "r", kind: "kulikov.raster", writes: ["out"])],
         outputs: ["out"])"#;
-    let plan = compile_str("g.ron", src, &strandgraph_passes::Registry).unwrap();
+    let plan = compile_str("g.ron", src, &strandgraph_passes::Registry, 1).unwrap();
     let inst = plan.instantiate(&quantities()).unwrap();
     let err = CpuBackend::default()
         .execute(&plan, &inst, &Inputs::default())
@@ -335,7 +335,7 @@ fn kinds_without_kernels_are_refused_by_name() {
 
 #[test]
 fn imported_inputs_are_uploaded_and_checked() {
-    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds()).unwrap();
+    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds(), 1).unwrap();
     let inst = plan.instantiate(&quantities()).unwrap();
     let mut inputs = Inputs::default();
     inputs.set("b", vec![5; 4096]);
