@@ -12,6 +12,7 @@ pub mod dom;
 pub mod filter;
 pub mod lod;
 pub mod payload;
+pub mod probe;
 pub mod raster;
 pub mod shade;
 pub mod strand;

@@ -1,6 +1,7 @@
 //! Packs a scene's hair meshes into `hairmesh.bundles` and `hairmesh.layers`
 //! (layouts in `scenes/graphs/lipp.ron` and [`super::BundleRecord`],
-//! [`super::Corner`]) and the environment into `env.sh`.
+//! [`super::Corner`]) and the environment into `env.sh` and
+//! `env.prefiltered` ([`super::probe`]).
 //!
 //! Layers are stored in world space (each groom's world matrix applied here
 //! once), so the kernels need no per-bundle transform. Bundles are numbered
@@ -11,7 +12,7 @@
 
 use super::{BUNDLE_WORDS, BundleRecord, LAYER_WORDS, MAX_LAYERS, pcg};
 use crate::upload::Upload;
-use glam::{Mat3, Vec3};
+use glam::Mat3;
 use strandgraph_assets::Scene;
 
 /// Resource names.
@@ -70,19 +71,17 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
     up.set(BUNDLES, bundles);
     up.set(LAYERS, layers);
     up.set(ENV_SH, env_sh(scene));
+    up.set(
+        super::probe::PREFILTERED,
+        super::probe::prefiltered_words(scene),
+    );
 }
 
 /// `env.sh`: 9 L2 spherical-harmonic radiance coefficients (Ramamoorthi and
-/// Hanrahan 2001), rgb + pad each. The scene's constant environment colour
-/// only has the L00 term (`L · 4π · Y00`); a map would fill the rest.
+/// Hanrahan 2001), rgb + pad each: the environment map projected, or the
+/// constant colour's L00 term (`L · 4π · Y00`) ([`super::probe::sh_words`]).
 pub fn env_sh(scene: &Scene) -> Vec<u32> {
-    let mut sh = [[0f32; 4]; 9];
-    if let Some(env) = &scene.desc.environment {
-        let c = Vec3::from(env.color) * env.intensity;
-        let l00 = 4.0 * std::f32::consts::PI * 0.282_095;
-        sh[0] = [c.x * l00, c.y * l00, c.z * l00, 0.0];
-    }
-    sh.iter().flatten().map(|x| x.to_bits()).collect()
+    super::probe::sh_words(scene)
 }
 
 #[cfg(test)]
