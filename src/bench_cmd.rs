@@ -96,7 +96,11 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 1",
         graph: LIPP,
-        overrides: &["lod.enabled=false", "filter.enabled=false"],
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "filter.enabled=false",
+        ],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
@@ -104,7 +108,7 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 1+F",
         graph: LIPP,
-        overrides: &["lod.enabled=false"],
+        overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
@@ -128,7 +132,12 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 2",
         graph: LIPP_MSAA,
-        overrides: &["lod.enabled=false", "raster.msaa=2", "filter.msaa=2"],
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=2",
+            "filter.msaa=2",
+        ],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
@@ -136,7 +145,12 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 4",
         graph: LIPP_MSAA,
-        overrides: &["lod.enabled=false", "raster.msaa=4", "filter.msaa=4"],
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=4",
+            "filter.msaa=4",
+        ],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
@@ -144,7 +158,12 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 8",
         graph: LIPP_MSAA,
-        overrides: &["lod.enabled=false", "raster.msaa=8", "filter.msaa=8"],
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=8",
+            "filter.msaa=8",
+        ],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
@@ -502,7 +521,7 @@ fn count_atomics(p: &Prepared, v: &Variant, counting: CpuOptions) -> Result<u64>
     Ok(counter
         .run(&plan, &p.upload)?
         .iter()
-        .filter(|t| v.raster.contains(&t.name.as_str()))
+        .filter(|t| v.raster.contains(&strandgraph_graph::base_name(&t.name)))
         .filter_map(|t| t.atomics)
         .sum())
 }

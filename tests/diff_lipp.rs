@@ -2,7 +2,8 @@
 //! the CPU simulator (the reference), wgpu and ash (lavapipe in CI; ash
 //! under the Khronos validation layer with synchronization validation) run
 //! the same WGSL-described passes on a small groom (the mid view's camera and
-//! hair mesh style, 8,000 strands in 128 bundles, at 200×120).
+//! hair mesh style and studio environment map, 8,000 strands in 128
+//! bundles, at 200×120).
 //!
 //! Gates:
 //! - `bundle_lod` and `raster_args` (integer decisions from float screen
@@ -36,12 +37,15 @@ const MAX_MEAN_FLIP: f32 = 0.02;
 /// The mid view with a small groom, written next to the other outputs.
 fn small_scene(tag: &str) -> PathBuf {
     let graph = root().join("scenes/graphs/lipp.ron");
+    // The studio map, so the prefiltered lookup is compared (a constant
+    // environment would make every probe texel the same).
+    let map = root().join("scenes/env/studio.exr");
     let text = format!(
         r#"Scene(
     resolution: ({W}, {H}),
     camera: Orbit(target: (0.0, 1.5, 0.0), distance: 2.5, yaw_deg: 25.0, pitch_deg: 5.0, fov_deg: 40.0),
     lights: [Directional(direction: (0.3, -0.7, -0.6), color: (1.0, 0.97, 0.92), intensity: 3.0)],
-    environment: (color: (0.5, 0.55, 0.65), intensity: 0.4),
+    environment: (color: (1.0, 1.0, 1.0), intensity: 0.5, map: {map:?}),
     meshes: [(name: "head", source: Head(resolution: 48), transform: (translation: (0.0, 1.6, 0.0)))],
     grooms: [(
         name: "small",

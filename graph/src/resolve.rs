@@ -23,6 +23,9 @@ pub struct Resource {
     /// For a version made by an in-place write (`"a -> b"`), the declared
     /// resource whose memory it is; `None` for declared resources.
     pub version_of: Option<ResourceId>,
+    /// For a per-model copy made by [`crate::unroll`] (`gbuffer[1]`): the
+    /// resource it copies (`gbuffer`). Kernels bind it under that name.
+    pub copy_of: Option<ResourceId>,
 }
 
 /// One entry of a pass's `reads`, `writes` or `atomics`.
@@ -47,6 +50,9 @@ pub struct Pass {
     pub repeat: Repeat,
     /// For a copy made by [`crate::unroll`]: the model it runs for.
     pub model_index: Option<u32>,
+    /// Accesses written `"resource as name"`: the kernel binds `resource`
+    /// under `name` (one pass kind used on two sets of resources).
+    pub bind_as: Vec<(ResourceId, String)>,
 }
 
 impl Pass {
@@ -123,6 +129,7 @@ pub fn resolve(
             decl: decl.clone(),
             span,
             version_of: None,
+            copy_of: None,
         });
     }
     declare_versions(desc, src, loc, &mut resources, &mut by_name, &mut errors);
@@ -158,7 +165,16 @@ pub fn resolve(
             }
             errors.push(e);
         }
-        let accesses = resolve_accesses(i, decl, &resources, &by_name, src, loc, &mut errors);
+        let mut bind_as = Vec::new();
+        let accesses = resolve_accesses(
+            i,
+            decl,
+            (&resources, &by_name),
+            &mut bind_as,
+            src,
+            loc,
+            &mut errors,
+        );
         passes.push(Pass {
             name: decl.name.clone(),
             kind: decl.kind.clone(),
@@ -168,6 +184,7 @@ pub fn resolve(
             span,
             repeat: decl.repeat,
             model_index: None,
+            bind_as,
         });
     }
 
@@ -220,8 +237,8 @@ pub fn resolve(
 fn resolve_accesses(
     pass_index: usize,
     decl: &PassDecl,
-    resources: &[Resource],
-    by_name: &HashMap<String, ResourceId>,
+    (resources, by_name): (&[Resource], &HashMap<String, ResourceId>),
+    bind_as: &mut Vec<(ResourceId, String)>,
     src: &Source,
     loc: &Locator,
     errors: &mut Vec<GraphError>,
@@ -235,10 +252,26 @@ fn resolve_accesses(
     for (mode, list) in lists {
         for (j, entry) in list.iter().enumerate() {
             let span = loc.span(&format!("passes[{pass_index}].{}[{j}]", mode.field()));
-            let (entry, renamed) = match entry.split_once("->") {
-                Some((old, new)) => (old.trim(), Some(new.trim())),
+            let (entry, alias) = match entry.split_once(" as ") {
+                Some((e, name)) => (e.trim(), Some(name.trim())),
                 None => (entry.as_str(), None),
             };
+            let (entry, renamed) = match entry.split_once("->") {
+                Some((old, new)) => (old.trim(), Some(new.trim())),
+                None => (entry, None),
+            };
+            if renamed.is_some() && alias.is_some() {
+                errors.push(GraphError::new(
+                    ErrorKind::BadAccess,
+                    src,
+                    span,
+                    format!(
+                        "pass `{}`: an in-place write `a -> b` binds under `a`'s name; it takes no `as`",
+                        decl.name
+                    ),
+                ));
+                continue;
+            }
             if renamed.is_some() && mode != AccessMode::Write {
                 errors.push(GraphError::new(
                     ErrorKind::BadAccess,
@@ -292,6 +325,9 @@ fn resolve_accesses(
                     format!("pass `{}`: `{entry}` {problem}", decl.name),
                 ));
                 continue;
+            }
+            if let Some(name) = alias {
+                bind_as.push((resource, name.to_string()));
             }
             if let Some(new) = renamed {
                 // An in-place write reads the old version and produces the new one.
@@ -416,6 +452,7 @@ fn declare_versions(
                 decl: resources[root].decl.clone(),
                 span: *span,
                 version_of: Some(root),
+                copy_of: None,
             });
             false
         });

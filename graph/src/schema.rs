@@ -17,7 +17,10 @@
 //! ```
 //!
 //! Access entries are resource names with an optional usage prefix
-//! (`"indirect:raster_args"`, `"color:output"`); see [`Usage`]. Sizes that
+//! (`"indirect:raster_args"`, `"color:output"`); see [`Usage`]. A suffix
+//! `as NAME` (`"indirect:shadow_args as raster_args"`) hands the resource to
+//! the pass's kernel under the binding name `NAME`, so one kind can run on
+//! two sets of resources. Sizes that
 //! depend on the scene are symbolic ([`Quantity`]) and resolved when a plan is
 //! instantiated.
 

@@ -97,6 +97,7 @@ pub fn unroll(mut g: Graph, models: u32) -> Result<Graph, GraphErrors> {
                     map.insert(r, g.resources.len());
                     g.resources.push(crate::resolve::Resource {
                         name: format!("{}[{k}]", copy.name),
+                        copy_of: Some(r),
                         ..copy
                     });
                 }
@@ -142,8 +143,12 @@ pub fn unroll(mut g: Graph, models: u32) -> Result<Graph, GraphErrors> {
                     ron::Value::Number((k as u64).into()),
                 );
             }
+            let remap = |r: ResourceId| map.get(&r).copied().unwrap_or(r);
             for a in &mut p.accesses {
-                a.resource = map.get(&a.resource).copied().unwrap_or(a.resource);
+                a.resource = remap(a.resource);
+            }
+            for (r, _) in &mut p.bind_as {
+                *r = remap(*r);
             }
             passes.push(p);
         }

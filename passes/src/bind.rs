@@ -1,7 +1,9 @@
 //! Matching a graph pass's accesses to its kind's bindings, the same way on
 //! every backend: by resource name, in the order the definition lists them.
 //! A pass reading a version of a resource (`clip_positions.skinned`) binds
-//! it under the resource's name (`clip_positions`).
+//! it under the resource's name (`clip_positions`), and a per-model copy
+//! (`gbuffer[1]`) under the name of what it copies (`gbuffer`). An access
+//! written `"shadow_lod as bundle_lod"` binds under the name after `as`.
 
 use crate::contract::PassDef;
 use strandgraph_graph::resolve::{Access, Graph, PassId};
@@ -42,11 +44,27 @@ pub fn bind(def: &dyn PassDef, g: &Graph, p: PassId) -> Result<Vec<Bound>, Missi
             .map(|b| {
                 // A version (`a -> a.next`) binds under its resource's name,
                 // so kernels need not know how the graph versions a resource.
-                let root = |a: &&Access| g.resources[g.physical(a.resource)].name == b.name;
+                let root = |a: &&Access| {
+                    let r = &g.resources[g.physical(a.resource)];
+                    let r = r.copy_of.map_or(r, |c| &g.resources[c]);
+                    r.name == b.name
+                };
+                let aliased = |a: &&Access| {
+                    pass.bind_as
+                        .iter()
+                        .any(|(r, name)| *r == a.resource && name == b.name)
+                };
+                let plain = |a: &&Access| !pass.bind_as.iter().any(|(r, _)| *r == a.resource);
                 pass.accesses
                     .iter()
-                    .find(|a| g.resources[a.resource].name == b.name)
-                    .or_else(|| pass.accesses.iter().find(root))
+                    .find(aliased)
+                    .or_else(|| {
+                        pass.accesses
+                            .iter()
+                            .filter(plain)
+                            .find(|a| g.resources[a.resource].name == b.name)
+                    })
+                    .or_else(|| pass.accesses.iter().filter(plain).find(root))
                     .map(|a| Bound {
                         name: b.name.to_string(),
                         access: *a,

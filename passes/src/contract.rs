@@ -231,6 +231,16 @@ impl<'a> Params<'a> {
         }
     }
 
+    /// The model a pass of the graph's per-model block runs for
+    /// (`strandgraph_graph::unroll`); `None` outside the block.
+    pub fn model_index(&self) -> Result<Option<u32>, ParamError> {
+        let name = strandgraph_graph::unroll::MODEL_INDEX;
+        match self.get(name) {
+            None => Ok(None),
+            Some(_) => self.u32(name, 0).map(Some),
+        }
+    }
+
     pub fn string(&self, name: &str, default: &str) -> Result<String, ParamError> {
         match self.get(name) {
             None => Ok(default.to_string()),

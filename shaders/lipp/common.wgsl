@@ -12,6 +12,7 @@ const RASTER_GROUP: u32 = 32u;
 const MAX_CONTROL_POINTS: u32 = 129u;
 const MAX_GROUPS_X: u32 = 65535u;
 const LOD_CULLED: u32 = 1u;
+const LOD_OTHER_GROOM: u32 = 2u;
 // payload::DEPTH_MAX, the sub-pixel snap grid.
 const DEPTH_MAX: f32 = 16777215.0;
 const SNAP: f32 = 256.0;

@@ -23,7 +23,8 @@ struct FilterParams {
     height: u32,
     // MSAA reference resolve (0: the single-sample filter).
     msaa: u32,
-    _pad: u32,
+    // Pixels at least this opaque write their hair depth (Lipp §3.5).
+    depth_alpha: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -31,6 +32,8 @@ struct FilterParams {
 @group(0) @binding(2) var<storage, read> gbuffer: array<vec2<u32>>;
 @group(0) @binding(3) var<storage, read> shaded: array<vec4<f32>>;
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, read_write>;
+// NDC depth (f32 bits) the next groom's rasterizer is tested against.
+@group(0) @binding(5) var<storage, read_write> hair_depth: array<u32>;
 
 fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
@@ -145,14 +148,18 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
     let cons = !is_empty(a);
     let scene = textureLoad(output, vec2<u32>(x, y));
     var out = vec4<f32>(0.0);
+    // NDC depth of the nearest sample the colour came from.
+    var depth = 1.0;
     if params.msaa > 1u {
         // MSAA reference resolve (Lipp Fig. 5, "MSAA 8").
         var sum = vec3<f32>(0.0);
         var hits = 0u;
         for (var s = 0u; s < min(params.msaa, layer_count()); s++) {
-            if !is_empty(payload(s, i)) {
+            let q = payload(s, i);
+            if !is_empty(q) {
                 sum += color(s, i).xyz;
                 hits += 1u;
+                depth = min(depth, unpack_payload(q).depth);
             }
         }
         if hits == 0u {
@@ -164,8 +171,10 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
             return;
         }
         out = vec4<f32>(color(0u, i).xyz, 1.0);
+        depth = unpack_payload(g).depth;
     } else if centre {
         let sg = unpack_payload(g);
+        depth = sg.depth;
         out = reconstruct(x, y, sg.depth, screen_tangent(x, y, sg), color(0u, i), false);
         var front = false;
         if cons && params.reconnect != 0u {
@@ -177,14 +186,19 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
             let sa = unpack_payload(a);
             let f = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
             out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
+            depth = sa.depth;
         }
     } else if cons && params.reconnect != 0u {
         // Promoted conservative-only pixel (§3.3.2).
         let sa = unpack_payload(a);
         out = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+        depth = sa.depth;
     } else {
         return;
     }
     let alpha = out.w;
     textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), scene.w));
+    if alpha >= params.depth_alpha {
+        hair_depth[i] = bitcast<u32>(min(bitcast<f32>(hair_depth[i]), depth));
+    }
 }

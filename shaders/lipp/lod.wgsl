@@ -5,7 +5,7 @@
 // paper's one-thread-per-bundle pass that lod.rs explains).
 
 #import strandgraph::layout::FrameData
-#import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, F32_MAX, F32_MIN}
+#import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
 struct LodParams {
@@ -18,6 +18,18 @@ struct LodParams {
     resolution_lod: u32,
     // Scene quantity: bundles packed.
     bundles: u32,
+    // Only this groom's bundles (the per-model block); ALL_MODELS: every groom.
+    model: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+const ALL_MODELS: u32 = 0xffffffffu;
+
+// Whether bundle b belongs to the groom(s) this pass decides for.
+fn included(b: u32) -> bool {
+    return params.model == ALL_MODELS || hairmesh_bundles[b * BUNDLE_WORDS + 3u] == params.model;
 }
 
 @group(0) @binding(0) var<uniform> params: LodParams;
@@ -42,6 +54,9 @@ fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
 
 // lod::choose for bundle b: (N_LOD, C, culled flag).
 fn choose(b: u32) -> vec3<u32> {
+    if !included(b) {
+        return vec3<u32>(0u, 3u, LOD_OTHER_GROOM);
+    }
     let o = b * BUNDLE_WORDS;
     let first_layer = hairmesh_bundles[o];
     let layers = clamp(hairmesh_bundles[o + 1u], 2u, MAX_LAYERS);
@@ -100,7 +115,9 @@ fn lod(@builtin(local_invocation_index) lane: u32) {
     var sum = 0u;
     var full = 0u;
     for (var b = begin; b < end; b++) {
-        full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
+        if included(b) {
+            full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
+        }
         let d = choose(b);
         bundle_lod[b * LOD_WORDS] = d.x;
         bundle_lod[b * LOD_WORDS + 1u] = d.y;

@@ -25,6 +25,12 @@ struct RasterParams {
     height: u32,
     // MSAA reference mode: 2, 4 or 8 sample layers (0 or 1: off).
     msaa: u32,
+    // The groom drawn, in the per-model block; grooms after the first also
+    // test hair_depth (Lipp §3.5).
+    model_index: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
@@ -34,7 +40,9 @@ struct RasterParams {
 @group(0) @binding(4) var<storage, read> hairmesh_bundles: array<u32>;
 @group(0) @binding(5) var<storage, read> hairmesh_layers: array<vec4<f32>>;
 @group(0) @binding(6) var scene_depth: texture_depth_2d;
-@group(0) @binding(7) var<storage, read_write> gbuffer: array<atomic<u64>>;
+// Earlier grooms' depth (f32 bits), written by their filter passes.
+@group(0) @binding(7) var<storage, read> hair_depth: array<u32>;
+@group(0) @binding(8) var<storage, read_write> gbuffer: array<atomic<u64>>;
 
 // Lipp Code 1's smLayer: the base layers with finite-difference tangents.
 var<workgroup> sm_pos: array<vec3<f32>, 16>;
@@ -182,6 +190,9 @@ fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, uv: vec2<f32
         return;
     }
     let pixel = u32(y) * params.width + u32(x);
+    if params.model_index > 0u && z >= bitcast<f32>(hair_depth[pixel]) {
+        return;
+    }
     let p = pack_payload(
         z,
         safe_normalize(lerp_vec(a.tangent, b.tangent, t)),

@@ -1,12 +1,14 @@
 // lipp.shade: Lipp §3.4, deferred shading of both G-buffer layers, one
 // invocation per pixel. Port of passes/src/lipp/shade.rs (compact Chiang 2016
 // R/TT/TRT, Kajiya-Kay-like multiple scattering, deep-opacity-map shadows
-// with Lipp Eq. 8's depth correction, L2 SH probe lighting with baked AO). Writes rgba32f into `shaded`
+// with Lipp Eq. 8's depth correction, probe lighting with baked AO: L2 SH
+// irradiance and a prefiltered GGX lookup for R + TRT, shaders/lipp/probe.wgsl). Writes rgba32f into `shaded`
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
 #import strandgraph::chiang::{chiang}
+#import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
 // ShadeParams (booleans as 0/1).
 struct ShadeParams {
@@ -22,8 +24,9 @@ struct ShadeParams {
     dom_resolution: u32,
     dom_layers: u32,
     dom_layer_thickness: f32,
-    _pad0: u32,
-    _pad1: u32,
+    // The groom shaded (its material), in the per-model block.
+    model_index: u32,
+    probe_specular: u32,
     _pad2: u32,
 }
 
@@ -37,6 +40,8 @@ struct ShadeParams {
 @group(0) @binding(7) var<storage, read> dom_depth: array<u32>;
 @group(0) @binding(8) var<storage, read> dom_layers: array<u32>;
 @group(0) @binding(9) var<storage, read_write> shaded: array<vec4<f32>>;
+// probe.rs's layout: 6 lat-long levels of rgba32f, back to back.
+@group(0) @binding(10) var<storage, read> env_prefiltered: array<vec4<f32>>;
 
 const NO_HIT: u32 = 0xFFFFFFFFu;
 const OPACITY_SCALE: f32 = 1024.0;
@@ -113,6 +118,29 @@ fn sh_irradiance(n: vec3<f32>) -> vec3<f32> {
         + 2.0 * c2 * (env_sh[3].xyz * x + env_sh[1].xyz * y + env_sh[2].xyz * z);
 }
 
+// probe::sample_level.
+fn probe_level(k: u32, d: vec3<f32>) -> vec3<f32> {
+    let tp = probe_taps(k, d);
+    return probe_blend(
+        env_prefiltered[tp.texel.x].xyz,
+        env_prefiltered[tp.texel.y].xyz,
+        env_prefiltered[tp.texel.z].xyz,
+        env_prefiltered[tp.texel.w].xyz,
+        tp.t,
+    );
+}
+
+// probe::specular: the R + TRT stand-in lobe's prefiltered radiance, weighted.
+fn probe_specular(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
+    let lobe = probe_lobe(t, v, n, color, roughness);
+    let lod = probe_alpha_lod(lobe.alpha);
+    let k0 = min(u32(floor(lod)), PROBE_LEVELS - 1u);
+    let k1 = min(k0 + 1u, PROBE_LEVELS - 1u);
+    let a = probe_level(k0, lobe.direction);
+    let b = probe_level(k1, lobe.direction);
+    return (a + (b - a) * (lod - f32(k0))) * lobe.weight;
+}
+
 // shade::shade_sample.
 fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
     let pos = world_position(frame.inv_view_proj, frame.screen, x, y, s.depth);
@@ -121,7 +149,7 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
     let qu = u32(floor(s.uvw.x * 63.0 + 0.5));
     let qv = u32(floor(s.uvw.y * 63.0 + 0.5));
     let vary = 0.85 + 0.3 * unit(pcg(qu | (qv << 6u)));
-    let c = models[0].color;
+    let c = models[params.model_index].color;
     let color = clamp(c.xyz * vary, vec3<f32>(0.0), vec3<f32>(1.0));
     let roughness = c.w;
     var out = vec3<f32>(0.0);
@@ -152,14 +180,13 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
         out += f * rad;
     }
     if params.probe_lighting != 0u {
-        var n = safe_normalize(v - t * dot(t, v));
-        if dot(n, n) <= 0.0 {
-            n = v;
-        }
+        let n = view_facing_normal(t, v);
         let e = max(sh_irradiance(n), vec3<f32>(0.0));
-        let cos_o = sqrt(max(1.0 - dot(t, v) * dot(t, v), 0.0));
-        let fr = 0.0465 + (1.0 - 0.0465) * pow(1.0 - cos_o, 5.0);
-        out += (e / PI * color + e / PI * fr * params.specular) * s.ao;
+        var spec = vec3<f32>(0.0);
+        if params.probe_specular != 0u {
+            spec = probe_specular(t, v, n, color, roughness);
+        }
+        out += (e / PI * color + spec * params.specular) * s.ao;
     }
     return out;
 }

@@ -77,7 +77,7 @@ impl Stats {
             .iter()
             .map(|f| {
                 f.iter()
-                    .filter(|t| raster.contains(&t.name.as_str()))
+                    .filter(|t| raster.contains(&strandgraph_graph::base_name(&t.name)))
                     .map(|t| t.millis)
                     .sum()
             })

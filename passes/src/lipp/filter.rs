@@ -18,6 +18,10 @@
 //!   tangent-aligned strip of width `strip_width` (Code 2 line 45; the text's
 //!   H_center / H_cons counts the centre hits among the conservative ones).
 //!
+//! - hair depth (§3.5, multiple grooms): where the output is at least
+//!   `depth_alpha` opaque, the pixel's hair depth goes into `hair_depth`
+//!   (in place, min), which the next groom's rasterizer tests against.
+//!
 //! Deviations: depths are compared as linear view depth in metres
 //! (`depth_threshold` 0.05, `front_threshold` 0.01): the paper's 1.45e-3 and
 //! 5e-4 are in an unstated depth space. Code 2 counts strip hits with P's own
@@ -56,6 +60,9 @@ pub struct FilterParams {
     /// MSAA reference resolve: average the N sample layers, α = hits / N
     /// (0: the single-sample filter above).
     pub msaa: u32,
+    /// Pixels at least this opaque write their hair depth to `hair_depth`,
+    /// which the next groom's rasterizer tests against (Lipp §3.5).
+    pub depth_alpha: f32,
 }
 
 impl FilterParams {
@@ -73,6 +80,7 @@ impl FilterParams {
             depth_threshold: p.f32("depth_threshold", 0.05)?,
             front_threshold: p.f32("front_threshold", 0.01)?,
             msaa: p.u32("msaa", 0)?,
+            depth_alpha: p.f32("depth_alpha", 0.5)?,
         };
         let bad = |param: &str, message: String| ParamError {
             kind: "lipp.filter",
@@ -111,6 +119,7 @@ impl PassDef for Filter {
             Binding::read("gbuffer"),
             Binding::read("shaded"),
             Binding::write("output"),
+            Binding::write("hair_depth"),
         ];
         Some(BINDINGS)
     }
@@ -150,7 +159,7 @@ impl PassDef for Filter {
             q.width,
             q.height,
             p.msaa,
-            0,
+            p.depth_alpha.to_bits(),
         ])
     }
 }
@@ -298,49 +307,71 @@ pub fn reconstruct(
     (c, alpha)
 }
 
-/// The output colour of pixel (x, y) over `scene`, or `None` where no strand is.
-pub fn filter_pixel(
-    p: &FilterParams,
-    v: &View<'_>,
-    x: u32,
-    y: u32,
-    scene: [f32; 4],
-) -> Option<[f32; 4]> {
+/// What the filter puts over one pixel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hair {
+    pub color: [f32; 3],
+    pub alpha: f32,
+    /// NDC depth of the nearest sample the colour came from.
+    pub depth: f32,
+}
+
+impl Hair {
+    /// This colour blended over `scene` (which keeps its alpha).
+    pub fn over(&self, scene: [f32; 4]) -> [f32; 4] {
+        let a = self.alpha;
+        let c = self.color;
+        [
+            c[0] * a + scene[0] * (1.0 - a),
+            c[1] * a + scene[1] * (1.0 - a),
+            c[2] * a + scene[2] * (1.0 - a),
+            scene[3],
+        ]
+    }
+}
+
+/// The hair over pixel (x, y), or `None` where no strand is.
+pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Hair> {
     let i = y * v.width + x;
     let (g, a) = (v.payload(0, i), v.payload(1, i));
     let (centre, cons) = (g != EMPTY, a != EMPTY);
-    let over = |c: [f32; 3], alpha: f32| {
-        Some([
-            c[0] * alpha + scene[0] * (1.0 - alpha),
-            c[1] * alpha + scene[1] * (1.0 - alpha),
-            c[2] * alpha + scene[2] * (1.0 - alpha),
-            scene[3],
-        ])
+    let hair = |color: [f32; 3], alpha: f32, depth: f32| {
+        Some(Hair {
+            color,
+            alpha,
+            depth,
+        })
     };
     if p.msaa > 1 {
         // MSAA reference resolve (Lipp Fig. 5, "MSAA 8").
-        let (mut sum, mut hits) = ([0.0f32; 3], 0u32);
+        let (mut sum, mut hits, mut depth) = ([0.0f32; 3], 0u32, 1.0f32);
         for s in 0..p.msaa.min(v.layers) {
-            if v.payload(s, i) != EMPTY {
+            let q = v.payload(s, i);
+            if q != EMPTY {
                 let c = v.color(s, i);
                 for k in 0..3 {
                     sum[k] += c[k];
                 }
                 hits += 1;
+                depth = depth.min(unpack(q).depth);
             }
         }
         if hits == 0 {
             return None;
         }
         let n = hits as f32;
-        return over([sum[0] / n, sum[1] / n, sum[2] / n], n / p.msaa as f32);
+        return hair(
+            [sum[0] / n, sum[1] / n, sum[2] / n],
+            n / p.msaa as f32,
+            depth,
+        );
     }
     if !p.enabled {
         if !centre {
             return None;
         }
         let c = v.color(0, i);
-        return over([c[0], c[1], c[2]], 1.0);
+        return hair([c[0], c[1], c[2]], 1.0, unpack(g).depth);
     }
     if !(centre || cons && p.reconnect) {
         return None;
@@ -360,15 +391,15 @@ pub fn filter_pixel(
             let ca = v.color(1, i);
             let (f, fa) = reconstruct(p, v, x, y, &Reference::of(v, x, y, &sa, ca, true));
             let mixed = [0, 1, 2].map(|k| f[k] * fa + c[k] * (1.0 - fa));
-            return over(mixed, 1.0);
+            return hair(mixed, 1.0, sa.depth);
         }
-        return over(c, alpha);
+        return hair(c, alpha, sg.depth);
     }
     // Promoted conservative-only pixel (§3.3.2).
     let sa = unpack(a);
     let ca = v.color(1, i);
     let (c, alpha) = reconstruct(p, v, x, y, &Reference::of(v, x, y, &sa, ca, true));
-    over(c, alpha)
+    hair(c, alpha, sa.depth)
 }
 
 struct FilterKernel(FilterParams);
@@ -386,11 +417,16 @@ impl CpuKernel for FilterKernel {
             gbuffer,
             shaded,
         };
-        let out = ctx.words("output");
+        let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
         for i in group * FILTER_GROUP..((group + 1) * FILTER_GROUP).min(w * h) {
-            let scene = load_rgba16f(&out, i as usize);
-            if let Some(c) = filter_pixel(&self.0, &v, i % w, i / w, scene) {
-                store_rgba16f(&out, i as usize, c);
+            let Some(hair) = filter_pixel(&self.0, &v, i % w, i / w) else {
+                continue;
+            };
+            let i = i as usize;
+            store_rgba16f(&out, i, hair.over(load_rgba16f(&out, i)));
+            // Lipp §3.5: the depth later grooms are tested against.
+            if hair.alpha >= self.0.depth_alpha {
+                depth.store_f32(i, depth.load_f32(i).min(hair.depth));
             }
         }
     }

@@ -9,6 +9,11 @@
 //! `raster_args` = (min(drawn, 65535), 1, 1, drawn, Σ N), whose last two
 //! words give `lipp.shade` the fraction β of Eq. 8.
 //!
+//! In the graph's per-model block (Lipp §3.5, multiple grooms), the pass
+//! decides for one groom (`model_index`): other grooms' bundles draw nothing
+//! and β counts only this groom's strands. Outside the block it decides for
+//! every groom at once (the deep opacity maps shadow with all of them).
+//!
 //! Deviation: the paper runs one thread per bundle and feeds N_LOD to a
 //! per-bundle indirect dispatch. Here the rasterizer is one flat indirect
 //! dispatch over all drawn strands (one workgroup per strand), so this pass
@@ -17,8 +22,8 @@
 //! workgroup memory. The CPU kernel computes the same values sequentially.
 
 use super::{
-    BUNDLE_WORDS, BundleLod, BundleRecord, Corner, LOD_CULLED, MAX_CONTROL_POINTS, MAX_GROUPS_X,
-    bundle_count, frame, pcg, transform, unit,
+    BUNDLE_WORDS, BundleLod, BundleRecord, Corner, LOD_CULLED, LOD_OTHER_GROOM, MAX_CONTROL_POINTS,
+    MAX_GROUPS_X, bundle_count, frame, pcg, transform, unit,
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
 use crate::layout::FrameData;
@@ -28,6 +33,9 @@ pub struct Lod;
 
 /// Threads of the single LOD workgroup (WGSL).
 pub const LOD_GROUP: u32 = 256;
+
+/// `LodParams.model` in WGSL when the pass decides for every groom.
+const ALL_MODELS: u32 = u32::MAX;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LodParams {
@@ -44,6 +52,8 @@ pub struct LodParams {
     pub strand_lod: bool,
     /// §3.2.2 dynamic strand resolution (Eq. 4-5); off, C from L = 1.
     pub resolution_lod: bool,
+    /// Only this groom's bundles (the per-model block); `None`: all.
+    pub model: Option<u32>,
 }
 
 impl LodParams {
@@ -57,6 +67,7 @@ impl LodParams {
             frustum_cull: p.bool("frustum_cull", true)?,
             strand_lod: p.bool("strand_lod", true)?,
             resolution_lod: p.bool("resolution_lod", true)?,
+            model: p.model_index()?,
         };
         let err = |param: &str, message: String| ParamError {
             kind: "lipp.lod",
@@ -124,6 +135,10 @@ impl PassDef for Lod {
             flag(p.strand_lod),
             flag(p.resolution_lod),
             crate::contract::count(q.bundles),
+            p.model.unwrap_or(ALL_MODELS),
+            0,
+            0,
+            0,
         ])
     }
 }
@@ -181,6 +196,14 @@ pub fn screen_aabb(
 
 /// The decision for one bundle (first_strand is filled in by the scan).
 pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord) -> BundleLod {
+    if p.model.is_some_and(|m| m != b.model) {
+        return BundleLod {
+            strands: 0,
+            control_points: 3,
+            first_strand: 0,
+            flags: LOD_OTHER_GROOM,
+        };
+    }
     let (lo, hi, behind) = screen_aabb(f, layers, b);
     let (w, h) = (f.screen[0], f.screen[1]);
     let any_in_front = lo[0] <= hi[0];
@@ -231,7 +254,9 @@ impl CpuKernel for LodKernel {
         let (mut total, mut full) = (0u32, 0u32);
         for b in 0..count {
             let rec = BundleRecord::load(&bundles, b);
-            full = full.saturating_add(rec.strands);
+            if self.0.model.is_none_or(|m| m == rec.model) {
+                full = full.saturating_add(rec.strands);
+            }
             let mut lod = choose(&self.0, &f, &layers, &rec);
             lod.first_strand = total;
             total = total.saturating_add(lod.strands);

@@ -8,6 +8,8 @@
 
 pub mod assemble;
 pub mod chiang;
+#[cfg(test)]
+mod chiang_reference;
 pub mod dom;
 pub mod filter;
 pub mod lod;
@@ -120,17 +122,19 @@ impl Corner {
 /// `bundle_lod`: Lipp §3.2's per-bundle decision (uint4).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct BundleLod {
-    /// N_LOD (Eq. 1); 0 when frustum-culled.
+    /// N_LOD (Eq. 1); 0 when frustum-culled or of another groom.
     pub strands: u32,
     /// C, control points per strand (Eq. 4-5).
     pub control_points: u32,
     /// First drawn strand of this bundle in the dispatch's numbering.
     pub first_strand: u32,
-    /// Bit 0: culled.
+    /// Bit 0: culled; bit 1: another groom's (not drawn this time).
     pub flags: u32,
 }
 
 pub const LOD_CULLED: u32 = 1;
+/// A bundle of another groom than the one a per-model LOD pass decides for.
+pub const LOD_OTHER_GROOM: u32 = 2;
 
 impl BundleLod {
     pub fn load(w: &Words<'_>, b: usize) -> Self {

@@ -21,7 +21,7 @@
 //! half vector, weighted by N·L. Each sample reads a box-filtered mip of the
 //! source chosen from its pdf (filtered importance sampling, Colbert and
 //! Křivánek 2007, "GPU-Based Importance Sampling", GPU Gems 3 ch. 20), so
-//! 256 samples give a noise-free result.
+//! 64 to 256 samples per texel give a noise-free result.
 //!
 //! **`env.sh`**: the map projected to 9 L2 SH radiance coefficients
 //! (Ramamoorthi and Hanrahan 2001) with exact per-row solid angles.
@@ -50,7 +50,8 @@ pub const HEIGHT: u32 = 64;
 pub const TEXELS: u32 = level_offset(LEVELS);
 /// `env.prefiltered`'s size in bytes (rgba32f texels).
 pub const BYTES: u64 = TEXELS as u64 * 16;
-/// GGX samples per prefiltered texel.
+/// GGX samples per prefiltered texel of the rough levels (fewer for the
+/// narrow lobes of levels 1 and 2).
 pub const SAMPLES: u32 = 256;
 
 const PI: f32 = std::f32::consts::PI;
@@ -399,16 +400,14 @@ fn hammersley(i: u32, n: u32) -> (f32, f32) {
     )
 }
 
-/// Karis 2013, ImportanceSampleGGX: a half vector around `n` for GGX α.
-fn importance_sample_ggx(xi: (f32, f32), alpha: f32, n: Vec3) -> Vec3 {
+/// Karis 2013, ImportanceSampleGGX: a half vector for GGX α, in the frame
+/// of the normal (z).
+fn importance_sample_ggx(xi: (f32, f32), alpha: f32) -> Vec3 {
     let a2 = alpha * alpha;
     let phi = 2.0 * PI * xi.0;
     let cos_t = ((1.0 - xi.1) / (1.0 + (a2 - 1.0) * xi.1)).sqrt();
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let up = if n.z.abs() < 0.999 { Vec3::Z } else { Vec3::X };
-    let tx = up.cross(n).normalize();
-    let ty = n.cross(tx);
-    tx * (sin_t * phi.cos()) + ty * (sin_t * phi.sin()) + n * cos_t
+    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t)
 }
 
 /// GGX D(n·h).
@@ -418,34 +417,65 @@ fn ggx_d(n_h: f32, alpha: f32) -> f32 {
     a2 / (PI * d * d)
 }
 
-/// Karis 2013, PrefilterEnvMap (N = V = R): the GGX-α average of `mips[0]`
-/// around `n`, each sample from the mip its pdf asks for (Colbert and
-/// Křivánek 2007: lod = ½ log2(Ω_s / Ω_p) + 1).
-fn prefilter_texel(mips: &[Level], n: Vec3, alpha: f32) -> [f32; 3] {
-    let base = &mips[0];
-    let omega_p = 4.0 * PI / (base.width * base.height) as f32;
+/// One prefilter sample in the normal's frame: the light direction, its
+/// N·L weight and the source mip it reads.
+#[derive(Debug, Clone, Copy)]
+struct Tap {
+    l: Vec3,
+    n_l: f32,
+    lod: f32,
+}
+
+/// Samples per texel of level k: a narrow lobe reads fine mips and needs
+/// fewer (the filtered importance sampling keeps each smooth).
+fn samples_of(k: u32) -> u32 {
+    match k {
+        0 => 1,
+        1 => 64,
+        2 => 128,
+        _ => SAMPLES,
+    }
+}
+
+/// Karis 2013, PrefilterEnvMap's samples for GGX α with N = V = R, in the
+/// normal's frame (they are the same for every texel): L = 2 (N·H) H − N,
+/// those below the horizon dropped. Each reads the source mip its pdf asks
+/// for (Colbert and Křivánek 2007: lod = ½ log2(Ω_s / Ω_p) + 1, Ω_s =
+/// 1 / (n pdf), Ω_p = a level-0 texel's mean solid angle).
+fn taps(alpha: f32, n: u32, omega_p: f32, mips: usize) -> Vec<Tap> {
+    (0..n)
+        .filter_map(|i| {
+            let h = importance_sample_ggx(hammersley(i, n), alpha);
+            let n_h = h.z;
+            let l = h * (2.0 * n_h) - Vec3::Z;
+            (l.z > 0.0).then(|| {
+                // pdf(l) = D(n·h) (n·h) / (4 v·h), and v·h = n·h with V = N.
+                let pdf = ggx_d(n_h, alpha) / 4.0;
+                let omega_s = 1.0 / (n as f32 * pdf + 1e-6);
+                let lod = (0.5 * (omega_s / omega_p).log2() + 1.0).clamp(0.0, (mips - 1) as f32);
+                Tap { l, n_l: l.z, lod }
+            })
+        })
+        .collect()
+}
+
+/// The N·L-weighted average of the mip chain over `taps` around `n`.
+fn prefilter_texel(mips: &[Level], n: Vec3, taps: &[Tap]) -> [f32; 3] {
+    let up = if n.z.abs() < 0.999 { Vec3::Z } else { Vec3::X };
+    let tx = up.cross(n).normalize();
+    let ty = n.cross(tx);
     let mut sum = [0.0f32; 3];
     let mut weight = 0.0;
-    for i in 0..SAMPLES {
-        let h = importance_sample_ggx(hammersley(i, SAMPLES), alpha, n);
-        let n_h = n.dot(h);
-        let l = h * (2.0 * n_h) - n;
-        let n_l = n.dot(l);
-        if n_l <= 0.0 {
-            continue;
-        }
-        // pdf(l) = D(n·h) (n·h) / (4 v·h), and v·h = n·h with V = N.
-        let pdf = ggx_d(n_h, alpha) / 4.0;
-        let omega_s = 1.0 / (SAMPLES as f32 * pdf + 1e-6);
-        let lod = (0.5 * (omega_s / omega_p).log2() + 1.0).clamp(0.0, (mips.len() - 1) as f32);
-        let m0 = lod.floor() as usize;
+    for tap in taps {
+        let l = tx * tap.l.x + ty * tap.l.y + n * tap.l.z;
+        let m0 = tap.lod.floor() as usize;
         let m1 = (m0 + 1).min(mips.len() - 1);
-        let t = lod - m0 as f32;
+        let t = tap.lod - m0 as f32;
         let (a, b) = (mips[m0].bilinear(l), mips[m1].bilinear(l));
         for k in 0..3 {
-            sum[k] += (a[k] + (b[k] - a[k]) * t) * n_l;
+            sum[k] += (a[k] + (b[k] - a[k]) * t) * tap.n_l;
         }
-        weight += n_l;
+        weight += tap.n_l;
     }
     sum.map(|s| s / weight.max(1e-12))
 }
@@ -471,11 +501,12 @@ pub fn prefilter(map: &EnvMap, scale: [f32; 3]) -> Vec<Level> {
     let mut levels = vec![mips[0].clone()];
     for k in 1..LEVELS {
         let (w, h) = level_size(k);
-        let alpha = level_alpha(k);
+        let omega_p = 4.0 * PI / (WIDTH * HEIGHT) as f32;
+        let taps = taps(level_alpha(k), samples_of(k), omega_p, mips.len());
         let texels = (0..h)
             .into_par_iter()
             .flat_map_iter(|y| (0..w).map(move |x| (x, y)))
-            .map(|(x, y)| prefilter_texel(&mips, envmap::texel_direction(w, h, x, y), alpha))
+            .map(|(x, y)| prefilter_texel(&mips, envmap::texel_direction(w, h, x, y), &taps))
             .collect();
         levels.push(Level {
             width: w,

@@ -24,7 +24,10 @@
 //! (DESIGN.md, "Determinism") and walked column by column along its major
 //! axis (a DDA). The conservative layer receives every pixel the segment
 //! crosses; the centre layer only pixels whose centre is within
-//! `centre_diameter / 2` of the line. Depth is tested against `scene.depth`.
+//! `centre_diameter / 2` of the line. Depth is tested against `scene.depth`
+//! and, for every groom after the first, against `hair_depth`: the depth the
+//! earlier grooms' filter passes wrote (Lipp §3.5, "strands occluded by
+//! previously rendered grooms are rejected early").
 //! "we rasterize them as single-pixel-wide lines" (§3.1.2).
 //!
 //! MSAA reference mode (Lipp §3.3: "recording samples into multiple layers
@@ -59,6 +62,9 @@ pub struct RasterParams {
     pub centre_diameter: f32,
     pub conservative_layer: bool,
     pub msaa: u32,
+    /// The groom this pass draws, in the graph's per-model block; grooms
+    /// after the first also test `hair_depth`.
+    pub model_index: u32,
 }
 
 impl RasterParams {
@@ -70,6 +76,7 @@ impl RasterParams {
             centre_diameter: p.f32("centre_diameter", 0.5)?,
             conservative_layer: p.bool("conservative_layer", true)?,
             msaa: p.u32("msaa", 0)?,
+            model_index: p.model_index()?.unwrap_or(0),
         };
         let err = |param: &str, message: &str| ParamError {
             kind: "lipp.raster",
@@ -101,6 +108,7 @@ impl PassDef for Raster {
             Binding::read("hairmesh.bundles"),
             Binding::read("hairmesh.layers"),
             Binding::read("scene.depth"),
+            Binding::read("hair_depth"),
             Binding::atomic("gbuffer"),
         ];
         Some(BINDINGS)
@@ -136,6 +144,10 @@ impl PassDef for Raster {
             q.width,
             q.height,
             p.msaa,
+            p.model_index,
+            0,
+            0,
+            0,
         ])
     }
 }
@@ -159,6 +171,8 @@ struct Target<'a> {
     width: u32,
     height: u32,
     depth: Words<'a>,
+    /// Earlier grooms' depth, tested only after the first groom.
+    hair_depth: Option<Words<'a>>,
     gbuffer: Words<'a>,
     params: &'a RasterParams,
     uv: [f32; 2],
@@ -195,6 +209,13 @@ impl Target<'_> {
         let z = a.z + (b.z - a.z) * t;
         let pixel = (y as u32 * self.width + x as u32) as usize;
         if !(0.0..1.0).contains(&z) || z >= self.depth.load_f32(pixel) {
+            return;
+        }
+        if self
+            .hair_depth
+            .as_ref()
+            .is_some_and(|h| z >= h.load_f32(pixel))
+        {
             return;
         }
         let sample = Sample {
@@ -374,6 +395,7 @@ impl CpuKernel for RasterKernel {
             width: ctx.quantities.width,
             height: ctx.quantities.height,
             depth: ctx.words("scene.depth"),
+            hair_depth: (self.0.model_index > 0).then(|| ctx.words("hair_depth")),
             gbuffer: ctx.words("gbuffer"),
             params: &self.0,
             uv: [0.0; 2],

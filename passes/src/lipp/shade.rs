@@ -4,7 +4,8 @@
 //! Position is reconstructed from the 24-bit depth at the pixel centre ("we
 //! use the common approach in deferred engines and reconstruct it from the
 //! depth value", §3.1.2); the tangent is the octahedral one; the material is
-//! `models[0]`'s colour and roughness, varied per strand by its (u, v).
+//! the groom's (`models[model_index]`, one groom per pass in the graph's
+//! per-model block) colour and roughness, varied per strand by its (u, v).
 //!
 //! Single scattering is Chiang et al. 2016 (R, TT, TRT), in a compact form:
 //! - M_p: a Gaussian in sin θ_i + sin θ_o − shift_p (the form Karis 2016
@@ -24,15 +25,20 @@
 //! maps of `lipp.dom_depth` / `lipp.dom_opacity` (`dom_shadows`), looked up
 //! Δ = −log β layers nearer the light (Lipp Eq. 8, `lod_depth_correction`;
 //! β = drawn / all strands over the whole groom, since a G-buffer pixel does
-//! not know its bundle). The head casts no shadow on the hair. Probe lighting uses `env.sh` (L2 SH,
-//! Ramamoorthi and Hanrahan) at the fibre normal facing the viewer for the
-//! diffuse part, times the baked AO; the specular probe term uses the same
-//! radiance in place of a prefiltered GGX lookup (no environment map is
-//! uploaded, and for the constant environments of our scenes they agree).
+//! not know its bundle). The head casts no shadow on the hair.
+//!
+//! Probe lighting (Lipp §3.4, [`super::probe`]), times the hair mesh's baked
+//! AO: the diffuse part is `env.sh`'s irradiance (L2 SH, Ramamoorthi and
+//! Hanrahan 2001) at the fibre normal facing the viewer, times colour / π;
+//! the specular part (`probe_specular`) is one GGX lobe standing in for
+//! R + TRT, looked up in `env.prefiltered` (Karis 2013's prefiltered
+//! environment) along the specular cone and weighted by A_R + A_TRT
+//! ([`super::probe::specular_lobe`] says how the lobe is chosen).
 
 pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
+use super::probe;
 use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
 use crate::layout::{FrameData, LightData, ModelData, read};
@@ -48,6 +54,8 @@ const PI: f32 = std::f32::consts::PI;
 pub struct ShadeParams {
     pub multiple_scattering: bool,
     pub probe_lighting: bool,
+    /// With `probe_lighting`: the prefiltered GGX lookup for R + TRT.
+    pub probe_specular: bool,
     /// Scales the single-scattering lobes (1 = Chiang).
     pub specular: f32,
     /// Volumetric shadows from the deep opacity maps (`lipp.dom_*`).
@@ -58,6 +66,8 @@ pub struct ShadeParams {
     pub dom_resolution: u32,
     pub dom_layers: u32,
     pub dom_layer_thickness: f32,
+    /// The groom shaded (its material), in the graph's per-model block.
+    pub model_index: u32,
 }
 
 impl ShadeParams {
@@ -75,12 +85,14 @@ impl ShadeParams {
         let out = Self {
             multiple_scattering: p.bool("multiple_scattering", true)?,
             probe_lighting: p.bool("probe_lighting", true)?,
+            probe_specular: p.bool("probe_specular", true)?,
             specular: p.f32("specular", 1.0)?,
             dom_shadows: p.bool("dom_shadows", true)?,
             lod_depth_correction: p.bool("lod_depth_correction", true)?,
             dom_resolution: p.u32("dom_resolution", 512)?,
             dom_layers: p.u32("dom_layers", 4)?,
             dom_layer_thickness: p.f32("dom_layer_thickness", 0.02)?,
+            model_index: p.model_index()?.unwrap_or(0),
         };
         if !(16..=4096).contains(&out.dom_resolution) {
             return Err(err("dom_resolution", "expected 16..=4096 texels"));
@@ -110,6 +122,7 @@ impl PassDef for Shade {
             Binding::read("dom_depth"),
             Binding::read("dom_layers"),
             Binding::write("shaded"),
+            Binding::read("env.prefiltered"),
         ];
         Some(BINDINGS)
     }
@@ -147,8 +160,8 @@ impl PassDef for Shade {
             p.dom_resolution,
             p.dom_layers,
             p.dom_layer_thickness.to_bits(),
-            0,
-            0,
+            p.model_index,
+            flag(p.probe_specular),
             0,
         ])
     }
@@ -181,6 +194,8 @@ pub struct Inputs<'a> {
     pub model: &'a ModelData,
     pub lights: &'a [LightData],
     pub sh: [[f32; 3]; 9],
+    /// `env.prefiltered` ([`super::probe`]'s layout).
+    pub prefiltered: Words<'a>,
     pub params: &'a ShadeParams,
     /// The deep opacity maps and their light views (one per mapped light).
     pub dom: Option<Dom<'a>>,
@@ -284,16 +299,18 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
         }
     }
     if inp.params.probe_lighting {
-        // Fibre normal facing the viewer (Lipp §3.4).
-        let n = normalize(sub(v, scale(t, dot(t, v))));
-        let n = if dot(n, n) > 0.0 { n } else { v };
+        // Lipp §3.4: "Ramamoorthi's irradiance expansion centered at a normal
+        // of the fiber oriented towards the view direction".
+        let n = probe::view_facing_normal(t, v);
         let e = sh_irradiance(&inp.sh, n);
-        let cos_o = (1.0 - dot(t, v) * dot(t, v)).max(0.0).sqrt();
-        let f = 0.0465 + (1.0 - 0.0465) * (1.0 - cos_o).powi(5);
+        let spec = if inp.params.probe_specular {
+            probe::specular(&inp.prefiltered, t, v, n, m.color, m.roughness)
+        } else {
+            [0.0; 3]
+        };
         for k in 0..3 {
             let diffuse = e[k].max(0.0) / PI * m.color[k];
-            let specular = e[k].max(0.0) / PI * f * inp.params.specular;
-            out[k] += (diffuse + specular) * s.ao;
+            out[k] += (diffuse + spec[k] * inp.params.specular) * s.ao;
         }
     }
     out
@@ -314,7 +331,7 @@ impl CpuKernel for ShadeKernel {
         let f = frame(ctx);
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let pixels = w * h;
-        let model: ModelData = read(&ctx.words("models"), 0);
+        let model: ModelData = read(&ctx.words("models"), self.0.model_index as usize);
         let lw = ctx.words("lights");
         let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
         let inp = Inputs {
@@ -322,6 +339,7 @@ impl CpuKernel for ShadeKernel {
             model: &model,
             lights: &lights,
             sh: load_sh(&ctx.words("env.sh")),
+            prefiltered: ctx.words("env.prefiltered"),
             params: &self.0,
             dom: self.0.dom_shadows.then(|| {
                 let depth = ctx.words("dom_depth");
