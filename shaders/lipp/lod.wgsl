@@ -85,11 +85,13 @@ fn choose(b: u32) -> vec3<u32> {
     let outside = !any_in_front || hi.x < 0.0 || lo.x > w || hi.y < 0.0 || lo.y > h;
     let culled = params.frustum_cull != 0u && outside && !behind;
     // Lipp Eq. 2.
+    // The groom's own strength multiplies the pass's (0: the groom has LOD off).
+    let groom_lambda = bitcast<f32>(hairmesh_bundles[o + 9u]);
     var l = 1.0;
-    if params.enabled != 0u && !behind {
+    if params.enabled != 0u && !behind && groom_lambda > 0.0 {
         let dx = hi.x - lo.x;
         let dy = hi.y - lo.y;
-        l = clamp(sqrt(dx * dx + dy * dy) / h * params.lambda, 0.0, 1.0);
+        l = clamp(sqrt(dx * dx + dy * dy) / h * (params.lambda * groom_lambda), 0.0, 1.0);
     }
     let delta = select(0.0, unit(pcg(seed)), params.random_delta != 0u);
     // Lipp Eq. 1.

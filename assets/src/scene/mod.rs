@@ -222,7 +222,8 @@ pub struct LodSettings {
     pub shuffle_seed: u64,
     /// Never draw fewer than this fraction of the strands.
     pub min_fraction: f32,
-    /// LOD sensitivity (Lipp's lambda).
+    /// LOD strength (Lipp's λ of Eq. 2, per groom as in Lipp Fig. 1),
+    /// multiplying the Lipp graph's `lod.lambda`; 0 draws the groom at full detail.
     pub lambda: f32,
 }
 

@@ -9,6 +9,10 @@
 //! `raster_args` = (min(drawn, 65535), 1, 1, drawn, Σ N), whose last two
 //! words give `lipp.shade` the fraction β of Eq. 8.
 //!
+//! λ of Eq. 2 is the pass's `lambda` times the groom's `lod.lambda` from the
+//! scene (Lipp Fig. 1 uses a different strength per style); a groom with
+//! `lod.enabled: false` is drawn at full detail.
+//!
 //! In the graph's per-model block (Lipp §3.5, multiple grooms), the pass
 //! decides for one groom (`model_index`): other grooms' bundles draw nothing
 //! and β counts only this groom's strands. Outside the block it decides for
@@ -210,10 +214,11 @@ pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord
     let outside = !any_in_front || hi[0] < 0.0 || lo[0] > w || hi[1] < 0.0 || lo[1] > h;
     // A corner behind the camera: the bundle may cover the screen; not culled, full detail.
     let culled = p.frustum_cull && outside && !behind;
-    let l = if !p.enabled || behind {
+    // The groom's own strength multiplies the pass's (0: the groom has LOD off).
+    let l = if !p.enabled || behind || b.lod_lambda <= 0.0 {
         1.0
     } else {
-        lod_value(lo, hi, h, p.lambda)
+        lod_value(lo, hi, h, p.lambda * b.lod_lambda)
     };
     let delta = if p.random_delta {
         unit(pcg(b.seed))
@@ -310,6 +315,67 @@ mod tests {
         let l = lod_value([0.0, 0.0], [30.0, 40.0], 1000.0, 2.0);
         assert!((l - 0.1).abs() < 1e-6);
         assert_eq!(lod_value([0.0, 0.0], [3000.0, 4000.0], 1000.0, 1.0), 1.0);
+    }
+
+    /// One bundle whose two layers span ±`half` NDC on a 1000×1000 screen
+    /// (clip = world, w = 1), with N = 1000 strands.
+    fn decide(p: &LodParams, lod_lambda: f32, model: u32, half: f32) -> BundleLod {
+        use std::sync::atomic::{AtomicU32, AtomicU64};
+        let mut f: FrameData = bytemuck::Zeroable::zeroed();
+        for i in 0..4 {
+            f.view_proj[i * 5] = 1.0;
+        }
+        f.screen = [1000.0, 1000.0, 1e-3, 1e-3];
+        f.near = 0.1;
+        let mut words = Vec::new();
+        for _layer in 0..2 {
+            for (u, v) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                words.extend([u * half, v * half, 0.5, 1.0, 0.0, 1.0, 0.0, 0.0].map(f32::to_bits));
+            }
+        }
+        let atoms: Vec<AtomicU32> = words.into_iter().map(AtomicU32::new).collect();
+        let oob = AtomicU64::new(0);
+        let b = BundleRecord {
+            layer_count: 2,
+            strands: 1000,
+            model,
+            lod_lambda,
+            ..Default::default()
+        };
+        choose(p, &f, &Words::new(&atoms, &oob), &b)
+    }
+
+    #[test]
+    fn the_grooms_strength_multiplies_lambda_and_zero_means_full_detail() {
+        let p = LodParams::from_ron(&ron::Value::Unit).unwrap();
+        let p = LodParams {
+            random_delta: false,
+            ..p
+        };
+        // AABB 20 x 20 px: L = 20√2 / 1000 · λ.
+        let one = decide(&p, 1.0, 0, 0.02).strands;
+        let four = decide(&p, 4.0, 0, 0.02).strands;
+        assert_eq!(one, (20.0 * 2f32.sqrt() / 1000.0 * 1000.0).ceil() as u32);
+        assert_eq!(
+            four,
+            (4.0 * 20.0 * 2f32.sqrt() / 1000.0 * 1000.0).ceil() as u32
+        );
+        assert_eq!(
+            decide(&p, 0.0, 0, 0.02).strands,
+            1000,
+            "LOD off for the groom"
+        );
+    }
+
+    #[test]
+    fn a_per_groom_pass_skips_other_grooms_bundles() {
+        let p = LodParams {
+            model: Some(1),
+            ..LodParams::from_ron(&ron::Value::Unit).unwrap()
+        };
+        let other = decide(&p, 1.0, 0, 0.02);
+        assert_eq!((other.strands, other.flags), (0, LOD_OTHER_GROOM));
+        assert!(decide(&p, 1.0, 1, 0.02).strands > 0);
     }
 
     #[test]

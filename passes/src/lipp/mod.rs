@@ -59,6 +59,10 @@ pub struct BundleRecord {
     pub noise: f32,
     /// Per-bundle random seed (δ of Eq. 1, strand identities).
     pub seed: u32,
+    /// The groom's LOD strength, multiplying the pass's λ of Eq. 2 (Lipp
+    /// Fig. 1 sets it per style: λ = {4.0, 5.5, 2.0, 2.8, 3.0}); 0 when the
+    /// groom's LOD is off (`lod.enabled: false`): full detail.
+    pub lod_lambda: f32,
 }
 
 impl BundleRecord {
@@ -74,6 +78,7 @@ impl BundleRecord {
             twist: w.load_f32(o + 6),
             noise: w.load_f32(o + 7),
             seed: w.load(o + 8),
+            lod_lambda: w.load_f32(o + 9),
         }
     }
 
@@ -88,6 +93,7 @@ impl BundleRecord {
         o[6] = self.twist.to_bits();
         o[7] = self.noise.to_bits();
         o[8] = self.seed;
+        o[9] = self.lod_lambda.to_bits();
         o
     }
 

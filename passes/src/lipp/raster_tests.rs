@@ -47,6 +47,7 @@ fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
             twist: 0.25,
             noise: 0.002,
             seed: 7 + b,
+            lod_lambda: 1.0,
         };
         bundles.extend(rec.words());
         for i in 0..4 {

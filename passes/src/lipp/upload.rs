@@ -52,6 +52,11 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
                 twist: bd.style.twist,
                 noise: bd.style.noise,
                 seed: pcg(index ^ pcg(model as u32 + 0x51ed_270b)),
+                lod_lambda: if g.lod.enabled {
+                    g.lod.lambda.max(0.0)
+                } else {
+                    0.0
+                },
             };
             for &k in &kept {
                 let l = &src[k as usize];
