@@ -570,12 +570,24 @@ fn gpu_params_fill_the_wgsl_parameter_block() {
         };
         let shader = def.shader();
         let source = std::fs::read_to_string(shaders_dir().join(shader.file)).unwrap();
-        let (module, _) = compose(&mut composer, shader.file, &source, all_capabilities())
+        let (module, info) = compose(&mut composer, shader.file, &source, all_capabilities())
             .unwrap_or_else(|e| panic!("{e}"));
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
-        let block = module.global_variables.iter().find(|(_, v)| {
+        // The block this pass's entry point uses: one module may hold several
+        // entry points with their own blocks at binding 0 (lipp/raster.wgsl).
+        let entries: Vec<usize> = (module.entry_points.iter().enumerate())
+            .filter(|(_, ep)| ep.name == shader.entry || Some(ep.name.as_str()) == shader.fragment)
+            .map(|(i, _)| i)
+            .collect();
+        let used = |h: naga::Handle<naga::GlobalVariable>| {
+            entries
+                .iter()
+                .any(|&e| !info.get_entry_point(e)[h].is_empty())
+        };
+        let block = module.global_variables.iter().find(|(h, v)| {
             v.space == AddressSpace::Uniform
+                && used(*h)
                 && v.binding
                     .as_ref()
                     .is_some_and(|b| b.group == 0 && b.binding == 0)
