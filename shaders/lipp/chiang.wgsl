@@ -1,10 +1,39 @@
 // Chiang et al. 2016 single scattering (R, TT, TRT), the compact form
-// lipp.shade evaluates per pixel. Port of passes/src/lipp/chiang.rs.
-// Composed with naga_oil:
+// lipp.shade evaluates per pixel: pbrt-v4's HairBxDF averaged over the fibre
+// offset h. Port of passes/src/lipp/chiang.rs, operation for operation (the
+// model, its sources and its measured error against pbrt are documented
+// there). Composed with naga_oil:
 //   #import strandgraph::chiang::{chiang}
 #define_import_path strandgraph::chiang
 
 #import strandgraph::lipp::{PI, safe_normalize}
+
+const ETA: f32 = 1.55;
+
+// chiang::TILT: sin 2kα, cos 2kα of the cuticle tilt of θ_o and v_p / v_0.
+const TILT: array<vec3<f32>, 3> = array<vec3<f32>, 3>(
+    vec3<f32>(-0.06975647, 0.9975641, 1.0),
+    vec3<f32>(0.0348995, 0.9993908, 0.25),
+    vec3<f32>(0.1391731, 0.99026805, 4.0),
+);
+
+// chiang::H_NODES: (h, γ, cos γ).
+const NODES: u32 = 5u;
+const H_NODES: array<vec3<f32>, 5> = array<vec3<f32>, 5>(
+    vec3<f32>(0.000000, 0.000000, 1.000000),
+    vec3<f32>(0.495291, 0.518170, 0.868727),
+    vec3<f32>(0.784684, 0.902186, 0.619896),
+    vec3<f32>(0.948310, 1.247869, 0.317344),
+    vec3<f32>(1.000000, 1.570796, 0.000000),
+);
+
+// chiang::PIECES.
+const PIECES: array<vec2<f32>, 4> = array<vec2<f32>, 4>(
+    vec2<f32>(0.253339, 0.241951),
+    vec2<f32>(0.152679, 0.136714),
+    vec2<f32>(0.090546, 0.073080),
+    vec2<f32>(0.034400, 0.017290),
+);
 
 // chiang::sigma_a (Chiang 2016 Eq. 9 inverted).
 fn sigma_a(color: vec3<f32>, b: f32) -> vec3<f32> {
@@ -23,22 +52,42 @@ fn logistic_cdf(x: f32, s: f32) -> f32 {
     return 1.0 / (1.0 + exp(-x / s));
 }
 
-fn trimmed_logistic(x: f32, s: f32) -> f32 {
-    return logistic(x, s) / (logistic_cdf(PI, s) - logistic_cdf(-PI, s));
+// chiang::fresnel (pbrt-v4 FrDielectric, from outside).
+fn fresnel(cos_i: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (ETA * ETA);
+    let cos_t = sqrt(max(1.0 - sin2_t, 0.0));
+    let r_parl = (ETA * cos_i - cos_t) / (ETA * cos_i + cos_t);
+    let r_perp = (cos_i - ETA * cos_t) / (cos_i + ETA * cos_t);
+    return 0.5 * (r_parl * r_parl + r_perp * r_perp);
 }
 
-fn wrap_angle(phi: f32) -> f32 {
-    var p = phi;
-    while p > PI {
-        p -= 2.0 * PI;
+// chiang::log_i0 (Abramowitz and Stegun 9.8.1, 9.8.2).
+fn log_i0(x: f32) -> f32 {
+    if x < 3.75 {
+        let t = (x / 3.75) * (x / 3.75);
+        return log(1.0 + t * (3.5156229 + t * (3.0899424 + t * (1.2067492 + t * (0.2659732
+            + t * (0.0360768 + t * 0.0045813))))));
     }
-    while p < -PI {
-        p += 2.0 * PI;
-    }
-    return p;
+    let t = 3.75 / x;
+    let p = 0.3989423 + t * (0.01328592 + t * (0.00225319 + t * (-0.00157565 + t * (0.00916281
+        + t * (-0.02057706 + t * (0.02635537 + t * (-0.01647633 + t * 0.00392377)))))));
+    return x - 0.5 * log(x) + log(p);
 }
 
-// chiang::chiang: R + TT + TRT times cos θ_i.
+// chiang::mp (d'Eon et al. 2011's M_p in log form).
+fn mp(cos_i: f32, cos_o: f32, sin_i: f32, sin_o: f32, v: f32) -> f32 {
+    let a = cos_i * cos_o / v;
+    let b = sin_i * sin_o / v;
+    return exp(log_i0(a) - b - 1.0 / v - log(v) - log(1.0 - exp(-2.0 / v)));
+}
+
+// chiang::n_r (d'Eon 2011's far-field N_R times A_R).
+fn n_r(phi: f32, cos_o: f32) -> f32 {
+    let c = abs(cos(0.5 * phi));
+    return 0.25 * c * fresnel(cos_o * c);
+}
+
+// chiang::chiang: R + TT + TRT, pbrt's f · |cos| averaged over h.
 fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
     let sin_i = clamp(dot(t, l), -1.0, 1.0);
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
@@ -46,36 +95,68 @@ fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness:
     let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
     let lp = safe_normalize(l - t * sin_i);
     let vp = safe_normalize(v - t * sin_o);
-    let phi = acos(clamp(dot(lp, vp), -1.0, 1.0));
-    let bm = clamp(roughness, 0.02, 1.0);
-    let x0 = 0.726 * bm + 0.812 * bm * bm + 3.7 * pow(bm, 20.0);
+    let cos_phi = clamp(dot(lp, vp), -1.0, 1.0);
+    let phi = acos(cos_phi);
+    let b = clamp(roughness, 0.02, 1.0);
+    let x0 = 0.726 * b + 0.812 * b * b + 3.7 * pow(b, 20.0);
     let v0 = x0 * x0;
-    let s = 0.626657 * (0.265 * bm + 1.194 * bm * bm + 5.372 * pow(bm, 22.0));
-    let alpha = radians(2.0);
-    let eta = 1.55;
-    let f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
-    let f = f0 + (1.0 - f0) * pow(1.0 - cos_o, 5.0);
-    let sin_t = sin_o / eta;
-    let cos_t = sqrt(max(1.0 - sin_t * sin_t, 1e-4));
-    let tr = exp(-2.0 * sigma_a(color, bm) / cos_t);
-    var out = vec3<f32>(0.0);
+    let s = 0.626657 * (0.265 * b + 1.194 * b * b + 5.372 * pow(b, 22.0));
+    var tilt = TILT;
+    var mps = array<f32, 3>(0.0, 0.0, 0.0);
     for (var p = 0u; p < 3u; p++) {
-        var var_p = v0;
-        var shift = -2.0 * alpha;
-        var a = vec3<f32>(f);
-        if p == 1u {
-            var_p = 0.25 * v0;
-            shift = alpha;
-            a = (1.0 - f) * (1.0 - f) * tr;
-        } else if p == 2u {
-            var_p = 4.0 * v0;
-            shift = 4.0 * alpha;
-            a = (1.0 - f) * (1.0 - f) * tr * tr * f;
-        }
-        let x = sin_i + sin_o - shift;
-        let mp = exp(-x * x / (2.0 * var_p)) / sqrt(2.0 * PI * var_p);
-        let np = trimmed_logistic(wrap_angle(phi - f32(p) * PI), s);
-        out += mp * a * np;
+        let k = tilt[p];
+        let sin_p = sin_o * k.y + cos_o * k.x;
+        let cos_p = abs(cos_o * k.y - sin_o * k.x);
+        mps[p] = mp(cos_i, cos_p, sin_i, sin_p, k.z * v0);
     }
-    return out * cos_i;
+    let a = 3.717 * s;
+    let r = (0.7619 * n_r(phi, cos_o) + 0.1190 * (n_r(phi - a, cos_o) + n_r(phi + a, cos_o)))
+        * mps[0];
+    let etap = sqrt(ETA * ETA - sin_o * sin_o) / max(cos_o, 1e-4);
+    let sin_t = sin_o / ETA;
+    let cos_t = sqrt(max(1.0 - sin_t * sin_t, 1e-4));
+    let sa = sigma_a(color, b);
+    var nodes = H_NODES;
+    var pieces = PIECES;
+    // A_p and Φ_p − pπ at each node, TT then TRT.
+    var ap: array<array<vec3<f32>, 5>, 2>;
+    var dphi: array<array<f32, 5>, 2>;
+    for (var j = 0u; j < NODES; j++) {
+        let node = nodes[j];
+        let sin_gt = node.x / etap;
+        let cos_gt = sqrt(max(1.0 - sin_gt * sin_gt, 0.0));
+        let gamma_t = asin(sin_gt);
+        let f = fresnel(cos_o * node.z);
+        let tr = exp(-2.0 * sa * cos_gt / cos_t);
+        let t1 = (1.0 - f) * (1.0 - f);
+        ap[0][j] = t1 * tr;
+        ap[1][j] = t1 * tr * tr * f;
+        dphi[0][j] = 2.0 * gamma_t - 2.0 * node.y;
+        dphi[1][j] = 4.0 * gamma_t - 2.0 * node.y;
+    }
+    var x = array<f32, 2>(phi - PI, phi);
+    let trim = 1.0 / (logistic_cdf(PI, s) - logistic_cdf(-PI, s));
+    var out = vec3<f32>(r);
+    for (var p = 0u; p < 2u; p++) {
+        var lobe = vec3<f32>(0.0);
+        for (var side = 0u; side < 2u; side++) {
+            let xs = select(-x[p], x[p], side == 0u);
+            var cdf = logistic_cdf(xs - dphi[p][0], s);
+            for (var j = 0u; j < NODES - 1u; j++) {
+                let next = logistic_cdf(xs - dphi[p][j + 1u], s);
+                let width = dphi[p][j + 1u] - dphi[p][j];
+                var n: f32;
+                if abs(width) < 1e-3 * s {
+                    n = logistic(xs - 0.5 * (dphi[p][j] + dphi[p][j + 1u]), s);
+                } else {
+                    n = (cdf - next) / width;
+                }
+                cdf = next;
+                let w = pieces[j];
+                lobe += 0.5 * n * (w.x * ap[p][j] + w.y * ap[p][j + 1u]);
+            }
+        }
+        out += lobe * (mps[p + 1u] * trim);
+    }
+    return out;
 }

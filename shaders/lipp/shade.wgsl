@@ -1,6 +1,6 @@
 // lipp.shade: Lipp §3.4, deferred shading of both G-buffer layers, one
 // invocation per pixel. Port of passes/src/lipp/shade.rs (compact Chiang 2016
-// R/TT/TRT, Kajiya-Kay-like multiple scattering, deep-opacity-map shadows
+// R/TT/TRT of shaders/lipp/chiang.wgsl, Kajiya-Kay-like multiple scattering, deep-opacity-map shadows
 // with Lipp Eq. 8's depth correction, probe lighting with baked AO: L2 SH
 // irradiance and a prefiltered GGX lookup for R + TRT, shaders/lipp/probe.wgsl). Writes rgba32f into `shaded`
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).

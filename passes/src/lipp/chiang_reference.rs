@@ -102,6 +102,10 @@ pub fn fr_dielectric(cos_theta_i: f64, eta: f64) -> f64 {
 }
 
 /// pbrt-v4 `HairBxDF::Mp` (d'Eon et al. 2011's longitudinal function).
+#[allow(
+    clippy::approx_constant,
+    reason = "pbrt's literal 0.6931 for ln 2, transcribed as is"
+)]
 pub fn mp(cos_theta_i: f64, cos_theta_o: f64, sin_theta_i: f64, sin_theta_o: f64, v: f64) -> f64 {
     let a = cos_theta_i * cos_theta_o / v;
     let b = sin_theta_i * sin_theta_o / v;
@@ -347,7 +351,6 @@ pub fn average_over_h(p: &Params, wo: [f64; 3], wi: [f64; 3], n: usize) -> Lobes
 pub struct Azimuthal {
     pub params: Params,
     pub sin_theta_o: f64,
-    pub phis: Vec<f64>,
     /// [φ index][lobe][rgb]; lobe 3 is pbrt's residual A_3 / 2π.
     pub table: Vec<Lobes>,
 }
@@ -373,7 +376,6 @@ impl Azimuthal {
         Self {
             params,
             sin_theta_o,
-            phis,
             table,
         }
     }
