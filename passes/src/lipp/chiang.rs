@@ -51,16 +51,17 @@
 //!
 //! Longitudinal peaks of R and TRT (β ≤ 0.3) now agree within 0.1°; before,
 //! every cuticle shift had the wrong sign (θ_o = 0, β = 0.2: R at −3.9°
-//! against pbrt's +3.9°, TRT at +7° against −7.5°). What the old form
-//! (Karis 2016's Gaussian M_p, N_p and A_p at h = 0, Schlick, × cos θ_i) got
-//! wrong, besides the signs: N_p at h = 0 is a logistic of width s around
-//! pπ, where R really spreads over every azimuth (¼ cos(φ/2)), TT over
-//! ±100° and TRT over ±20° with a caustic; A_R at h = 0 is Fresnel at normal
-//! incidence (with the extra cos θ_i, R's albedo was 1.6 to 7 times too
-//! low); the extra cos θ_i lost energy at grazing light (half at 60°); and the Gaussian in sin θ lost 38% of TRT's
-//! M_p at β = 0.5 outside sin θ_i ∈ [−1, 1]. The shifts of Karis's form are
-//! for a tangent pointing to the root (Unreal's convention); ours points to
-//! the tip (`strand::calc_tangent`), as pbrt's ∂p/∂u does.
+//! against pbrt's +3.9°, TRT at +7° against −7.5°). What the old form (Karis
+//! 2016's Gaussian M_p, N_p and A_p at h = 0, Schlick, × cos θ_i) got wrong,
+//! besides the signs: N_p at h = 0 is a logistic of width s around pπ, where
+//! R really spreads over every azimuth (¼ cos(φ/2)), TT over ±100° and TRT
+//! over ±20° with a caustic; A_R at h = 0 is Fresnel at normal incidence
+//! (with the extra cos θ_i, R's albedo was 1.6 to 7 times too low); the extra
+//! cos θ_i lost energy at grazing light (half at 60°); and the Gaussian in
+//! sin θ lost 38% of TRT's M_p at β = 0.5 outside sin θ_i ∈ [−1, 1]. The
+//! shifts of Karis's form are for a tangent pointing to the root (Unreal's
+//! convention); ours points to the tip (`strand::calc_tangent`), as pbrt's
+//! ∂p/∂u does.
 
 use super::{dot, normalize, scale, sub};
 
