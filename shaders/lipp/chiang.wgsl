@@ -87,6 +87,34 @@ fn n_r(phi: f32, cos_o: f32) -> f32 {
     return 0.25 * c * fresnel(cos_o * c);
 }
 
+// chiang::reflected_albedo: R's (x) and TRT's (yzw) directional albedo at
+// sin θ_o, pbrt-v4's A_p averaged over h.
+fn reflected_albedo(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> vec4<f32> {
+    let sin_o = clamp(sin_o_in, -1.0, 1.0);
+    let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
+    let etap = sqrt(ETA * ETA - sin_o * sin_o) / max(cos_o, 1e-4);
+    let cos_t = sqrt(max(1.0 - (sin_o / ETA) * (sin_o / ETA), 1e-4));
+    let sa = sigma_a(color, clamp(roughness, 0.02, 1.0));
+    var r = 0.0;
+    var trt = vec3<f32>(0.0);
+    var prev = vec4<f32>(0.0);
+    for (var j = 0u; j < NODES; j++) {
+        let node = H_NODES[j];
+        let sin_gt = node.x / etap;
+        let cos_gt = sqrt(max(1.0 - sin_gt * sin_gt, 0.0));
+        let f = fresnel(cos_o * node.z);
+        let t = exp(-2.0 * sa * cos_gt / cos_t);
+        let cur = vec4<f32>(f, (1.0 - f) * (1.0 - f) * t * t * f);
+        if j > 0u {
+            let w = PIECES[j - 1u];
+            r += w.x * prev.x + w.y * cur.x;
+            trt += w.x * prev.yzw + w.y * cur.yzw;
+        }
+        prev = cur;
+    }
+    return vec4<f32>(r, trt);
+}
+
 // chiang::chiang: R + TT + TRT, pbrt's f · |cos| averaged over h.
 fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
     let sin_i = clamp(dot(t, l), -1.0, 1.0);

@@ -7,7 +7,7 @@
 #define_import_path strandgraph::probe
 
 #import strandgraph::lipp::{PI, safe_normalize}
-#import strandgraph::chiang::{sigma_a}
+#import strandgraph::chiang::{reflected_albedo}
 
 // probe::{LEVELS, WIDTH, HEIGHT, MIN_WIDTH, MIN_HEIGHT}.
 const PROBE_LEVELS: u32 = 6u;
@@ -103,22 +103,17 @@ struct ProbeLobe {
 // probe::specular_lobe: one GGX lobe for R + TRT.
 fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32) -> ProbeLobe {
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
-    let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
     let bm = clamp(roughness, 0.02, 1.0);
     let x0 = 0.726 * bm + 0.812 * bm * bm + 3.7 * pow(bm, 20.0);
     let v0 = x0 * x0;
     let alpha = radians(2.0);
-    let eta = 1.55;
-    let f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
-    let f = f0 + (1.0 - f0) * pow(1.0 - cos_o, 5.0);
-    let sin_t = sin_o / eta;
-    let cos_t = sqrt(max(1.0 - sin_t * sin_t, 1e-4));
-    let tr = exp(-2.0 * sigma_a(color, bm) / cos_t);
-    let a_trt = (1.0 - f) * (1.0 - f) * tr * tr * f;
-    let w_r = f;
+    let albedo = reflected_albedo(sin_o, color, roughness);
+    let w_r = albedo.x;
+    let a_trt = albedo.yzw;
     let w_trt = (a_trt.x + a_trt.y + a_trt.z) / 3.0;
-    let s_r = -2.0 * alpha;
-    let s_trt = 4.0 * alpha;
+    // M_p's peaks in sin θ_i + sin θ_o (tangent root to tip): R +2α, TRT −4α.
+    let s_r = 2.0 * alpha;
+    let s_trt = -4.0 * alpha;
     let sum = w_r + w_trt;
     let mu = (w_r * s_r + w_trt * s_trt) / sum;
     let second = (w_r * (v0 + s_r * s_r) + w_trt * (4.0 * v0 + s_trt * s_trt)) / sum;
@@ -126,5 +121,5 @@ fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughn
     let sin_l = clamp(mu - sin_o, -1.0, 1.0);
     let cos_l = sqrt(max(1.0 - sin_l * sin_l, 0.0));
     let direction = safe_normalize(t * sin_l + n * cos_l);
-    return ProbeLobe(direction, min(sqrt(0.5 * variance), 1.0), a_trt + f);
+    return ProbeLobe(direction, min(sqrt(0.5 * variance), 1.0), a_trt + w_r);
 }

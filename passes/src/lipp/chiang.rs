@@ -190,6 +190,39 @@ fn n_r(phi: f32, cos_o: f32) -> f32 {
 
 const ETA: f32 = 1.55;
 
+/// The fibre's directional albedo in R and in TRT seen at sin θ_o: pbrt-v4's
+/// `HairBxDF::Ap` for p = 0 and 2 averaged over h (M_p and N_p integrate to
+/// one, so under uniform light the lobes return exactly this), by the same
+/// offsets and pieces as [`chiang_lobes`]. `lipp.shade`'s probe term weights
+/// its single GGX lobe with it (Lipp §3.4).
+pub fn reflected_albedo(sin_o: f32, m: &Material) -> (f32, [f32; 3]) {
+    let sin_o = sin_o.clamp(-1.0, 1.0);
+    let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
+    let etap = (ETA * ETA - sin_o * sin_o).sqrt() / cos_o.max(1e-4);
+    let cos_t = (1.0 - (sin_o / ETA) * (sin_o / ETA)).max(1e-4).sqrt();
+    let sa = sigma_a(m.color, m.roughness.clamp(0.02, 1.0));
+    let node = |j: usize| {
+        let (h, _, cos_gamma_o) = H_NODES[j];
+        let sin_gt = h / etap;
+        let cos_gt = (1.0 - sin_gt * sin_gt).max(0.0).sqrt();
+        let f = fresnel(cos_o * cos_gamma_o);
+        let trt = sa.map(|a| {
+            let t = (-2.0 * a * cos_gt / cos_t).exp();
+            (1.0 - f) * (1.0 - f) * t * t * f
+        });
+        (f, trt)
+    };
+    let (mut r, mut trt) = (0.0f32, [0.0f32; 3]);
+    for (j, &(wa, wb)) in PIECES.iter().enumerate() {
+        let ((ra, ta), (rb, tb)) = (node(j), node(j + 1));
+        r += wa * ra + wb * rb;
+        for k in 0..3 {
+            trt[k] += wa * ta[k] + wb * tb[k];
+        }
+    }
+    (r, trt)
+}
+
 /// Per lobe: sin 2kα, cos 2kα of the cuticle tilt applied to θ_o (α = 2°;
 /// R: −2α, TT: +α, TRT: +4α, pbrt-v4 `HairBxDF::f`) and v_p / v_0 (Chiang
 /// Eq. 7: v_1 = v_0 / 4, v_2 = 4 v_0).

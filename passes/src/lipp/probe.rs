@@ -31,7 +31,7 @@
 //! colour fills only L00 and every prefiltered texel; without an
 //! environment, both are zero.
 
-use super::chiang::sigma_a;
+use super::chiang::{Material, reflected_albedo};
 use super::{dot, normalize, scale, sub};
 use crate::sim::Words;
 use glam::Vec3;
@@ -168,16 +168,17 @@ pub struct SpecularLobe {
 /// longitudinal roughness `roughness` (β_m), in the terms of
 /// [`super::chiang::chiang`]:
 ///
-/// - **Weight**: Chiang's attenuations at θ_o, A_R = f and A_TRT =
-///   (1 − f)² T² f (Schlick f, η = 1.55; T = exp(−2 σ_a / cos θ_t)). The
-///   hair lobes are normalised in M_p and N_p, so under uniform radiance
+/// - **Weight**: R's and TRT's directional albedo at θ_o, pbrt-v4's A_p
+///   averaged over the fibre offset h ([`super::chiang::reflected_albedo`]).
+///   The hair lobes are normalised in M_p and N_p, so under uniform radiance
 ///   their sum returns A_R + A_TRT of it, and so does this term.
 /// - **Direction**: the longitudinal mirror of V across the fibre's normal
 ///   plane (sin θ_i = −sin θ_o, the specular cone), on the side of the
 ///   view-facing normal (azimuth φ = 0, where R and TRT both reflect back
 ///   towards the viewer), shifted along the fibre by the cuticle tilt:
 ///   Chiang's M_p peaks where sin θ_i + sin θ_o equals the lobe's shift
-///   (−2α for R, 4α for TRT, α = 2° as in `chiang`).
+///   (+2α for R, −4α for TRT with the tangent root to tip, α = 2° as in
+///   `chiang`).
 /// - **Width**: the two longitudinal Gaussians (variances v_0 and 4 v_0,
 ///   Chiang Eq. 7) moment-matched into one, weighted by A_R and mean A_TRT:
 ///   shift μ = Σ w_p s_p / Σ w_p and σ² = Σ w_p (v_p + s_p²) / Σ w_p − μ².
@@ -194,26 +195,17 @@ pub fn specular_lobe(
     roughness: f32,
 ) -> SpecularLobe {
     let sin_o = dot(t, v).clamp(-1.0, 1.0);
-    let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
     let bm = roughness.clamp(0.02, 1.0);
     let v0 = {
         let x = 0.726 * bm + 0.812 * bm * bm + 3.7 * bm.powi(20);
         x * x
     };
     let alpha = 2.0f32.to_radians();
-    let eta = 1.55;
-    let f0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));
-    let f = f0 + (1.0 - f0) * (1.0 - cos_o).powi(5);
-    let sin_t = sin_o / eta;
-    let cos_t = (1.0 - sin_t * sin_t).max(1e-4).sqrt();
-    let sa = sigma_a(color, bm);
-    let a_trt = sa.map(|a| {
-        let tr = (-2.0 * a / cos_t).exp();
-        (1.0 - f) * (1.0 - f) * tr * tr * f
-    });
-    let w_r = f;
+    let (w_r, a_trt) = reflected_albedo(sin_o, &Material { color, roughness });
     let w_trt = (a_trt[0] + a_trt[1] + a_trt[2]) / 3.0;
-    let (s_r, s_trt) = (-2.0 * alpha, 4.0 * alpha);
+    // Where M_p peaks in sin θ_i + sin θ_o (tangent root to tip, as in
+    // `chiang`): R at +2α, TRT at −4α.
+    let (s_r, s_trt) = (2.0 * alpha, -4.0 * alpha);
     let sum = w_r + w_trt;
     let mu = (w_r * s_r + w_trt * s_trt) / sum;
     let second = (w_r * (v0 + s_r * s_r) + w_trt * (4.0 * v0 + s_trt * s_trt)) / sum;
@@ -228,7 +220,7 @@ pub fn specular_lobe(
     SpecularLobe {
         direction,
         alpha: (0.5 * var).sqrt().min(1.0),
-        weight: a_trt.map(|a| a + f),
+        weight: a_trt.map(|a| a + w_r),
     }
 }
 
@@ -783,15 +775,25 @@ mod tests {
         let dark = [0.02, 0.015, 0.01];
         let lobe = specular_lobe(t, v, n, dark, 0.3);
         // The lobe sits on the specular cone (sin θ_l = −sin θ_o) shifted by
-        // the A-weighted mean of R's −2α and TRT's 4α; dark hair: nearly R's.
+        // the A-weighted mean of R's +2α and TRT's −4α; dark hair: nearly R's.
         let sin_o = dot(t, v);
         let shift = dot(lobe.direction, t) + sin_o;
-        let f = 0.0465 + (1.0 - 0.0465) * (1.0 - (1.0 - sin_o * sin_o).sqrt()).powi(5);
-        let a_trt = (lobe.weight.iter().sum::<f32>() / 3.0) - f;
+        let (f, trt) = reflected_albedo(
+            sin_o,
+            &Material {
+                color: dark,
+                roughness: 0.3,
+            },
+        );
+        let a_trt = trt.iter().sum::<f32>() / 3.0;
+        assert!((lobe.weight.iter().sum::<f32>() / 3.0 - (f + a_trt)).abs() < 1e-6);
         let alpha_c = 2f32.to_radians();
-        let mu = (f * -2.0 * alpha_c + a_trt * 4.0 * alpha_c) / (f + a_trt);
+        let mu = (f * 2.0 * alpha_c + a_trt * -4.0 * alpha_c) / (f + a_trt);
         assert!((shift - mu).abs() < 1e-3, "shift {shift} rad, μ {mu}");
-        assert!(a_trt < 0.15 * f && shift < -alpha_c, "{lobe:?}");
+        assert!(a_trt < 0.15 * f && shift > alpha_c, "{lobe:?}");
+        // R averaged over the fibre's width reflects more than at its centre
+        // (Fresnel grows towards grazing offsets): above normal incidence's 4.65%.
+        assert!(f > 0.0465, "{f}");
         assert!(dot(lobe.direction, n) > 0.9);
         // Between R's α = √(v0 / 2) and TRT's √(4 v0 / 2), near R's.
         let bm: f32 = 0.3;
@@ -805,10 +807,10 @@ mod tests {
             lobe.weight.iter().all(|&w| (0.04..0.1).contains(&w)),
             "{lobe:?}"
         );
-        // Blond hair: TRT adds weight (more in red), shifts the lobe towards +4α, widens it.
+        // Blond hair: TRT adds weight (more in red), shifts the lobe towards −4α, widens it.
         let blond = specular_lobe(t, v, n, [0.8, 0.6, 0.35], 0.3);
         assert!(blond.weight[0] > blond.weight[2] && blond.weight[2] > lobe.weight[2]);
-        assert!(dot(blond.direction, t) > dot(lobe.direction, t));
+        assert!(dot(blond.direction, t) < dot(lobe.direction, t));
         assert!(blond.alpha > lobe.alpha);
         // Rougher hair, wider lobe; capped at α = 1.
         let rough = specular_lobe(t, v, n, dark, 0.6);
