@@ -237,6 +237,19 @@ fn classify(
     }
     for (&r, role) in &roles {
         if let Role::Chain { consumed } = *role
+            && matches!(roles.get(&consumed), Some(Role::Chain { .. }))
+        {
+            errors.push(GraphError::new(
+                ErrorKind::BadAccess,
+                &g.source,
+                g.resources[r].span,
+                format!(
+                    "`{}` is made in place from `{}`, which the per-model block also makes in place; a block carries one version of a resource from model to model",
+                    g.resources[r].name, g.resources[consumed].name
+                ),
+            ));
+        }
+        if let Role::Chain { consumed } = *role
             && matches!(roles.get(&consumed), Some(Role::Local))
         {
             errors.push(GraphError::new(
@@ -389,6 +402,22 @@ mod tests {
             "{e}"
         );
         assert_eq!(e.line, 11, "points at the access: {e}");
+    }
+
+    #[test]
+    fn two_in_place_writes_of_one_resource_in_the_block_are_an_error() {
+        let src = GROOMS.replace(
+            r#"        Pass(name: "post""#,
+            r#"        Pass(name: "tone", kind: "test.produce", repeat: PerModel, writes: ["out.hair -> out.toned"]),
+        Pass(name: "post""#,
+        );
+        let err = compile_str("bad.ron", &src, &kinds(), 2).unwrap_err();
+        assert!(
+            err.0.iter().any(|e| e
+                .message
+                .contains("`out.toned` is made in place from `out.hair`")),
+            "{err}"
+        );
     }
 
     #[test]
