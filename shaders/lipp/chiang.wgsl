@@ -87,26 +87,45 @@ fn n_r(phi: f32, cos_o: f32) -> f32 {
     return 0.25 * c * fresnel(cos_o * c);
 }
 
+// chiang::Offset: the light path at one offset of H_NODES.
+struct Offset {
+    f: f32,
+    tr: vec3<f32>,
+    sin_gt: f32,
+}
+
+// The view's modified index η' and cos θ_t (pbrt-v4 HairBxDF::f), once per
+// view for offset_at.
+fn refraction(sin_o: f32, cos_o: f32) -> vec2<f32> {
+    let sin_t = sin_o / ETA;
+    return vec2<f32>(sqrt(ETA * ETA - sin_o * sin_o) / max(cos_o, 1e-4), sqrt(max(1.0 - sin_t * sin_t, 1e-4)));
+}
+
+// chiang::offsets, one node j at a time; rc = refraction(sin θ_o, cos θ_o).
+fn offset_at(j: u32, cos_o: f32, rc: vec2<f32>, sa: vec3<f32>) -> Offset {
+    var nodes = H_NODES;
+    let node = nodes[j];
+    let sin_gt = node.x / rc.x;
+    let cos_gt = sqrt(max(1.0 - sin_gt * sin_gt, 0.0));
+    return Offset(fresnel(cos_o * node.z), exp(-2.0 * sa * cos_gt / rc.y), sin_gt);
+}
+
 // chiang::reflected_albedo: R's (x) and TRT's (yzw) directional albedo at
 // sin θ_o, pbrt-v4's A_p averaged over h.
 fn reflected_albedo(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> vec4<f32> {
     let sin_o = clamp(sin_o_in, -1.0, 1.0);
     let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
-    let etap = sqrt(ETA * ETA - sin_o * sin_o) / max(cos_o, 1e-4);
-    let cos_t = sqrt(max(1.0 - (sin_o / ETA) * (sin_o / ETA), 1e-4));
     let sa = sigma_a(color, clamp(roughness, 0.02, 1.0));
+    let rc = refraction(sin_o, cos_o);
+    var pieces = PIECES;
     var r = 0.0;
     var trt = vec3<f32>(0.0);
     var prev = vec4<f32>(0.0);
     for (var j = 0u; j < NODES; j++) {
-        let node = H_NODES[j];
-        let sin_gt = node.x / etap;
-        let cos_gt = sqrt(max(1.0 - sin_gt * sin_gt, 0.0));
-        let f = fresnel(cos_o * node.z);
-        let t = exp(-2.0 * sa * cos_gt / cos_t);
-        let cur = vec4<f32>(f, (1.0 - f) * (1.0 - f) * t * t * f);
+        let o = offset_at(j, cos_o, rc, sa);
+        let cur = vec4<f32>(o.f, (1.0 - o.f) * (1.0 - o.f) * o.tr * o.tr * o.f);
         if j > 0u {
-            let w = PIECES[j - 1u];
+            let w = pieces[j - 1u];
             r += w.x * prev.x + w.y * cur.x;
             trt += w.x * prev.yzw + w.y * cur.yzw;
         }
@@ -140,10 +159,8 @@ fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness:
     let a = 3.717 * s;
     let r = (0.7619 * n_r(phi, cos_o) + 0.1190 * (n_r(phi - a, cos_o) + n_r(phi + a, cos_o)))
         * mps[0];
-    let etap = sqrt(ETA * ETA - sin_o * sin_o) / max(cos_o, 1e-4);
-    let sin_t = sin_o / ETA;
-    let cos_t = sqrt(max(1.0 - sin_t * sin_t, 1e-4));
     let sa = sigma_a(color, b);
+    let rc = refraction(sin_o, cos_o);
     var nodes = H_NODES;
     var pieces = PIECES;
     // A_p and Φ_p − pπ at each node, TT then TRT.
@@ -151,11 +168,10 @@ fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness:
     var dphi: array<array<f32, 5>, 2>;
     for (var j = 0u; j < NODES; j++) {
         let node = nodes[j];
-        let sin_gt = node.x / etap;
-        let cos_gt = sqrt(max(1.0 - sin_gt * sin_gt, 0.0));
-        let gamma_t = asin(sin_gt);
-        let f = fresnel(cos_o * node.z);
-        let tr = exp(-2.0 * sa * cos_gt / cos_t);
+        let o = offset_at(j, cos_o, rc, sa);
+        let gamma_t = asin(o.sin_gt);
+        let f = o.f;
+        let tr = o.tr;
         let t1 = (1.0 - f) * (1.0 - f);
         ap[0][j] = t1 * tr;
         ap[1][j] = t1 * tr * tr * f;

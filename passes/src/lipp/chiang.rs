@@ -135,20 +135,13 @@ pub fn chiang_lobes(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [[f3
     // TT, TRT: ½∫ A_p(h) N_p(φ; h) dh with A_p and Φ_p(h) evaluated at the
     // offsets of H_NODES and Φ_p linear in between: each piece is a box in φ
     // convolved with the logistic, a difference of two logistic CDFs.
-    let etap = (ETA * ETA - sin_o * sin_o).sqrt() / cos_o.max(1e-4);
-    let sin_t = sin_o / ETA;
-    let cos_t = (1.0 - sin_t * sin_t).max(1e-4).sqrt();
-    let sa = sigma_a(m.color, b);
     let mut ap = [[[0.0f32; 3]; 2]; NODES];
     let mut dphi = [[0.0f32; 2]; NODES];
-    for (j, &(h, gamma_o, cos_gamma_o)) in H_NODES.iter().enumerate() {
-        let sin_gt = h / etap;
-        let cos_gt = (1.0 - sin_gt * sin_gt).max(0.0).sqrt();
-        let gamma_t = sin_gt.asin();
-        let f = fresnel(cos_o * cos_gamma_o);
-        let tr = sa.map(|a| (-2.0 * a * cos_gt / cos_t).exp());
-        let t1 = (1.0 - f) * (1.0 - f);
-        ap[j] = [tr.map(|t| t1 * t), tr.map(|t| t1 * t * t * f)];
+    let at = offsets(sin_o, cos_o, sigma_a(m.color, b));
+    for (j, (o, &(_, gamma_o, _))) in at.iter().zip(&H_NODES).enumerate() {
+        let gamma_t = o.sin_gt.asin();
+        let (f, t1) = (o.f, (1.0 - o.f) * (1.0 - o.f));
+        ap[j] = [o.tr.map(|t| t1 * t), o.tr.map(|t| t1 * t * t * f)];
         dphi[j] = [2.0 * gamma_t - 2.0 * gamma_o, 4.0 * gamma_t - 2.0 * gamma_o];
     }
     // Deviation from each lobe's centre: TT at π, TRT at 2π.
@@ -190,6 +183,30 @@ fn n_r(phi: f32, cos_o: f32) -> f32 {
 
 const ETA: f32 = 1.55;
 
+/// The light path at one offset h of [`H_NODES`], seen at (sin θ_o, cos θ_o):
+/// Fresnel at entry, the RGB transmittance through the fibre and sin γ_t
+/// (pbrt-v4 `HairBxDF::Ap`'s inputs and `Phi`'s refracted angle).
+struct Offset {
+    f: f32,
+    tr: [f32; 3],
+    sin_gt: f32,
+}
+
+fn offsets(sin_o: f32, cos_o: f32, sigma_a: [f32; 3]) -> [Offset; NODES] {
+    let etap = (ETA * ETA - sin_o * sin_o).sqrt() / cos_o.max(1e-4);
+    let sin_t = sin_o / ETA;
+    let cos_t = (1.0 - sin_t * sin_t).max(1e-4).sqrt();
+    H_NODES.map(|(h, _, cos_gamma_o)| {
+        let sin_gt = h / etap;
+        let cos_gt = (1.0 - sin_gt * sin_gt).max(0.0).sqrt();
+        Offset {
+            f: fresnel(cos_o * cos_gamma_o),
+            tr: sigma_a.map(|a| (-2.0 * a * cos_gt / cos_t).exp()),
+            sin_gt,
+        }
+    })
+}
+
 /// The fibre's directional albedo in R and in TRT seen at sin θ_o: pbrt-v4's
 /// `HairBxDF::Ap` for p = 0 and 2 averaged over h (M_p and N_p integrate to
 /// one, so under uniform light the lobes return exactly this), by the same
@@ -198,19 +215,10 @@ const ETA: f32 = 1.55;
 pub fn reflected_albedo(sin_o: f32, m: &Material) -> (f32, [f32; 3]) {
     let sin_o = sin_o.clamp(-1.0, 1.0);
     let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
-    let etap = (ETA * ETA - sin_o * sin_o).sqrt() / cos_o.max(1e-4);
-    let cos_t = (1.0 - (sin_o / ETA) * (sin_o / ETA)).max(1e-4).sqrt();
-    let sa = sigma_a(m.color, m.roughness.clamp(0.02, 1.0));
+    let at = offsets(sin_o, cos_o, sigma_a(m.color, m.roughness.clamp(0.02, 1.0)));
     let node = |j: usize| {
-        let (h, _, cos_gamma_o) = H_NODES[j];
-        let sin_gt = h / etap;
-        let cos_gt = (1.0 - sin_gt * sin_gt).max(0.0).sqrt();
-        let f = fresnel(cos_o * cos_gamma_o);
-        let trt = sa.map(|a| {
-            let t = (-2.0 * a * cos_gt / cos_t).exp();
-            (1.0 - f) * (1.0 - f) * t * t * f
-        });
-        (f, trt)
+        let (f, tr) = (at[j].f, at[j].tr);
+        (f, tr.map(|t| (1.0 - f) * (1.0 - f) * t * t * f))
     };
     let (mut r, mut trt) = (0.0f32, [0.0f32; 3]);
     for (j, &(wa, wb)) in PIECES.iter().enumerate() {
