@@ -14,7 +14,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strandgraph::frame::prepare;
-use strandgraph::runner::{Backend, CpuOptions, Runner, gpu_frame_millis};
+use strandgraph::runner::{self, Backend, CpuOptions, frame_millis};
 
 const PIPELINES: [(&str, &str); 2] = [
     ("kulikov", "scenes/graphs/kulikov.ron"),
@@ -40,7 +40,7 @@ fn frame_benches(c: &mut Criterion) {
             for backend in [Backend::Cpu, Backend::Wgpu, Backend::Ash] {
                 let id = format!("{}/{pipeline}/{view}", backend.name());
                 let mut runner =
-                    match Runner::open(backend, &p.plan, &p.instance, CpuOptions::default()) {
+                    match runner::open(backend, &p.plan, &p.instance, CpuOptions::default()) {
                         Ok(r) => r,
                         Err(e) => {
                             eprintln!("frame/{id}: skipped: {e}");
@@ -50,13 +50,13 @@ fn frame_benches(c: &mut Criterion) {
                 eprintln!("frame/{id}: {}", runner.device());
                 let mut frame = || {
                     runner
-                        .run(&p.plan, &p.upload)
+                        .run(&p.upload)
                         .unwrap_or_else(|e| panic!("{id}: {e:?}"))
                 };
                 if backend.is_gpu() {
                     group.bench_function(&id, |b| {
                         b.iter_custom(|iters| {
-                            let ms: f64 = (0..iters).map(|_| gpu_frame_millis(&frame())).sum();
+                            let ms: f64 = (0..iters).map(|_| frame_millis(&frame())).sum();
                             Duration::from_secs_f64(ms * 1e-3)
                         })
                     });

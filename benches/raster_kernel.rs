@@ -9,7 +9,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strandgraph::frame::{override_param, prepare};
-use strandgraph::runner::{Backend, CpuOptions, Runner};
+use strandgraph::runner::{self, Backend, CpuOptions};
 
 const SWITCHES: [(&str, &[&str]); 3] = [
     ("all_optimisations", &[]),
@@ -31,19 +31,17 @@ fn raster_benches(c: &mut Criterion) {
         for o in overrides {
             override_param(&mut plan, o).unwrap_or_else(|e| panic!("{e:?}"));
         }
-        let mut runner = Runner::open(Backend::Cpu, &plan, &p.instance, CpuOptions::default())
+        let mut runner = runner::open(Backend::Cpu, &plan, &p.instance, CpuOptions::default())
             .unwrap_or_else(|e| panic!("{e:?}"));
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {
                 let ms: f64 = (0..iters)
                     .map(|_| {
-                        let frame = runner
-                            .run(&plan, &p.upload)
-                            .unwrap_or_else(|e| panic!("{e:?}"));
+                        let frame = runner.run(&p.upload).unwrap_or_else(|e| panic!("{e:?}"));
                         frame
                             .iter()
                             .filter(|t| t.name == "raster")
-                            .map(|t| t.millis)
+                            .filter_map(|t| t.millis)
                             .sum::<f64>()
                     })
                     .sum();

@@ -16,7 +16,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
-use strandgraph::runner::{Backend, CpuOptions, Runner, gpu_frame_millis};
+use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_passes::upload::Upload;
 use strandgraph_passes::{Definitions, Registry};
@@ -375,7 +375,7 @@ pub fn run(mut args: Args) -> Result<()> {
         .collect();
     let cpu = CpuOptions {
         subgroup_width: args.subgroup,
-        instrument: false,
+        ..CpuOptions::default()
     };
     let counting = CpuOptions {
         instrument: true,
@@ -479,25 +479,24 @@ pub fn run(mut args: Args) -> Result<()> {
 
 /// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
 /// and the frame times (CPU: wall time of the frame, its queues overlap;
-/// GPU: [`gpu_frame_millis`], timestamps only).
+/// GPU: [`frame_millis`], timestamps only).
 fn frames(
-    runner: &mut Runner,
-    plan: &strandgraph_graph::Plan,
+    session: &mut dyn Session,
     upload: &Upload,
     args: &Args,
-) -> Result<(Vec<Vec<strandgraph::runner::PassTime>>, Vec<f64>)> {
+) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
     for _ in 0..args.warmup {
-        runner.run(plan, upload)?;
+        session.run(upload)?;
     }
     let mut passes = Vec::with_capacity(args.frames);
     let mut totals = Vec::with_capacity(args.frames);
     for _ in 0..args.frames {
         let t = Instant::now();
-        let times = runner.run(plan, upload)?;
+        let times = session.run(upload)?;
         let wall = t.elapsed().as_secs_f64() * 1e3;
-        totals.push(match runner.backend() {
-            Backend::Cpu => wall,
-            _ => gpu_frame_millis(&times),
+        totals.push(match session.clock() {
+            Clock::CpuWall => wall,
+            Clock::GpuTimestamps => frame_millis(&times),
         });
         passes.push(times);
     }
@@ -517,12 +516,12 @@ fn variant_plan(p: &Prepared, v: &Variant) -> Result<strandgraph_graph::Plan> {
 /// configuration. GPUs expose no atomic counters, so GPU rows use this count.
 fn count_atomics(p: &Prepared, v: &Variant, counting: CpuOptions) -> Result<u64> {
     let plan = variant_plan(p, v)?;
-    let mut counter = Runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
+    let mut counter = runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
     Ok(counter
-        .run(&plan, &p.upload)?
+        .run(&p.upload)?
         .iter()
         .filter(|t| v.raster.contains(&strandgraph_graph::base_name(&t.name)))
-        .filter_map(|t| t.atomics)
+        .filter_map(|t| t.counters.as_ref().map(|c| c.atomics))
         .sum())
 }
 
@@ -536,10 +535,10 @@ fn measure(
     atomics: u64,
 ) -> Result<(String, Vec<String>, Stats)> {
     let plan = variant_plan(p, v)?;
-    let mut runner = Runner::open(backend, &plan, &p.instance, cpu)?;
-    let (passes, totals) = frames(&mut runner, &plan, &p.upload, args)?;
+    let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
+    let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);
-    Ok((runner.device(), runner.notes(), stats))
+    Ok((session.device(), session.notes(), stats))
 }
 
 /// What the roofline run gives one backend.
@@ -563,24 +562,24 @@ fn roofline(
         quantities: first.upload.quantities,
         ..Default::default()
     };
-    let mut counter = Runner::open(Backend::Cpu, &plan, &instance, counting)?;
-    let counted = counter.run(&plan, &upload)?;
+    let mut counter = runner::open(Backend::Cpu, &plan, &instance, counting)?;
+    let counted = counter.run(&upload)?;
     let ops = |name: &str| {
         counted
             .iter()
             .find(|t| t.name == name)
-            .and_then(|t| t.atomics)
+            .and_then(|t| t.counters.as_ref().map(|c| c.atomics))
             .unwrap_or(0)
     };
     let (atomics32, atomics64) = (ops("atomic_min32"), ops("atomic_min64"));
     drop(counter);
 
-    let mut runner = Runner::open(backend, &plan, &instance, cpu)?;
-    let (passes, _) = frames(&mut runner, &plan, &upload, args)?;
+    let mut session = runner::open(backend, &plan, &instance, cpu)?;
+    let (passes, _) = frames(session.as_mut(), &upload, args)?;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()
-            .filter_map(|f| f.iter().find(|t| t.name == name).map(|t| t.millis))
+            .filter_map(|f| f.iter().find(|t| t.name == name).and_then(|t| t.millis))
             .collect();
         report::median(&v)
     };
@@ -589,8 +588,8 @@ fn roofline(
         .resource_id("copy_dst")
         .map_or(0, |r| instance.sizes[r].bytes);
     Ok(Roofline {
-        device: runner.device(),
-        notes: runner.notes(),
+        device: session.device(),
+        notes: session.notes(),
         ceilings: Ceilings {
             atomic_min32: (atomics32, median("atomic_min32")),
             atomic_min64: (atomics64, median("atomic_min64")),

@@ -5,9 +5,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
 use strandgraph::images::{depth_to_view, motion_image, to_linear, to_picture};
-use strandgraph_cpu::{CpuBackend, PassTiming};
+use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
-use strandgraph_wgpu::WgpuBackend;
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Backend {
@@ -88,34 +87,42 @@ pub fn run(args: Args) -> Result<()> {
         ))
     });
 
-    let cpu = if matches!(args.backend, Backend::Cpu | Backend::All) {
-        Some(run_cpu(&args, &p, &main)?)
-    } else {
-        None
+    let chosen: &[runner::Backend] = match args.backend {
+        Backend::Cpu => &[runner::Backend::Cpu],
+        Backend::Wgpu => &[runner::Backend::Wgpu],
+        Backend::Ash => &[runner::Backend::Ash],
+        Backend::All => &runner::Backend::ALL,
     };
-    // With several backends the CPU's files keep their names and the others
-    // are tagged: showcase.png, showcase.wgpu.png, showcase.ash.png.
-    let gpu = if matches!(args.backend, Backend::Wgpu | Backend::All) {
-        let tag = cpu.is_some().then_some("wgpu");
-        Some(run_wgpu(&p, &tagged(&main, tag), &Extras::of(&args, tag))?)
-    } else {
-        None
+    let options = CpuOptions {
+        subgroup_width: args.subgroup,
+        instrument: args.instrument,
+        alias: !args.no_alias,
     };
-    let ash = if matches!(args.backend, Backend::Ash | Backend::All) {
-        let tag = (cpu.is_some() || gpu.is_some()).then_some("ash");
-        Some(run_ash(
-            &args,
-            &p,
-            &tagged(&main, tag),
-            &Extras::of(&args, tag),
-        )?)
-    } else {
-        None
-    };
-    if let (Some(cpu), Some(gpu), Some(ash)) = (&cpu, &gpu, &ash) {
-        print_three_way(&p.plan, cpu, gpu, ash);
-    } else if let (Some(cpu), Some(gpu)) = (&cpu, &gpu) {
-        print_side_by_side(&p.plan, cpu, gpu);
+    let mut all = Vec::new();
+    for (i, &backend) in chosen.iter().enumerate() {
+        // With several backends the first one's files keep their names and
+        // the others are tagged: showcase.png, showcase.wgpu.png, …
+        let tag = (i > 0).then_some(backend.name());
+        let t1 = Instant::now();
+        let mut session = runner::open(backend, &p.plan, &p.instance, options)?;
+        let times = session.run(&p.upload)?;
+        let wall = t1.elapsed().as_secs_f64() * 1e3;
+        print_timings(&p.plan, &times, args.instrument);
+        println!(
+            "{} backend: frame {wall:.1} ms wall, including device and pipeline creation; {}",
+            backend.name(),
+            session.device()
+        );
+        for note in session.notes() {
+            println!("  {note}");
+        }
+        write_outputs(&p, &tagged(&main, tag), &Extras::of(&args, tag), |name| {
+            Ok(session.read(name)?)
+        })?;
+        all.push((backend, times));
+    }
+    if all.len() > 1 {
+        print_side_by_side(&p.plan, &all);
     }
     Ok(())
 }
@@ -142,156 +149,6 @@ fn tagged(path: &Path, tag: Option<&str>) -> PathBuf {
         (Some(tag), None) => path.with_extension(tag),
         (None, _) => path.to_path_buf(),
     }
-}
-
-fn run_cpu(args: &Args, p: &Prepared, main: &Path) -> Result<Vec<PassTiming>> {
-    let backend = CpuBackend {
-        subgroup_width: args.subgroup.clamp(1, 64),
-        instrument: args.instrument,
-        alias: !args.no_alias,
-        ..CpuBackend::default()
-    };
-    let t1 = Instant::now();
-    let frame = backend
-        .execute(&p.plan, &p.instance, &p.upload)
-        .into_diagnostic()?;
-    let wall = t1.elapsed().as_secs_f64() * 1e3;
-    print_timings(&p.plan, &frame.timings, args.instrument);
-    println!(
-        "cpu backend: frame {wall:.1} ms wall ({} queues on threads, subgroup width {}), transient arena {:.1} MiB ({})",
-        p.plan.lanes.len(),
-        backend.subgroup_width,
-        frame.memory.arena_bytes as f64 / (1 << 20) as f64,
-        if backend.alias {
-            "aliased"
-        } else {
-            "not aliased"
-        }
-    );
-    let oob = frame
-        .memory
-        .out_of_bounds
-        .load(std::sync::atomic::Ordering::Relaxed);
-    if oob > 0 {
-        tracing::warn!(oob, "kernels accessed memory out of range");
-    }
-    write_outputs(p, main, &Extras::of(args, None), |name| {
-        Ok(frame.read(&p.plan, name))
-    })?;
-    Ok(frame.timings)
-}
-
-fn run_wgpu(
-    p: &Prepared,
-    main: &Path,
-    extras: &Extras,
-) -> Result<Vec<strandgraph_wgpu::PassTiming>> {
-    let t1 = Instant::now();
-    let frame = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .into_diagnostic()?;
-    let wall = t1.elapsed().as_secs_f64() * 1e3;
-    print!(
-        "\n  {:<14} {:<16} {:<24} {:>9} {:>10}\n",
-        "queue", "pass", "kind", "groups", "GPU ms"
-    );
-    for t in &frame.timings {
-        println!(
-            "  {:<14} {:<16} {:<24} {:>9} {:>10.3}",
-            t.queue.to_string(),
-            t.name,
-            p.plan.graph.passes[t.pass].kind,
-            t.workgroups,
-            t.millis
-        );
-    }
-    let total: f64 = frame.timings.iter().map(|t| t.millis).sum();
-    println!("  one queue      total {total:.3} ms (per-pass GPU timestamps)");
-    println!("wgpu backend: frame {wall:.1} ms wall, including device and pipeline creation");
-    for note in &frame.notes {
-        println!("  {note}");
-    }
-    write_outputs(p, main, extras, |name| {
-        frame.read(&p.plan, name).into_diagnostic()
-    })?;
-    Ok(frame.timings)
-}
-
-/// The ash backend: one frame on raw Vulkan (`STRANDGRAPH_VK_VALIDATION=1`
-/// runs it under the Khronos validation layer, `STRANDGRAPH_VK_DEVICE`
-/// picks a device by name).
-fn run_ash(
-    args: &Args,
-    p: &Prepared,
-    main: &Path,
-    extras: &Extras,
-) -> Result<Vec<strandgraph_ash::PassTiming>> {
-    let backend = strandgraph_ash::AshBackend {
-        alias: !args.no_alias,
-        ..strandgraph_ash::AshBackend::default()
-    };
-    let t1 = Instant::now();
-    let (session, frame) = backend
-        .execute(&p.plan, &p.instance, &p.upload)
-        .into_diagnostic()?;
-    let wall = t1.elapsed().as_secs_f64() * 1e3;
-    print!(
-        "\n  {:<14} {:<16} {:<24} {:>6} {:>9} {:>10} {:>19}\n",
-        "queue", "pass", "kind", "family", "groups", "GPU ms", "span ms"
-    );
-    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-    for t in &frame.timings {
-        println!(
-            "  {:<14} {:<16} {:<24} {:>6} {:>9} {:>10} {:>19}",
-            t.queue.to_string(),
-            t.name,
-            p.plan.graph.passes[t.pass].kind,
-            t.family,
-            t.workgroups.map_or("-".to_string(), |n| n.to_string()),
-            show(t.millis),
-            t.span
-                .map_or("-".to_string(), |(a, b)| format!("{a:.3}..{b:.3}"))
-        );
-    }
-    let total: f64 = frame.timings.iter().filter_map(|t| t.millis).sum();
-    println!("  sum of passes {total:.3} ms (per-pass timestamps per queue)");
-    println!("ash backend: frame {wall:.1} ms wall, including device and pipeline creation");
-    for note in &session.notes {
-        println!("  {note}");
-    }
-    write_outputs(p, main, extras, |name| session.read(name).into_diagnostic())?;
-    Ok(frame.timings)
-}
-
-fn print_three_way(
-    plan: &Plan,
-    cpu: &[PassTiming],
-    gpu: &[strandgraph_wgpu::PassTiming],
-    ash: &[strandgraph_ash::PassTiming],
-) {
-    println!(
-        "\n  {:<16} {:<24} {:>14} {:>14} {:>14}",
-        "pass", "kind", "cpu wall ms", "wgpu GPU ms", "ash GPU ms"
-    );
-    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-    for &pass in &plan.order {
-        println!(
-            "  {:<16} {:<24} {:>14} {:>14} {:>14}",
-            plan.pass_name(pass),
-            plan.graph.passes[pass].kind,
-            show(cpu.iter().find(|t| t.pass == pass).map(|t| t.millis)),
-            show(gpu.iter().find(|t| t.pass == pass).map(|t| t.millis)),
-            show(ash.iter().find(|t| t.pass == pass).and_then(|t| t.millis)),
-        );
-    }
-    println!(
-        "  {:<16} {:<24} {:>14.3} {:>14.3} {:>14.3}",
-        "total",
-        "",
-        cpu.iter().map(|t| t.millis).sum::<f64>(),
-        gpu.iter().map(|t| t.millis).sum::<f64>(),
-        ash.iter().filter_map(|t| t.millis).sum::<f64>()
-    );
 }
 
 /// Writes every image output: the first to `main`, the others beside it;
@@ -383,55 +240,56 @@ fn write_outputs(
     Ok(())
 }
 
-/// `--backend all`: per-pass times of both backends, in plan order.
-fn print_side_by_side(plan: &Plan, cpu: &[PassTiming], gpu: &[strandgraph_wgpu::PassTiming]) {
-    println!(
-        "\n  {:<16} {:<24} {:>14} {:>14}",
-        "pass", "kind", "cpu wall ms", "wgpu GPU ms"
-    );
-    for &pass in &plan.order {
-        let c = cpu.iter().find(|t| t.pass == pass).map(|t| t.millis);
-        let g = gpu.iter().find(|t| t.pass == pass).map(|t| t.millis);
-        let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
-        println!(
-            "  {:<16} {:<24} {:>14} {:>14}",
-            plan.pass_name(pass),
-            plan.graph.passes[pass].kind,
-            show(c),
-            show(g)
-        );
+/// `--backend all`: per-pass times of every backend, in plan order.
+fn print_side_by_side(plan: &Plan, all: &[(runner::Backend, Vec<PassTime>)]) {
+    print!("\n  {:<16} {:<24}", "pass", "kind");
+    for (b, _) in all {
+        print!(" {:>14}", format!("{} ms", b.name()));
     }
-    let sum = |v: &mut dyn Iterator<Item = f64>| v.sum::<f64>();
-    println!(
-        "  {:<16} {:<24} {:>14.3} {:>14.3}",
-        "total",
-        "",
-        sum(&mut cpu.iter().map(|t| t.millis)),
-        sum(&mut gpu.iter().map(|t| t.millis))
-    );
+    println!();
+    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for &pass in &plan.order {
+        print!(
+            "  {:<16} {:<24}",
+            plan.pass_name(pass),
+            plan.graph.passes[pass].kind
+        );
+        for (_, times) in all {
+            let t = times.iter().find(|t| t.pass == pass).and_then(|t| t.millis);
+            print!(" {:>14}", show(t));
+        }
+        println!();
+    }
+    print!("  {:<16} {:<24}", "frame", "");
+    for (_, times) in all {
+        print!(" {:>14.3}", frame_millis(times));
+    }
+    println!();
 }
 
-fn print_timings(plan: &Plan, timings: &[PassTiming], instrument: bool) {
+/// One backend's per-pass times, with the counters of an instrumented CPU run.
+fn print_timings(plan: &Plan, times: &[PassTime], instrument: bool) {
     print!(
-        "\n  {:<14} {:<16} {:<24} {:>9} {:>10}",
-        "queue", "pass", "kind", "groups", "ms"
+        "\n  {:<14} {:<16} {:<24} {:>9} {:>10} {:>17}",
+        "queue", "pass", "kind", "groups", "ms", "span ms"
     );
     if instrument {
         print!(" {:>8} {:>12} {:>12}", "lanes", "atomics", "pixels");
     }
     println!();
-    for t in timings {
-        let kind = &plan.graph.passes[t.pass].kind;
+    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
+    for t in times {
         print!(
-            "  {:<14} {:<16} {:<24} {:>9} {:>10.2}",
+            "  {:<14} {:<16} {:<24} {:>9} {:>10} {:>17}",
             t.queue.to_string(),
             t.name,
-            kind,
-            t.workgroups,
-            t.millis
+            plan.graph.passes[t.pass].kind,
+            t.workgroups.map_or("-".to_string(), |n| n.to_string()),
+            show(t.millis),
+            t.span
+                .map_or("-".to_string(), |(a, b)| format!("{a:.3}..{b:.3}"))
         );
-        if instrument {
-            let c = &t.counters;
+        if let (true, Some(c)) = (instrument, &t.counters) {
             let lanes = c
                 .lane_utilisation()
                 .map_or("-".to_string(), |u| format!("{:.1}%", 100.0 * u));
@@ -440,11 +298,12 @@ fn print_timings(plan: &Plan, timings: &[PassTiming], instrument: bool) {
         println!();
     }
     for lane in &plan.lanes {
-        let sum: f64 = timings
+        let sum: f64 = times
             .iter()
             .filter(|t| t.queue == lane.queue)
-            .map(|t| t.millis)
+            .filter_map(|t| t.millis)
             .sum();
-        println!("  {:<14} total {sum:.2} ms", lane.queue.to_string());
+        println!("  {:<14} sum {sum:.3} ms", lane.queue.to_string());
     }
+    println!("  frame {:.3} ms", frame_millis(times));
 }

@@ -11,6 +11,7 @@
 // failing case, as their WGSL ports do.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod backend;
 pub mod bench;
 pub mod bind;
 mod catalogue;

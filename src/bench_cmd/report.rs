@@ -68,7 +68,7 @@ impl Stats {
             .map(|(i, t)| {
                 let v: Vec<f64> = frames
                     .iter()
-                    .filter_map(|f| f.get(i).map(|t| t.millis))
+                    .filter_map(|f| f.get(i).and_then(|t| t.millis))
                     .collect();
                 (t.name.clone(), t.kind.clone(), Spread::of(&v))
             })
@@ -78,7 +78,7 @@ impl Stats {
             .map(|f| {
                 f.iter()
                     .filter(|t| raster.contains(&strandgraph_graph::base_name(&t.name)))
-                    .map(|t| t.millis)
+                    .filter_map(|t| t.millis)
                     .sum()
             })
             .collect();
@@ -90,7 +90,7 @@ impl Stats {
             raster_atomics: atomics,
             per_frame: frames
                 .iter()
-                .map(|f| f.iter().map(|t| t.millis).collect())
+                .map(|f| f.iter().map(|t| t.millis.unwrap_or(f64::NAN)).collect())
                 .collect(),
         }
     }
@@ -225,7 +225,7 @@ impl Report {
             self.warmup
         );
         for (b, d, _) in &self.devices {
-            let _ = writeln!(o, "  {:<5} {d}  [{}]", b.name(), b.clock());
+            let _ = writeln!(o, "  {:<5} {d}  [{}]", b.name(), b.clock().describe());
         }
         let _ = writeln!(
             o,
@@ -408,7 +408,7 @@ impl Report {
             "warmup": self.warmup,
             "cpu_subgroup_width": self.subgroup,
             "devices": self.devices.iter().map(|(b, d, notes)| json!({
-                "backend": b.name(), "device": d, "clock": b.clock(), "notes": notes,
+                "backend": b.name(), "device": d, "clock": b.clock().describe(), "notes": notes,
             })).collect::<Vec<_>>(),
             "roofline": self.ceilings.iter().map(|(b, c)| json!({
                 "backend": b.name(),

@@ -48,6 +48,7 @@
 mod barriers;
 mod device;
 mod error;
+mod interface;
 mod loader;
 mod memory;
 mod pipelines;

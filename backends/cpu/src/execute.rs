@@ -44,6 +44,10 @@ pub struct CpuBackend {
     pub alias: bool,
     /// How long a queue may wait at a sync point before the frame fails.
     pub sync_timeout: Duration,
+    /// Keep a copy of every pass's bindings as they are just before it runs
+    /// ([`Session::captured`]): the inputs the per-pass agreement harness
+    /// replays on the GPU backends.
+    pub capture: bool,
 }
 
 impl Default for CpuBackend {
@@ -53,6 +57,7 @@ impl Default for CpuBackend {
             instrument: false,
             alias: true,
             sync_timeout: Duration::from_secs(120),
+            capture: false,
         }
     }
 }
@@ -68,6 +73,14 @@ pub struct PassTiming {
     pub counters: CounterValues,
 }
 
+/// A pass's bindings just before it ran ([`CpuBackend::capture`]).
+#[derive(Debug, Clone)]
+pub struct Captured {
+    pub pass: PassId,
+    /// Binding name (as the kernel sees it) and the resource's words.
+    pub bindings: Vec<(String, Vec<u32>)>,
+}
+
 /// A plan opened on the simulator: memory laid out and kernels built once;
 /// each [`Session::run`] uploads a frame's inputs and runs every pass.
 /// History resources keep their contents between runs.
@@ -79,12 +92,24 @@ pub struct Session<'d> {
     pub memory: Memory,
     /// The last frame's per-pass timings, in plan order.
     pub timings: Vec<PassTiming>,
+    /// With [`CpuBackend::capture`]: every pass's bindings before it ran, in
+    /// plan order.
+    pub captured: Vec<Captured>,
 }
 
 /// A session after one frame ([`CpuBackend::execute`]).
 pub type Frame<'d> = Session<'d>;
 
 impl Session<'_> {
+    /// The options it was opened with.
+    pub fn options(&self) -> &CpuBackend {
+        &self.backend
+    }
+
+    pub fn plan(&self) -> &Plan {
+        &self.plan
+    }
+
     pub fn read(&self, plan: &Plan, resource: &str) -> Option<Vec<u32>> {
         self.memory.read(plan, resource)
     }
@@ -92,9 +117,11 @@ impl Session<'_> {
     /// Uploads `inputs` and runs one frame; returns its per-pass timings.
     pub fn run(&mut self, inputs: &Inputs) -> Result<&[PassTiming], CpuError> {
         self.memory.upload(&self.plan, inputs)?;
-        self.timings =
+        let (timings, captured) =
             self.backend
                 .run_frame(&self.plan, &self.instance, &self.prepared, &self.memory)?;
+        self.timings = timings;
+        self.captured = captured;
         Ok(&self.timings)
     }
 }
@@ -144,6 +171,7 @@ impl CpuBackend {
             plan: plan.clone(),
             instance: instance.clone(),
             timings: Vec::new(),
+            captured: Vec::new(),
         })
     }
 
@@ -154,7 +182,7 @@ impl CpuBackend {
         instance: &Instance,
         prepared: &HashMap<PassId, Prepared<'_>>,
         memory: &Memory,
-    ) -> Result<Vec<PassTiming>, CpuError> {
+    ) -> Result<(Vec<PassTiming>, Vec<Captured>), CpuError> {
         let timelines: HashMap<Queue, Timeline> = plan
             .lanes
             .iter()
@@ -163,18 +191,24 @@ impl CpuBackend {
         let abort = AtomicBool::new(false);
         let failure: Mutex<Option<CpuError>> = Mutex::new(None);
         let timings: Mutex<Vec<PassTiming>> = Mutex::new(Vec::new());
+        let captured: Mutex<Vec<Captured>> = Mutex::new(Vec::new());
 
         std::thread::scope(|scope| {
             for lane in &plan.lanes {
-                let (timelines, abort, failure, timings) = (&timelines, &abort, &failure, &timings);
+                let (timelines, abort, failure, timings, captured) =
+                    (&timelines, &abort, &failure, &timings, &captured);
                 scope.spawn(move || {
                     for (i, &p) in lane.passes.iter().enumerate() {
                         if abort.load(Ordering::Relaxed) {
                             return;
                         }
-                        let result = self
-                            .wait_for(plan, p, timelines, abort)
-                            .and_then(|()| self.run_pass(plan, instance, p, &prepared[&p], memory));
+                        let result = self.wait_for(plan, p, timelines, abort).and_then(|()| {
+                            if self.capture {
+                                let c = capture(plan, p, &prepared[&p], memory);
+                                captured.lock().unwrap_or_else(|e| e.into_inner()).push(c);
+                            }
+                            self.run_pass(plan, instance, p, &prepared[&p], memory)
+                        });
                         match result {
                             Ok(t) => timings.lock().unwrap_or_else(|e| e.into_inner()).push(t),
                             Err(e) => {
@@ -197,7 +231,9 @@ impl CpuBackend {
         }
         let mut timings = timings.into_inner().unwrap_or_else(|e| e.into_inner());
         timings.sort_by_key(|t| plan.position(t.pass));
-        Ok(timings)
+        let mut captured = captured.into_inner().unwrap_or_else(|e| e.into_inner());
+        captured.sort_by_key(|c| plan.position(c.pass));
+        Ok((timings, captured))
     }
 
     /// Looks up every live pass's definition, binds it and builds its kernel.
@@ -328,4 +364,22 @@ impl CpuBackend {
             counters: counters.snapshot(),
         })
     }
+}
+
+/// A copy of pass `p`'s bindings. Safe to take while another queue runs:
+/// the plan orders every pass that touches these resources against `p`,
+/// and aliased memory is never shared with a resource live at the same time.
+fn capture(plan: &Plan, p: PassId, prep: &Prepared<'_>, memory: &Memory) -> Captured {
+    let bindings = prep
+        .bindings
+        .iter()
+        .map(|(name, r)| {
+            let words = memory.words(plan, *r);
+            (
+                name.clone(),
+                words.iter().map(|w| w.load(Ordering::Relaxed)).collect(),
+            )
+        })
+        .collect();
+    Captured { pass: p, bindings }
 }

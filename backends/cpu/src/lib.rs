@@ -11,8 +11,9 @@
 //!   atomics and pixels written.
 
 pub mod execute;
+mod interface;
 pub mod memory;
 pub mod timeline;
 
-pub use execute::{CpuBackend, CpuError, Frame, PassTiming, Session};
+pub use execute::{Captured, CpuBackend, CpuError, Frame, PassTiming, Session};
 pub use memory::Inputs;
