@@ -2,6 +2,7 @@
 //! benches share — preparing a scene's frame for a graph, and turning
 //! rendered images into pictures.
 
+pub mod agree;
 pub mod compare;
 pub mod frame;
 pub mod images;

@@ -3,6 +3,7 @@
 //! Each subcommand lives in its own module; `main` only parses arguments,
 //! sets up logging and turns errors into diagnostics with exit code 2.
 
+mod agree_cmd;
 mod bench_cmd;
 mod graph_cmd;
 mod info;
@@ -28,6 +29,8 @@ enum Command {
     Render(render_cmd::Args),
     /// Time pipeline variants at close/mid/far views on backends, with a roofline (Lipp's Table 1).
     Bench(bench_cmd::Args),
+    /// Run every pass of a scene's graph alone on the CPU simulator and the GPU backends, and compare every output.
+    Agree(agree_cmd::Args),
 }
 
 fn main() -> ExitCode {
@@ -44,6 +47,7 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::Render(args) => render_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
+        Command::Agree(args) => agree_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

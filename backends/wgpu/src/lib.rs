@@ -15,6 +15,7 @@
 //! colour and depth attachments are not bound. Each pass is one compute or
 //! render pass with begin/end `TIMESTAMP_QUERY` writes.
 
+mod depth_upload;
 mod interface;
 mod memory;
 mod pipelines;

@@ -52,7 +52,9 @@ pub(crate) fn create_memory(
                 let wformat = texture_format(*format);
                 let mut usage = usages[r];
                 if format.is_depth() {
+                    // Uploads draw into depth images (crate::depth_upload).
                     usage -= wgpu::TextureUsages::STORAGE_BINDING;
+                    usage |= wgpu::TextureUsages::RENDER_ATTACHMENT;
                 }
                 let texture = device.create_texture(&wgpu::TextureDescriptor {
                     label: Some(&res.name),
@@ -86,6 +88,7 @@ pub(crate) fn create_memory(
 /// transients are ignored, as on the CPU backend; history resources named by
 /// no input keep what the previous frame wrote.
 pub(crate) fn upload(
+    device: &wgpu::Device,
     queue: &wgpu::Queue,
     plan: &Plan,
     instance: &Instance,
@@ -115,6 +118,21 @@ pub(crate) fn upload(
             None => {}
             Some(Memory::Buffer(buffer, _)) => {
                 queue.write_buffer(buffer, 0, bytemuck::cast_slice(words));
+            }
+            Some(Memory::Texture {
+                texture,
+                format: wgpu::TextureFormat::Depth32Float,
+                extent,
+                ..
+            }) => {
+                if extent[2] > 1 {
+                    return Err(input_error(
+                        "depth images with more than one layer cannot be uploaded".into(),
+                    ));
+                }
+                let mut texels = words.clone();
+                texels.resize((extent[0] * extent[1]) as usize, 0);
+                crate::depth_upload::upload_depth(device, queue, texture, extent[0], &texels);
             }
             Some(Memory::Texture {
                 texture,

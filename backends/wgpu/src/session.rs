@@ -120,6 +120,7 @@ impl Session {
     /// Uploads `inputs` and runs one frame; returns its per-pass GPU times.
     pub fn run(&mut self, inputs: &Upload) -> Result<&[PassTiming], WgpuError> {
         upload(
+            &self.device,
             &self.queue,
             &self.plan,
             &self.instance,

@@ -1,0 +1,178 @@
+//! Per-pass agreement: every pass of a graph run alone on the CPU simulator
+//! and on the GPU backends with the same inputs, every output compared.
+//!
+//! Whole-frame image diffs say *that* backends disagree, not *where*. Here
+//! the CPU simulator runs the frame once and keeps every pass's bindings as
+//! they were just before it ran ([`strandgraph_cpu::CpuBackend::capture`]);
+//! then each pass is [isolated](isolate) into a one-pass plan, given those
+//! words on every backend, and its outputs are compared under a [`Rule`]:
+//! integers bit-exact, floats within a stated ULP bound, and the few
+//! exceptions listed in [`rules`] with the reason the CPU and GPU must differ.
+
+pub mod compare;
+pub mod isolate;
+pub mod rules;
+
+use crate::frame::Prepared;
+use crate::runner::{self, Backend, CpuOptions};
+use compare::{Outcome, Rule, compare};
+use miette::{IntoDiagnostic, Result};
+use serde::Serialize;
+use strandgraph_cpu::{Captured, CpuBackend};
+use strandgraph_graph::Plan;
+use strandgraph_passes::Registry;
+use strandgraph_passes::upload::Upload;
+
+/// One output of one pass on one GPU backend, against the CPU.
+#[derive(Debug, Clone, Serialize)]
+pub struct OutputCheck {
+    pub binding: String,
+    pub rule: Rule,
+    /// Why the rule is looser than the resource's default, if it is.
+    pub why: Option<&'static str>,
+    pub outcome: Outcome,
+}
+
+/// One pass on one GPU backend.
+#[derive(Debug, Clone, Serialize)]
+pub struct PassCheck {
+    pub pass: String,
+    pub kind: String,
+    pub backend: &'static str,
+    pub outputs: Vec<OutputCheck>,
+}
+
+impl PassCheck {
+    pub fn passed(&self) -> bool {
+        self.outputs.iter().all(|o| o.outcome.passed())
+    }
+}
+
+/// Runs `p`'s frame on the CPU simulator, keeping every pass's inputs.
+pub fn capture(p: &Prepared) -> Result<Vec<Captured>> {
+    let backend = CpuBackend {
+        capture: true,
+        ..CpuBackend::default()
+    };
+    let mut session = backend
+        .open(&Registry, &p.plan, &p.instance)
+        .into_diagnostic()?;
+    session.run(&p.upload).into_diagnostic()?;
+    Ok(std::mem::take(&mut session.captured))
+}
+
+/// Checks every captured pass of `plan` on each of `gpus` (passes whose name
+/// contains `only`, when given).
+pub fn check_all(
+    plan: &Plan,
+    upload: &Upload,
+    captured: &[Captured],
+    gpus: &[Backend],
+    only: Option<&str>,
+) -> Result<Vec<PassCheck>> {
+    let mut checks = Vec::new();
+    for c in captured {
+        let name = plan.pass_name(c.pass);
+        if only.is_some_and(|o| !name.contains(o)) {
+            continue;
+        }
+        checks.extend(check_pass(plan, upload, c, gpus)?);
+    }
+    Ok(checks)
+}
+
+/// Runs one captured pass alone on the CPU and on each of `gpus`, and
+/// compares every output.
+pub fn check_pass(
+    plan: &Plan,
+    upload: &Upload,
+    captured: &Captured,
+    gpus: &[Backend],
+) -> Result<Vec<PassCheck>> {
+    let pass = &plan.graph.passes[captured.pass];
+    let alone = isolate::isolate(plan, captured.pass)?;
+    let instance = alone.plan.instantiate(&upload.quantities)?;
+    let inputs = Upload {
+        resources: captured.bindings.iter().cloned().collect(),
+        quantities: upload.quantities,
+        ..Upload::default()
+    };
+    let outputs: Vec<&isolate::Port> = alone.ports.iter().filter(|p| p.mode.writes()).collect();
+    let run = |backend: Backend| -> Result<Vec<Vec<u32>>> {
+        let mut session = runner::open(backend, &alone.plan, &instance, CpuOptions::default())?;
+        session.run(&inputs)?;
+        outputs
+            .iter()
+            .map(|port| {
+                session.read(&port.name)?.ok_or_else(|| {
+                    miette::miette!("{}: output `{}` has no memory", backend.name(), port.name)
+                })
+            })
+            .collect()
+    };
+    let cpu = run(Backend::Cpu)?;
+    let mut checks = Vec::new();
+    for &backend in gpus {
+        let gpu = run(backend).map_err(|e| {
+            e.wrap_err(format!(
+                "pass `{}` alone on {}; its graph:\n{}",
+                pass.name,
+                backend.name(),
+                alone.text
+            ))
+        })?;
+        let outputs = outputs
+            .iter()
+            .zip(cpu.iter().zip(&gpu))
+            .map(|(port, (c, g))| {
+                let (rule, why) = rules::rule(&pass.kind, &port.name, &port.decl);
+                OutputCheck {
+                    binding: port.name.clone(),
+                    rule,
+                    why,
+                    outcome: compare(c, g, rule),
+                }
+            })
+            .collect();
+        checks.push(PassCheck {
+            pass: pass.name.clone(),
+            kind: pass.kind.clone(),
+            backend: backend.name(),
+            outputs,
+        });
+    }
+    Ok(checks)
+}
+
+/// A table for people: one line per pass, backend and output.
+pub fn table(checks: &[PassCheck]) -> String {
+    use std::fmt::Write;
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9} {:>9} {:>8}  rule",
+        "pass", "kind", "on", "output", "words", "equal %", "failing", "worst"
+    );
+    for c in checks {
+        for out in &c.outputs {
+            let r = &out.outcome;
+            let equal = 100.0 * (r.words - r.differing) as f64 / r.words.max(1) as f64;
+            let _ = writeln!(
+                o,
+                "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9.4} {:>9} {:>8} {} {:?}{}",
+                c.pass,
+                c.kind,
+                c.backend,
+                out.binding,
+                r.words,
+                equal,
+                r.failing,
+                r.worst,
+                if r.passed() { "ok  " } else { "FAIL" },
+                out.rule,
+                out.why.map_or(String::new(), |w| format!(" ({w})")),
+            );
+        }
+    }
+    o
+}
