@@ -26,6 +26,9 @@ pub struct Args {
     /// Override a pass parameter, as PASS.PARAM=VALUE (repeatable).
     #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
     pub params: Vec<String>,
+    /// Write the CPU's and the GPU's words of every failing output here.
+    #[arg(long, value_name = "DIR")]
+    pub dump: Option<PathBuf>,
     /// Also write every check as JSON here.
     #[arg(long, value_name = "FILE.json")]
     pub json: Option<PathBuf>,
@@ -44,7 +47,17 @@ pub fn run(args: Args) -> Result<()> {
         .filter(|b| b.is_gpu())
         .collect();
     let captured = agree::capture(&p)?;
-    let checks = agree::check_all(&p.plan, &p.upload, &captured, &gpus, args.pass.as_deref())?;
+    if let Some(dir) = &args.dump {
+        std::fs::create_dir_all(dir).into_diagnostic()?;
+    }
+    let checks = agree::check_all(
+        &p.plan,
+        &p.upload,
+        &captured,
+        &gpus,
+        args.pass.as_deref(),
+        args.dump.as_deref(),
+    )?;
     print!("{}", agree::table(&checks));
     if let Some(path) = &args.json {
         let json = serde_json::to_string_pretty(&checks).into_diagnostic()?;

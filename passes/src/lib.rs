@@ -23,6 +23,7 @@ pub mod layout;
 pub mod lipp;
 pub mod scene;
 pub mod sim;
+pub mod spirv;
 pub mod upload;
 pub mod wgsl;
 

@@ -19,6 +19,8 @@ pub enum Rule {
     /// The same words in any order: the order is set by which GPU thread
     /// wins an atomic slot, and every consumer is order-independent.
     Multiset,
+    /// Unsigned counts (fixed-point sums) within `max` of each other.
+    Near { max: u32 },
 }
 
 /// The rule for an image format: exact unless it stores floats or UNORMs.
@@ -53,11 +55,18 @@ pub struct Outcome {
     pub worst: f64,
     /// The first failing word, for the report.
     pub first_failure: Option<usize>,
+    /// Whatever the rule: the largest difference of differing words read
+    /// as unsigned integers, and read as f32 in ULPs (what a rule would
+    /// have to allow).
+    pub max_int: u64,
+    pub max_f32_ulps: u64,
+    /// Failing elements the output's judgement allows (its outliers).
+    pub allowed: usize,
 }
 
 impl Outcome {
     pub fn passed(&self) -> bool {
-        self.failing == 0
+        self.failing <= self.allowed
     }
 }
 
@@ -73,7 +82,17 @@ pub fn compare(cpu: &[u32], gpu: &[u32], rule: Rule) -> Outcome {
         failing: 0,
         worst: 0.0,
         first_failure: None,
+        max_int: 0,
+        max_f32_ulps: 0,
+        allowed: 0,
     };
+    for i in 0..n {
+        let (c, g) = (at(cpu, i), at(gpu, i));
+        if c != g {
+            out.max_int = out.max_int.max(u64::from(c.abs_diff(g)));
+            out.max_f32_ulps = out.max_f32_ulps.max(ulp_distance(c, g));
+        }
+    }
     if rule == Rule::Multiset {
         let (mut a, mut b) = (cpu.to_vec(), gpu.to_vec());
         a.resize(n, 0);
@@ -119,6 +138,10 @@ fn word_error(c: u32, g: u32, rule: Rule) -> (f64, bool) {
                 .max()
                 .unwrap_or(0);
             (d as f64, d <= u64::from(ulps))
+        }
+        Rule::Near { max } => {
+            let d = c.abs_diff(g);
+            (f64::from(d), d <= max)
         }
         Rule::Unorm8 { steps } => {
             let d = (0..4)

@@ -15,7 +15,8 @@ pub mod rules;
 
 use crate::frame::Prepared;
 use crate::runner::{self, Backend, CpuOptions};
-use compare::{Outcome, Rule, compare};
+use compare::{Outcome, compare};
+use std::collections::HashMap;
 use miette::{IntoDiagnostic, Result};
 use serde::Serialize;
 use strandgraph_cpu::{Captured, CpuBackend};
@@ -27,9 +28,7 @@ use strandgraph_passes::upload::Upload;
 #[derive(Debug, Clone, Serialize)]
 pub struct OutputCheck {
     pub binding: String,
-    pub rule: Rule,
-    /// Why the rule is looser than the resource's default, if it is.
-    pub why: Option<&'static str>,
+    pub judgement: rules::Judgement,
     pub outcome: Outcome,
 }
 
@@ -69,38 +68,53 @@ pub fn check_all(
     captured: &[Captured],
     gpus: &[Backend],
     only: Option<&str>,
+    dump: Option<&std::path::Path>,
 ) -> Result<Vec<PassCheck>> {
     let mut checks = Vec::new();
+    let mut own = Own::default();
     for c in captured {
         let name = plan.pass_name(c.pass);
         if only.is_some_and(|o| !name.contains(o)) {
             continue;
         }
-        checks.extend(check_pass(plan, upload, c, gpus)?);
+        checks.extend(check_pass(plan, upload, c, gpus, dump, &mut own)?);
     }
     Ok(checks)
 }
 
 /// Runs one captured pass alone on the CPU and on each of `gpus`, and
-/// compares every output.
+/// compares every output. With `dump`, the words of every output that
+/// fails are written there as `PASS.OUTPUT.BACKEND.u32` (little endian).
+/// `own` holds each backend's outputs of earlier passes, for the inputs
+/// [`rules::own_input`] lists, and receives this pass's.
 pub fn check_pass(
     plan: &Plan,
     upload: &Upload,
     captured: &Captured,
     gpus: &[Backend],
+    dump: Option<&std::path::Path>,
+    own: &mut Own,
 ) -> Result<Vec<PassCheck>> {
     let pass = &plan.graph.passes[captured.pass];
     let alone = isolate::isolate(plan, captured.pass)?;
     let instance = alone.plan.instantiate(&upload.quantities)?;
-    let inputs = Upload {
-        resources: captured.bindings.iter().cloned().collect(),
+    let inputs_on = |backend: Backend| Upload {
+        resources: captured
+            .bindings
+            .iter()
+            .map(|(name, words)| {
+                let mine = rules::own_input(&pass.kind, name)
+                    .and_then(|(from, _)| own.get(&(backend, from.to_string(), name.clone())));
+                (name.clone(), mine.unwrap_or(words).clone())
+            })
+            .collect(),
         quantities: upload.quantities,
         ..Upload::default()
     };
     let outputs: Vec<&isolate::Port> = alone.ports.iter().filter(|p| p.mode.writes()).collect();
     let run = |backend: Backend| -> Result<Vec<Vec<u32>>> {
         let mut session = runner::open(backend, &alone.plan, &instance, CpuOptions::default())?;
-        session.run(&inputs)?;
+        session.run(&inputs_on(backend))?;
         outputs
             .iter()
             .map(|port| {
@@ -112,6 +126,7 @@ pub fn check_pass(
     };
     let cpu = run(Backend::Cpu)?;
     let mut checks = Vec::new();
+    let mut produced = vec![(Backend::Cpu, cpu.clone())];
     for &backend in gpus {
         let gpu = run(backend).map_err(|e| {
             e.wrap_err(format!(
@@ -121,27 +136,45 @@ pub fn check_pass(
                 alone.text
             ))
         })?;
-        let outputs = outputs
-            .iter()
-            .zip(cpu.iter().zip(&gpu))
-            .map(|(port, (c, g))| {
-                let (rule, why) = rules::rule(&pass.kind, &port.name, &port.decl);
-                OutputCheck {
-                    binding: port.name.clone(),
-                    rule,
-                    why,
-                    outcome: compare(c, g, rule),
+        let mut checks_here = Vec::new();
+        for (port, (c, g)) in outputs.iter().zip(cpu.iter().zip(&gpu)) {
+            let judgement = rules::rule(&pass.kind, &port.name, &port.decl);
+            let mut outcome = compare(c, g, judgement.rule);
+            outcome.allowed = (judgement.outliers * outcome.words as f64) as usize;
+            if let (Some(dir), false) = (dump, outcome.passed()) {
+                for (who, words) in [("cpu", c), (backend.name(), g)] {
+                    let file = dir.join(format!("{}.{}.{who}.u32", pass.name, port.name));
+                    std::fs::write(&file, bytemuck_words(words)).into_diagnostic()?;
                 }
-            })
-            .collect();
+            }
+            checks_here.push(OutputCheck {
+                binding: port.name.clone(),
+                judgement,
+                outcome,
+            });
+        }
         checks.push(PassCheck {
             pass: pass.name.clone(),
             kind: pass.kind.clone(),
             backend: backend.name(),
-            outputs,
+            outputs: checks_here,
         });
+        produced.push((backend, gpu));
+    }
+    for (backend, words) in produced {
+        for (port, w) in outputs.iter().zip(words) {
+            own.insert((backend, pass.kind.clone(), port.name.clone()), w);
+        }
     }
     Ok(checks)
+}
+
+/// Each backend's outputs of the passes checked so far, by (backend, pass
+/// kind, binding).
+pub type Own = HashMap<(Backend, String, String), Vec<u32>>;
+
+fn bytemuck_words(words: &[u32]) -> Vec<u8> {
+    words.iter().flat_map(|w| w.to_le_bytes()).collect()
 }
 
 /// A table for people: one line per pass, backend and output.
@@ -150,8 +183,8 @@ pub fn table(checks: &[PassCheck]) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9} {:>9} {:>8}  rule",
-        "pass", "kind", "on", "output", "words", "equal %", "failing", "worst"
+        "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9} {:>9} {:>8} {:>10} {:>10}  rule",
+        "pass", "kind", "on", "output", "words", "equal %", "failing", "allowed", "max int", "max ulps"
     );
     for c in checks {
         for out in &c.outputs {
@@ -159,7 +192,7 @@ pub fn table(checks: &[PassCheck]) -> String {
             let equal = 100.0 * (r.words - r.differing) as f64 / r.words.max(1) as f64;
             let _ = writeln!(
                 o,
-                "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9.4} {:>9} {:>8} {} {:?}{}",
+                "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9.4} {:>9} {:>8} {:>10} {:>10} {} {:?}",
                 c.pass,
                 c.kind,
                 c.backend,
@@ -167,10 +200,11 @@ pub fn table(checks: &[PassCheck]) -> String {
                 r.words,
                 equal,
                 r.failing,
-                r.worst,
+                r.allowed,
+                r.max_int,
+                if r.max_f32_ulps == u64::MAX { "nan".to_string() } else { r.max_f32_ulps.to_string() },
                 if r.passed() { "ok  " } else { "FAIL" },
-                out.rule,
-                out.why.map_or(String::new(), |w| format!(" ({w})")),
+                out.judgement.rule,
             );
         }
     }

@@ -98,7 +98,7 @@ pub(crate) fn translate(
         },
         ..Default::default()
     };
-    let words = spv::write_vec(module, &info, &options, None).map_err(|e| match e {
+    let mut words = spv::write_vec(module, &info, &options, None).map_err(|e| match e {
         spv::Error::MissingCapabilities(what, missing) => AshError::MissingFeature {
             device: device.to_string(),
             feature: format!("SPIR-V capability {missing:?}"),
@@ -107,6 +107,12 @@ pub(crate) fn translate(
         },
         e => AshError::Shader(format!("pass `{pass}`: SPIR-V: {e}")),
     })?;
+    // Round every float operation as written, as the CPU simulator does
+    // (strandgraph_passes::spirv says why).
+    if !strandgraph_passes::spirv::contraction_allowed() {
+        strandgraph_passes::spirv::forbid_contraction(&mut words)
+            .map_err(|e| AshError::Shader(format!("pass `{pass}`: {e}")))?;
+    }
     // naga checks some capabilities against the given set and adds others
     // (Float64, Int64) unchecked: check every declared one here.
     for cap in declared_capabilities(&words) {
