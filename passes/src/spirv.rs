@@ -116,7 +116,10 @@ mod tests {
         let n = forbid_contraction(&mut words).unwrap();
         assert_eq!(n, 2);
         // The decorations sit where the type declaration was.
-        assert_eq!(&words[7..13], &[(3 << 16) | 71, 10, 42, (3 << 16) | 71, 11, 42]);
+        assert_eq!(
+            &words[7..13],
+            &[(3 << 16) | 71, 10, 42, (3 << 16) | 71, 11, 42]
+        );
         assert_eq!(words[13], (3 << 16) | 22);
         assert_eq!(words.len(), module().len() + 6);
     }

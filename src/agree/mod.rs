@@ -16,9 +16,9 @@ pub mod rules;
 use crate::frame::Prepared;
 use crate::runner::{self, Backend, CpuOptions};
 use compare::{Outcome, compare};
-use std::collections::HashMap;
 use miette::{IntoDiagnostic, Result};
 use serde::Serialize;
+use std::collections::HashMap;
 use strandgraph_cpu::{Captured, CpuBackend};
 use strandgraph_graph::Plan;
 use strandgraph_passes::Registry;
@@ -184,7 +184,16 @@ pub fn table(checks: &[PassCheck]) -> String {
     let _ = writeln!(
         o,
         "  {:<18} {:<26} {:<5} {:<18} {:>10} {:>9} {:>9} {:>8} {:>10} {:>10}  rule",
-        "pass", "kind", "on", "output", "words", "equal %", "failing", "allowed", "max int", "max ulps"
+        "pass",
+        "kind",
+        "on",
+        "output",
+        "words",
+        "equal %",
+        "failing",
+        "allowed",
+        "max int",
+        "max ulps"
     );
     for c in checks {
         for out in &c.outputs {
@@ -202,7 +211,11 @@ pub fn table(checks: &[PassCheck]) -> String {
                 r.failing,
                 r.allowed,
                 r.max_int,
-                if r.max_f32_ulps == u64::MAX { "nan".to_string() } else { r.max_f32_ulps.to_string() },
+                if r.max_f32_ulps == u64::MAX {
+                    "nan".to_string()
+                } else {
+                    r.max_f32_ulps.to_string()
+                },
                 if r.passed() { "ok  " } else { "FAIL" },
                 out.judgement.rule,
             );
