@@ -14,7 +14,7 @@
 //!   are serialised in plan order and the frame notes say so;
 //! - **per-pass timestamps per queue** ([`timing`]).
 //!
-//! Shaders are the WGSL under `shaders/`, composed by
+//! Shaders are the WGSL under `shaders/` (built into the binary), composed by
 //! [`strandgraph_passes::wgsl`] and translated by naga to SPIR-V 1.3 with the
 //! capabilities each pass needs ([`spirv`]). Binding 0 is the pass's parameter
 //! block ([`PassDef::gpu_params`]), then its `bindings()` in order.
@@ -92,8 +92,10 @@ impl Validation {
 /// How the ash backend runs.
 #[derive(Debug, Clone)]
 pub struct AshBackend {
-    /// The WGSL directory ([`strandgraph_passes::wgsl::default_dir`]).
-    pub shader_dir: PathBuf,
+    /// Read the WGSL from this directory instead of the shaders built into
+    /// the binary ([`strandgraph_passes::wgsl::EMBEDDED`]); by default
+    /// `$STRANDGRAPH_SHADERS` ([`strandgraph_passes::wgsl::override_dir`]).
+    pub shader_dir: Option<PathBuf>,
     pub validation: Validation,
     /// Place transients at the plan's aliasing offsets; `false` gives each
     /// its own memory, so every transient can be read back after a frame.
@@ -109,7 +111,7 @@ pub struct AshBackend {
 impl Default for AshBackend {
     fn default() -> Self {
         Self {
-            shader_dir: strandgraph_passes::wgsl::default_dir(),
+            shader_dir: strandgraph_passes::wgsl::override_dir(),
             validation: Validation::from_env(),
             alias: true,
             async_compute: true,

@@ -72,7 +72,7 @@ impl Session {
         plan: &Plan,
         instance: &Instance,
     ) -> Result<Session, AshError> {
-        let mut shaders = Shaders::load(&backend.shader_dir).map_err(AshError::Shader)?;
+        let mut shaders = Shaders::open(backend.shader_dir.as_deref()).map_err(AshError::Shader)?;
         let (prepared, needs) = prepare(defs, plan, instance, &mut shaders)?;
         let gpu = Gpu::new(backend, &needs)?;
         let g = &plan.graph;
