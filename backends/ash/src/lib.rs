@@ -46,12 +46,17 @@
 //!   that serves all of them (barriers.rs), not the plan's per-pass layouts.
 
 mod barriers;
+mod descriptors;
 mod device;
 mod error;
+mod host;
 mod loader;
 mod memory;
+mod owned;
 mod pipelines;
 mod prepare;
+mod prologue;
+mod raster;
 mod readback;
 mod record;
 mod session;
