@@ -511,6 +511,13 @@ impl Gpu {
         self.messages.is_some()
     }
 
+    /// The shared message list, which outlives the device (tests read what
+    /// the layer says while a session is destroyed).
+    #[cfg(test)]
+    pub fn messages(&self) -> Option<Messages> {
+        self.messages.clone()
+    }
+
     /// A memory type with `wanted` among `bits`.
     pub fn memory_type(&self, bits: u32, wanted: vk::MemoryPropertyFlags) -> Option<u32> {
         (0..self.memory_props.memory_type_count).find(|&i| {
