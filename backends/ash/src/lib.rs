@@ -19,6 +19,11 @@
 //! capabilities each pass needs ([`spirv`]). Binding 0 is the pass's parameter
 //! block ([`PassDef::gpu_params`]), then its `bindings()` in order.
 //!
+//! Every Vulkan object is owned by a value that destroys it on drop
+//! ([`owned`]): children hold the device, the device holds the instance, so
+//! an early `?` frees whatever was made and destruction order follows from
+//! ownership.
+//!
 //! A [`Session`] creates the device, pipelines, memory and command buffers
 //! once ([`AshBackend::open`]); [`Session::run`] uploads a frame's inputs and
 //! runs it; [`Session::read`] reads any resource back. Validation
@@ -49,11 +54,13 @@ mod barriers;
 mod descriptors;
 mod device;
 mod error;
+mod features;
 mod host;
 mod loader;
 mod memory;
 mod owned;
 mod pipelines;
+mod placement;
 mod prepare;
 mod prologue;
 mod raster;

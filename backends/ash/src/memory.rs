@@ -20,6 +20,7 @@
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
 use crate::owned::Owned;
+use crate::placement::{Placements, alias_requests, placements_fit, sharing_bytes};
 use ash::vk;
 use strandgraph_graph::alias::{AliasRequest, HeapKind, plan_memory};
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl, Usage};
@@ -319,50 +320,6 @@ impl Unbound {
     }
 }
 
-/// Where transients go: `(resource, heap, offset)`.
-type Placements = Vec<(usize, HeapKind, u64)>;
-
-/// Whether the plan's placements honour the real requirements: aligned, and
-/// no two resources alive at once overlap.
-fn placements_fit(placements: &Placements, requests: &[AliasRequest]) -> bool {
-    let request = |r: usize| requests.iter().find(|q| q.resource == r);
-    placements.iter().all(|&(r, heap, off)| {
-        let Some(a) = request(r) else { return false };
-        off % a.alignment == 0
-            && placements.iter().all(|&(o, oheap, ooff)| {
-                let Some(b) = request(o) else { return false };
-                o == r
-                    || oheap != heap
-                    || !(a.first <= b.end && b.first <= a.end)
-                    || off + a.size <= ooff
-                    || ooff + b.size <= off
-            })
-    })
-}
-
-/// The transients' real sizes and alignments, with their lifetimes.
-fn alias_requests(plan: &Plan, reqs: &[Option<vk::MemoryRequirements>]) -> Vec<AliasRequest> {
-    plan.lifetimes
-        .iter()
-        .filter_map(|l| {
-            let req = reqs[l.resource]?;
-            let heap = if plan.graph.resources[l.resource].decl.is_image() {
-                HeapKind::Images
-            } else {
-                HeapKind::Buffers
-            };
-            Some(AliasRequest {
-                resource: l.resource,
-                heap,
-                size: req.size,
-                alignment: req.alignment.max(heap.default_alignment()),
-                first: l.first,
-                end: l.end,
-            })
-        })
-        .collect()
-}
-
 impl Memory {
     pub fn create(
         gpu: &Gpu,
@@ -546,27 +503,6 @@ fn create_unbound(
         out.push(Some(made));
     }
     Ok(out)
-}
-
-/// Pairs of one heap's members that share bytes, earlier lifetime first.
-fn sharing_bytes(members: &[(usize, u64)], requests: &[AliasRequest]) -> Vec<(usize, usize)> {
-    let request = |r: usize| requests.iter().find(|q| q.resource == r);
-    let mut out = Vec::new();
-    for (i, &(a, ao)) in members.iter().enumerate() {
-        for &(b, bo) in &members[i + 1..] {
-            let (Some(ra), Some(rb)) = (request(a), request(b)) else {
-                continue;
-            };
-            if ao < bo + rb.size && bo < ao + ra.size {
-                if ra.end < rb.first {
-                    out.push((a, b));
-                } else if rb.end < ra.first {
-                    out.push((b, a));
-                }
-            }
-        }
-    }
-    out
 }
 
 pub(crate) fn full_range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::ImageSubresourceRange {
