@@ -199,70 +199,87 @@ struct Group {
     layout: vk::ImageLayout,
 }
 
-pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
-    let g = &plan.graph;
-    let n = g.passes.len();
-    let mut out = SyncPlan {
-        before: vec![Vec::new(); n],
-        after: vec![Vec::new(); n],
-        ..SyncPlan::default()
-    };
-    let q = |p: PassId| at.queue_of[p];
-    let co = |p: PassId| at.compute_only[q(p)];
-    let point = |p: PassId, r: usize| access_point(g, p, r);
+/// The plan and the backend's placement, with the lookups every step uses.
+struct Planner<'a> {
+    plan: &'a Plan,
+    at: &'a Placement<'a>,
+}
 
-    // Buffers: one barrier per same-queue dependency, merged per (pass, buffer).
-    let mut buffer: BTreeMap<(PassId, usize), (Scope, Scope)> = BTreeMap::new();
-    for d in &plan.dependencies {
-        if q(d.from) != q(d.to) {
-            out.semaphore_deps += 1;
-            continue;
-        }
-        out.barrier_deps += 1;
-        if g.resources[d.resource].decl.is_image() {
-            continue;
-        }
-        let e = buffer
-            .entry((d.to, d.resource))
-            .or_insert((Scope::NONE, Scope::NONE));
-        e.0 = e.0.or(Scope::of(&d.src, co(d.to)));
-        e.1 = e.1.or(Scope::of(&d.dst, co(d.to)));
-    }
-    for ((p, r), (src, dst)) in buffer {
-        out.before[p].push(Barrier {
-            target: Target::Buffer(r),
-            src,
-            dst,
-        });
+impl Planner<'_> {
+    /// Backend queue of pass `p`.
+    fn q(&self, p: PassId) -> usize {
+        self.at.queue_of[p]
     }
 
-    // Aliasing predecessors' uses on the first pass's queue.
-    let mut alias_src: BTreeMap<usize, (PassId, Scope)> = BTreeMap::new();
-    for &(a, b) in at.aliases {
-        let (Some(la), Some(lb)) = (
-            plan.lifetimes.iter().find(|l| l.resource == a),
-            plan.lifetimes.iter().find(|l| l.resource == b),
-        ) else {
-            continue;
-        };
-        let first = plan.order[lb.first];
-        let mut src = Scope::NONE;
-        for &(u, _) in &la.uses {
-            if q(u) == q(first) {
-                src = src.or(Scope::of(&point(u, a), co(first)));
+    /// Whether pass `p` runs on a compute-only queue.
+    fn co(&self, p: PassId) -> bool {
+        self.at.compute_only[self.q(p)]
+    }
+
+    fn point(&self, p: PassId, r: usize) -> AccessPoint {
+        access_point(&self.plan.graph, p, r)
+    }
+
+    /// Buffers: one barrier per same-queue dependency, merged per (pass,
+    /// buffer); counts the dependencies barriers and semaphores carry.
+    fn buffer_barriers(&self, out: &mut SyncPlan) {
+        let g = &self.plan.graph;
+        let mut buffer: BTreeMap<(PassId, usize), (Scope, Scope)> = BTreeMap::new();
+        for d in &self.plan.dependencies {
+            if self.q(d.from) != self.q(d.to) {
+                out.semaphore_deps += 1;
+                continue;
             }
+            out.barrier_deps += 1;
+            if g.resources[d.resource].decl.is_image() {
+                continue;
+            }
+            let e = buffer
+                .entry((d.to, d.resource))
+                .or_insert((Scope::NONE, Scope::NONE));
+            e.0 = e.0.or(Scope::of(&d.src, self.co(d.to)));
+            e.1 = e.1.or(Scope::of(&d.dst, self.co(d.to)));
         }
-        let e = alias_src.entry(b).or_insert((first, Scope::NONE));
-        e.1 = e.1.or(src);
+        for ((p, r), (src, dst)) in buffer {
+            out.before[p].push(Barrier {
+                target: Target::Buffer(r),
+                src,
+                dst,
+            });
+        }
     }
 
-    // Images: groups of accesses and the transitions between them.
-    for (r, res) in g.resources.iter().enumerate() {
-        if res.version_of.is_some() || !res.decl.is_image() {
-            continue;
+    /// Per transient that reuses another's bytes: its first pass, and the
+    /// earlier transient's uses on that pass's queue.
+    fn alias_sources(&self) -> BTreeMap<usize, (PassId, Scope)> {
+        let plan = self.plan;
+        let mut alias_src: BTreeMap<usize, (PassId, Scope)> = BTreeMap::new();
+        for &(a, b) in self.at.aliases {
+            let (Some(la), Some(lb)) = (
+                plan.lifetimes.iter().find(|l| l.resource == a),
+                plan.lifetimes.iter().find(|l| l.resource == b),
+            ) else {
+                continue;
+            };
+            let first = plan.order[lb.first];
+            let mut src = Scope::NONE;
+            for &(u, _) in &la.uses {
+                if self.q(u) == self.q(first) {
+                    src = src.or(Scope::of(&self.point(u, a), self.co(first)));
+                }
+            }
+            let e = alias_src.entry(b).or_insert((first, Scope::NONE));
+            e.1 = e.1.or(src);
         }
+        alias_src
+    }
+
+    /// Image `r`'s accesses in plan order as groups: each write alone, the
+    /// reads between two writes together, in a layout that serves them all.
+    fn image_groups(&self, r: usize) -> Vec<Group> {
+        let g = &self.plan.graph;
         let mut groups: Vec<Group> = Vec::new();
-        for &p in &plan.order {
+        for &p in &self.plan.order {
             if !g.passes[p]
                 .accesses
                 .iter()
@@ -270,13 +287,13 @@ pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
             {
                 continue;
             }
-            let ap = point(p, r);
+            let ap = self.point(p, r);
             let l = layout(ap.layout.unwrap_or(Layout::General));
             let write = ap.access.writes();
             match groups.last_mut() {
                 Some(last) if !write && !last.write => {
                     if last.layout != l {
-                        last.layout = if (at.is_depth)(r) {
+                        last.layout = if (self.at.is_depth)(r) {
                             vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL
                         } else {
                             vk::ImageLayout::GENERAL
@@ -291,96 +308,135 @@ pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
                 }),
             }
         }
-        let (Some(first), Some(last)) = (groups.first(), groups.last()) else {
-            continue;
+        groups
+    }
+
+    /// The barrier before the writer of `groups[i]` (a write group): after
+    /// the earlier accesses on its queue, into the group's layout; for the
+    /// first group of a transient that reuses bytes, after their last users.
+    fn write_transition(
+        &self,
+        r: usize,
+        groups: &[Group],
+        i: usize,
+        alias_src: &mut BTreeMap<usize, (PassId, Scope)>,
+    ) -> Option<(PassId, Barrier)> {
+        let group = &groups[i];
+        let p = group.passes[0];
+        let transient = self.plan.graph.resources[r].decl.lifetime() == LifetimeClass::Transient;
+        let old = match i {
+            // Imported images are put in their first layout by the prologue.
+            0 if !transient => return None,
+            0 => vk::ImageLayout::UNDEFINED,
+            _ => groups[i - 1].layout,
         };
-        out.first_layout.insert(r, first.layout);
-        out.last_layout.insert(r, last.layout);
-        let transient = res.decl.lifetime() == LifetimeClass::Transient;
-        for (i, group) in groups.iter().enumerate() {
-            for &p in &group.passes {
-                out.layout_in.insert((p, r), group.layout);
+        let mut src = Scope::NONE;
+        let mut cross = false;
+        for d in self
+            .plan
+            .dependencies
+            .iter()
+            .filter(|d| d.to == p && d.resource == r)
+        {
+            if self.q(d.from) == self.q(p) {
+                src = src.or(Scope::of(&d.src, self.co(p)));
+            } else {
+                cross = true;
             }
-            if group.write {
-                let p = group.passes[0];
-                let old = match i {
-                    // Imported images are put in their first layout by the prologue.
-                    0 if !transient => continue,
-                    0 => vk::ImageLayout::UNDEFINED,
-                    _ => groups[i - 1].layout,
-                };
-                let mut src = Scope::NONE;
-                let mut cross = false;
-                for d in plan
-                    .dependencies
-                    .iter()
-                    .filter(|d| d.to == p && d.resource == r)
-                {
-                    if q(d.from) == q(p) {
-                        src = src.or(Scope::of(&d.src, co(p)));
-                    } else {
-                        cross = true;
-                    }
-                }
-                let dst = Scope::of(&point(p, r), co(p));
-                if cross {
-                    // Chains with the semaphore wait before this batch.
-                    src = src.or(Scope {
-                        stages: dst.stages,
-                        access: vk::AccessFlags2::NONE,
-                    });
-                }
-                if i == 0
-                    && let Some((f, s)) = alias_src.remove(&r)
-                    && f == p
-                {
-                    src = src.or(s);
-                }
-                if old != group.layout || !src.is_none() {
-                    out.before[p].push(Barrier {
-                        target: Target::Image {
-                            resource: r,
-                            old,
-                            new: group.layout,
-                        },
-                        src,
-                        dst,
-                    });
-                }
-            } else if i > 0 {
-                // After the writer that precedes this read group, on its queue.
-                let w = groups[i - 1].passes[0];
-                let src = Scope::of(&point(w, r), co(w));
-                let mut dst = Scope::NONE;
-                let mut cross = false;
+        }
+        let dst = Scope::of(&self.point(p, r), self.co(p));
+        if cross {
+            // Chains with the semaphore wait before this batch.
+            src = src.or(Scope {
+                stages: dst.stages,
+                access: vk::AccessFlags2::NONE,
+            });
+        }
+        if i == 0
+            && let Some((f, s)) = alias_src.remove(&r)
+            && f == p
+        {
+            src = src.or(s);
+        }
+        let target = Target::Image {
+            resource: r,
+            old,
+            new: group.layout,
+        };
+        (old != group.layout || !src.is_none()).then_some((p, Barrier { target, src, dst }))
+    }
+
+    /// The barrier after the writer that precedes read group `groups[i]`,
+    /// on the writer's queue: into the readers' layout, before it signals.
+    fn read_transition(&self, r: usize, groups: &[Group], i: usize) -> Option<(PassId, Barrier)> {
+        let group = &groups[i];
+        let w = groups[i - 1].passes[0];
+        let src = Scope::of(&self.point(w, r), self.co(w));
+        let mut dst = Scope::NONE;
+        let mut cross = false;
+        for &p in &group.passes {
+            if self.q(p) == self.q(w) {
+                dst = dst.or(Scope::of(&self.point(p, r), self.co(w)));
+            } else {
+                cross = true;
+            }
+        }
+        if cross {
+            dst = dst.or(Scope {
+                stages: vk::PipelineStageFlags2::ALL_COMMANDS,
+                access: vk::AccessFlags2::NONE,
+            });
+        }
+        let old = groups[i - 1].layout;
+        let target = Target::Image {
+            resource: r,
+            old,
+            new: group.layout,
+        };
+        (old != group.layout || !dst.is_none()).then_some((w, Barrier { target, src, dst }))
+    }
+
+    /// Images: groups of accesses and the transitions between them.
+    fn image_barriers(&self, out: &mut SyncPlan, alias_src: &mut BTreeMap<usize, (PassId, Scope)>) {
+        for (r, res) in self.plan.graph.resources.iter().enumerate() {
+            if res.version_of.is_some() || !res.decl.is_image() {
+                continue;
+            }
+            let groups = self.image_groups(r);
+            let (Some(first), Some(last)) = (groups.first(), groups.last()) else {
+                continue;
+            };
+            out.first_layout.insert(r, first.layout);
+            out.last_layout.insert(r, last.layout);
+            for (i, group) in groups.iter().enumerate() {
                 for &p in &group.passes {
-                    if q(p) == q(w) {
-                        dst = dst.or(Scope::of(&point(p, r), co(w)));
-                    } else {
-                        cross = true;
+                    out.layout_in.insert((p, r), group.layout);
+                }
+                if group.write {
+                    if let Some((p, b)) = self.write_transition(r, &groups, i, alias_src) {
+                        out.before[p].push(b);
                     }
-                }
-                if cross {
-                    dst = dst.or(Scope {
-                        stages: vk::PipelineStageFlags2::ALL_COMMANDS,
-                        access: vk::AccessFlags2::NONE,
-                    });
-                }
-                let old = groups[i - 1].layout;
-                if old != group.layout || !dst.is_none() {
-                    out.after[w].push(Barrier {
-                        target: Target::Image {
-                            resource: r,
-                            old,
-                            new: group.layout,
-                        },
-                        src,
-                        dst,
-                    });
+                } else if i > 0
+                    && let Some((w, b)) = self.read_transition(r, &groups, i)
+                {
+                    out.after[w].push(b);
                 }
             }
         }
     }
+}
+
+pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
+    let n = plan.graph.passes.len();
+    let mut out = SyncPlan {
+        before: vec![Vec::new(); n],
+        after: vec![Vec::new(); n],
+        ..SyncPlan::default()
+    };
+    let planner = Planner { plan, at };
+    planner.buffer_barriers(&mut out);
+    let mut alias_src = planner.alias_sources();
+    planner.image_barriers(&mut out, &mut alias_src);
     // Buffers (and images whose first use was not a write) that reuse bytes.
     for (b, (first, src)) in alias_src {
         if src.is_none() {
@@ -389,7 +445,7 @@ pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
         out.before[first].push(Barrier {
             target: Target::Global,
             src,
-            dst: Scope::of(&point(first, b), co(first)),
+            dst: Scope::of(&planner.point(first, b), planner.co(first)),
         });
     }
     out

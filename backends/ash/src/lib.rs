@@ -14,10 +14,15 @@
 //!   are serialised in plan order and the frame notes say so;
 //! - **per-pass timestamps per queue** ([`timing`]).
 //!
-//! Shaders are the WGSL under `shaders/`, composed by
+//! Shaders are the WGSL under `shaders/` (built into the binary), composed by
 //! [`strandgraph_passes::wgsl`] and translated by naga to SPIR-V 1.3 with the
 //! capabilities each pass needs ([`spirv`]). Binding 0 is the pass's parameter
 //! block ([`PassDef::gpu_params`]), then its `bindings()` in order.
+//!
+//! Every Vulkan object is owned by a value that destroys it on drop
+//! ([`owned`]): children hold the device, the device holds the instance, so
+//! an early `?` frees whatever was made and destruction order follows from
+//! ownership.
 //!
 //! A [`Session`] creates the device, pipelines, memory and command buffers
 //! once ([`AshBackend::open`]); [`Session::run`] uploads a frame's inputs and
@@ -46,13 +51,20 @@
 //!   that serves all of them (barriers.rs), not the plan's per-pass layouts.
 
 mod barriers;
+mod descriptors;
 mod device;
 mod error;
+mod features;
+mod host;
 mod interface;
 mod loader;
 mod memory;
+mod owned;
 mod pipelines;
+mod placement;
 mod prepare;
+mod prologue;
+mod raster;
 mod readback;
 mod record;
 mod session;
@@ -93,8 +105,10 @@ impl Validation {
 /// How the ash backend runs.
 #[derive(Debug, Clone)]
 pub struct AshBackend {
-    /// The WGSL directory ([`strandgraph_passes::wgsl::default_dir`]).
-    pub shader_dir: PathBuf,
+    /// Read the WGSL from this directory instead of the shaders built into
+    /// the binary ([`strandgraph_passes::wgsl::EMBEDDED`]); by default
+    /// `$STRANDGRAPH_SHADERS` ([`strandgraph_passes::wgsl::override_dir`]).
+    pub shader_dir: Option<PathBuf>,
     pub validation: Validation,
     /// Place transients at the plan's aliasing offsets; `false` gives each
     /// its own memory, so every transient can be read back after a frame.
@@ -110,7 +124,7 @@ pub struct AshBackend {
 impl Default for AshBackend {
     fn default() -> Self {
         Self {
-            shader_dir: strandgraph_passes::wgsl::default_dir(),
+            shader_dir: strandgraph_passes::wgsl::override_dir(),
             validation: Validation::from_env(),
             alias: true,
             async_compute: true,

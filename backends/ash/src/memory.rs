@@ -19,6 +19,8 @@
 
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
+use crate::owned::Owned;
+use crate::placement::{Placements, alias_requests, placements_fit, sharing_bytes};
 use ash::vk;
 use strandgraph_graph::alias::{AliasRequest, HeapKind, plan_memory};
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl, Usage};
@@ -26,15 +28,16 @@ use strandgraph_graph::{Instance, LifetimeClass, Plan};
 
 pub(crate) enum Res {
     Buffer {
-        buffer: vk::Buffer,
+        buffer: Owned<vk::Buffer>,
         /// Bytes created (the plan's size rounded up to 4).
         size: u64,
         /// The plan's size in 32-bit words.
         words: usize,
     },
     Image {
-        image: vk::Image,
-        view: vk::ImageView,
+        // Declared before the image: dropped (destroyed) first.
+        view: Owned<vk::ImageView>,
+        image: Owned<vk::Image>,
         format: vk::Format,
         extent: [u32; 3],
         texel_bytes: u32,
@@ -51,10 +54,27 @@ impl Res {
     }
 }
 
+/// A resource created but not yet bound to memory (so without a view).
+enum Unbound {
+    Buffer {
+        buffer: Owned<vk::Buffer>,
+        size: u64,
+        words: usize,
+    },
+    Image {
+        image: Owned<vk::Image>,
+        format: vk::Format,
+        extent: [u32; 3],
+        texel_bytes: u32,
+        depth: bool,
+    },
+}
+
 pub(crate) struct Memory {
     /// By physical resource id; `None` for versions and unused transients.
+    /// Declared before `allocations`: resources go before their memory.
     pub res: Vec<Option<Res>>,
-    allocations: Vec<vk::DeviceMemory>,
+    allocations: Vec<Owned<vk::DeviceMemory>>,
     /// Transient bytes allocated (with the aliasing in use).
     pub transient_bytes: u64,
     /// What the transients would take in separate allocations.
@@ -89,7 +109,7 @@ pub(crate) fn allocate(
     req: vk::MemoryRequirements,
     wanted: vk::MemoryPropertyFlags,
     what: &str,
-) -> Result<vk::DeviceMemory, AshError> {
+) -> Result<Owned<vk::DeviceMemory>, AshError> {
     let ty = gpu
         .memory_type(req.memory_type_bits, wanted)
         .or_else(|| {
@@ -110,14 +130,194 @@ pub(crate) fn allocate(
         .allocation_size(req.size.max(4))
         .memory_type_index(ty);
     // SAFETY: valid device and info.
-    unsafe { gpu.device.allocate_memory(&info, None) }.map_err(|e| match AshError::vk(what, e) {
-        AshError::OutOfMemory { what, kind, .. } => AshError::OutOfMemory {
-            what,
-            kind,
-            bytes: req.size,
-        },
-        other => other,
-    })
+    let memory =
+        unsafe { gpu.device.allocate_memory(&info, None) }.map_err(|e| {
+            match AshError::vk(what, e) {
+                AshError::OutOfMemory { what, kind, .. } => AshError::OutOfMemory {
+                    what,
+                    kind,
+                    bytes: req.size,
+                },
+                other => other,
+            }
+        })?;
+    Ok(gpu.device.own(memory))
+}
+
+/// Image usages from how live passes access each image (by physical id).
+fn image_usages(plan: &Plan) -> Vec<vk::ImageUsageFlags> {
+    let g = &plan.graph;
+    let mut usage = vec![
+        vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
+        g.resources.len()
+    ];
+    for &p in &plan.order {
+        for a in &g.passes[p].accesses {
+            usage[g.physical(a.resource)] |= match a.usage {
+                Usage::Sampled => vk::ImageUsageFlags::SAMPLED,
+                Usage::Color => vk::ImageUsageFlags::COLOR_ATTACHMENT,
+                Usage::Depth => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+                _ => vk::ImageUsageFlags::STORAGE,
+            };
+        }
+    }
+    usage
+}
+
+/// How resources are created: shared between the queue families in use.
+struct Creation<'a> {
+    gpu: &'a Gpu,
+    sharing: vk::SharingMode,
+    families: &'a [u32],
+}
+
+impl Creation<'_> {
+    fn buffer(
+        &self,
+        name: &str,
+        bytes: u64,
+    ) -> Result<(Unbound, vk::MemoryRequirements), AshError> {
+        let d = &self.gpu.device;
+        let size = bytes.max(4).next_multiple_of(4);
+        let info = vk::BufferCreateInfo::default()
+            .size(size)
+            .usage(
+                vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::UNIFORM_BUFFER
+                    | vk::BufferUsageFlags::INDIRECT_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+            )
+            .sharing_mode(self.sharing)
+            .queue_family_indices(self.families);
+        // SAFETY: valid device and info.
+        let buffer = d
+            .own(unsafe { d.create_buffer(&info, None) }.ctx(&format!("vkCreateBuffer `{name}`"))?);
+        // SAFETY: the buffer was just created.
+        let req = unsafe { d.get_buffer_memory_requirements(buffer.raw()) };
+        let words = bytes.div_ceil(4) as usize;
+        Ok((
+            Unbound::Buffer {
+                buffer,
+                size,
+                words,
+            },
+            req,
+        ))
+    }
+
+    fn image(
+        &self,
+        name: &str,
+        f: ImageFormat,
+        extent: [u32; 3],
+        usage: vk::ImageUsageFlags,
+    ) -> Result<(Unbound, vk::MemoryRequirements), AshError> {
+        let d = &self.gpu.device;
+        let vf = format(f);
+        let mut u = usage;
+        if f.is_depth() {
+            u &= !vk::ImageUsageFlags::STORAGE;
+        }
+        check_format(self.gpu, vf, u, name)?;
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(vf)
+            .extent(vk::Extent3D {
+                width: extent[0],
+                height: extent[1],
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(extent[2])
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(u)
+            .sharing_mode(self.sharing)
+            .queue_family_indices(self.families)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid device and info.
+        let image =
+            d.own(unsafe { d.create_image(&info, None) }.ctx(&format!("vkCreateImage `{name}`"))?);
+        // SAFETY: the image was just created.
+        let req = unsafe { d.get_image_memory_requirements(image.raw()) };
+        let unbound = Unbound::Image {
+            image,
+            format: vf,
+            extent,
+            texel_bytes: f.texel_bytes() as u32,
+            depth: f.is_depth(),
+        };
+        Ok((unbound, req))
+    }
+}
+
+impl Unbound {
+    fn bind(
+        &self,
+        d: &ash::Device,
+        memory: vk::DeviceMemory,
+        offset: u64,
+    ) -> Result<(), vk::Result> {
+        // SAFETY: the resource and memory are live; offsets honour the requirements.
+        unsafe {
+            match self {
+                Unbound::Buffer { buffer, .. } => {
+                    d.bind_buffer_memory(buffer.raw(), memory, offset)
+                }
+                Unbound::Image { image, .. } => d.bind_image_memory(image.raw(), memory, offset),
+            }
+        }
+    }
+
+    /// The resource, with a view for an image (which now has memory).
+    fn into_res(self, gpu: &Gpu) -> Result<Res, AshError> {
+        let d = &gpu.device;
+        Ok(match self {
+            Unbound::Buffer {
+                buffer,
+                size,
+                words,
+            } => Res::Buffer {
+                buffer,
+                size,
+                words,
+            },
+            Unbound::Image {
+                image,
+                format,
+                extent,
+                texel_bytes,
+                depth,
+            } => {
+                let aspect = if depth {
+                    vk::ImageAspectFlags::DEPTH
+                } else {
+                    vk::ImageAspectFlags::COLOR
+                };
+                let info = vk::ImageViewCreateInfo::default()
+                    .image(image.raw())
+                    .view_type(if extent[2] > 1 {
+                        vk::ImageViewType::TYPE_2D_ARRAY
+                    } else {
+                        vk::ImageViewType::TYPE_2D
+                    })
+                    .format(format)
+                    .subresource_range(full_range(aspect, extent[2]));
+                // SAFETY: the image is bound to memory.
+                let view =
+                    d.own(unsafe { d.create_image_view(&info, None) }.ctx("vkCreateImageView")?);
+                Res::Image {
+                    view,
+                    image,
+                    format,
+                    extent,
+                    texel_bytes,
+                    depth,
+                }
+            }
+        })
+    }
 }
 
 impl Memory {
@@ -129,9 +329,11 @@ impl Memory {
         families: &[u32],
         alias: bool,
     ) -> Result<Memory, AshError> {
-        let g = &plan.graph;
+        let unbound = create_unbound(gpu, plan, instance, used, families)?;
+        let reqs: Vec<Option<vk::MemoryRequirements>> =
+            unbound.iter().map(|u| u.as_ref().map(|u| u.1)).collect();
         let mut mem = Memory {
-            res: (0..g.resources.len()).map(|_| None).collect(),
+            res: Vec::new(),
             allocations: Vec::new(),
             transient_bytes: 0,
             unaliased_bytes: 0,
@@ -139,304 +341,168 @@ impl Memory {
             aliases: Vec::new(),
             notes: Vec::new(),
         };
-        let result = mem.fill(gpu, plan, instance, used, families, alias);
-        if let Err(e) = result {
-            mem.destroy(&gpu.device);
-            return Err(e);
+        let requests = alias_requests(plan, &reqs);
+        mem.unaliased_bytes = requests.iter().map(|r| r.size).sum();
+        if alias {
+            let placements = mem.placements(instance, &reqs, &requests);
+            mem.bind_heaps(gpu, plan, &unbound, &placements, &requests)?;
         }
+        mem.bind_separately(gpu, plan, &unbound, alias)?;
+        mem.res = unbound
+            .into_iter()
+            .map(|u| u.map(|(u, _)| u.into_res(gpu)).transpose())
+            .collect::<Result<_, _>>()?;
         Ok(mem)
     }
 
-    fn fill(
+    /// The plan's placements of transients, checked against the real
+    /// requirements, else re-planned with them (and a note saying so).
+    fn placements(
         &mut self,
-        gpu: &Gpu,
-        plan: &Plan,
         instance: &Instance,
-        used: &[bool],
-        families: &[u32],
-        alias: bool,
-    ) -> Result<(), AshError> {
-        let g = &plan.graph;
-        let d = &gpu.device;
-        let sharing = if families.len() > 1 {
-            vk::SharingMode::CONCURRENT
-        } else {
-            vk::SharingMode::EXCLUSIVE
-        };
-        // Image usages from how live passes access each image.
-        let mut usage = vec![
-            vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST;
-            g.resources.len()
-        ];
-        for &p in &plan.order {
-            for a in &g.passes[p].accesses {
-                usage[g.physical(a.resource)] |= match a.usage {
-                    Usage::Sampled => vk::ImageUsageFlags::SAMPLED,
-                    Usage::Color => vk::ImageUsageFlags::COLOR_ATTACHMENT,
-                    Usage::Depth => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-                    _ => vk::ImageUsageFlags::STORAGE,
-                };
-            }
-        }
-        let mut reqs: Vec<Option<vk::MemoryRequirements>> = vec![None; g.resources.len()];
-        for (r, res) in g.resources.iter().enumerate() {
-            let imported = res.decl.lifetime() != LifetimeClass::Transient;
-            if res.version_of.is_some() || !(used[r] || imported) {
-                continue;
-            }
-            let bytes = instance.sizes[r].bytes;
-            let made = match &res.decl {
-                ResourceDecl::Buffer { .. } => {
-                    let size = bytes.max(4).next_multiple_of(4);
-                    let info = vk::BufferCreateInfo::default()
-                        .size(size)
-                        .usage(
-                            vk::BufferUsageFlags::STORAGE_BUFFER
-                                | vk::BufferUsageFlags::UNIFORM_BUFFER
-                                | vk::BufferUsageFlags::INDIRECT_BUFFER
-                                | vk::BufferUsageFlags::TRANSFER_SRC
-                                | vk::BufferUsageFlags::TRANSFER_DST,
-                        )
-                        .sharing_mode(sharing)
-                        .queue_family_indices(families);
-                    // SAFETY: valid device and info.
-                    let buffer = unsafe { d.create_buffer(&info, None) }
-                        .ctx(&format!("vkCreateBuffer `{}`", res.name))?;
-                    // SAFETY: the buffer was just created.
-                    reqs[r] = Some(unsafe { d.get_buffer_memory_requirements(buffer) });
-                    Res::Buffer {
-                        buffer,
-                        size,
-                        words: bytes.div_ceil(4) as usize,
-                    }
-                }
-                ResourceDecl::Image { format: f, .. } => {
-                    let extent = instance.sizes[r]
-                        .extent
-                        .unwrap_or([1, 1, 1])
-                        .map(|x| x.max(1));
-                    let vf = format(*f);
-                    let mut u = usage[r];
-                    if f.is_depth() {
-                        u &= !vk::ImageUsageFlags::STORAGE;
-                    }
-                    check_format(gpu, vf, u, &res.name)?;
-                    let info = vk::ImageCreateInfo::default()
-                        .image_type(vk::ImageType::TYPE_2D)
-                        .format(vf)
-                        .extent(vk::Extent3D {
-                            width: extent[0],
-                            height: extent[1],
-                            depth: 1,
-                        })
-                        .mip_levels(1)
-                        .array_layers(extent[2])
-                        .samples(vk::SampleCountFlags::TYPE_1)
-                        .tiling(vk::ImageTiling::OPTIMAL)
-                        .usage(u)
-                        .sharing_mode(sharing)
-                        .queue_family_indices(families)
-                        .initial_layout(vk::ImageLayout::UNDEFINED);
-                    // SAFETY: valid device and info.
-                    let image = unsafe { d.create_image(&info, None) }
-                        .ctx(&format!("vkCreateImage `{}`", res.name))?;
-                    // SAFETY: the image was just created.
-                    reqs[r] = Some(unsafe { d.get_image_memory_requirements(image) });
-                    Res::Image {
-                        image,
-                        view: vk::ImageView::null(),
-                        format: vf,
-                        extent,
-                        texel_bytes: f.texel_bytes() as u32,
-                        depth: f.is_depth(),
-                    }
-                }
-            };
-            self.res[r] = Some(made);
-        }
-
-        // Transients: the plan's placements, checked against the real requirements.
-        let mut placements: Vec<(usize, HeapKind, u64)> = instance
+        reqs: &[Option<vk::MemoryRequirements>],
+        requests: &[AliasRequest],
+    ) -> Placements {
+        let placements: Placements = instance
             .memory
             .placements
             .iter()
             .filter(|p| reqs[p.resource].is_some())
             .map(|p| (p.resource, p.heap, p.offset))
             .collect();
-        let requests: Vec<AliasRequest> = plan
-            .lifetimes
+        if placements_fit(&placements, requests) {
+            return placements;
+        }
+        self.notes.push(
+            "the plan's aliasing offsets do not fit the driver's memory requirements; \
+             transients were re-placed by the same planner with the real sizes and alignments"
+                .into(),
+        );
+        plan_memory(requests)
+            .placements
             .iter()
-            .filter_map(|l| {
-                let req = reqs[l.resource]?;
-                let heap = if g.resources[l.resource].decl.is_image() {
-                    HeapKind::Images
-                } else {
-                    HeapKind::Buffers
-                };
-                Some(AliasRequest {
-                    resource: l.resource,
-                    heap,
-                    size: req.size,
-                    alignment: req.alignment.max(heap.default_alignment()),
-                    first: l.first,
-                    end: l.end,
-                })
-            })
-            .collect();
-        let request = |r: usize| requests.iter().find(|q| q.resource == r);
-        let fits = placements.iter().all(|&(r, heap, off)| {
-            let Some(a) = request(r) else { return false };
-            off % a.alignment == 0
-                && placements.iter().all(|&(o, oheap, ooff)| {
-                    let Some(b) = request(o) else { return false };
-                    o == r
-                        || oheap != heap
-                        || !(a.first <= b.end && b.first <= a.end)
-                        || off + a.size <= ooff
-                        || ooff + b.size <= off
-                })
-        });
-        if alias && !fits {
-            let replanned = plan_memory(&requests);
-            placements = replanned
-                .placements
-                .iter()
-                .map(|p| (p.resource, p.heap, p.offset))
-                .collect();
-            self.notes.push(
-                "the plan's aliasing offsets do not fit the driver's memory requirements; \
-                 transients were re-placed by the same planner with the real sizes and alignments"
-                    .into(),
-            );
-        }
-        self.unaliased_bytes = requests.iter().map(|r| r.size).sum();
+            .map(|p| (p.resource, p.heap, p.offset))
+            .collect()
+    }
 
-        let bind = |r: usize, memory: vk::DeviceMemory, offset: u64| -> Result<(), AshError> {
-            let name = &g.resources[r].name;
-            // SAFETY: the resource and memory are live; offsets honour the requirements.
-            unsafe {
-                match &self.res[r] {
-                    Some(Res::Buffer { buffer, .. }) => {
-                        d.bind_buffer_memory(*buffer, memory, offset)
-                    }
-                    Some(Res::Image { image, .. }) => d.bind_image_memory(*image, memory, offset),
-                    None => Ok(()),
+    /// One allocation per heap of the placements, each transient bound at its
+    /// offset; records which transients share bytes.
+    fn bind_heaps(
+        &mut self,
+        gpu: &Gpu,
+        plan: &Plan,
+        unbound: &[Option<(Unbound, vk::MemoryRequirements)>],
+        placements: &Placements,
+        requests: &[AliasRequest],
+    ) -> Result<(), AshError> {
+        for heap in [HeapKind::Buffers, HeapKind::Images] {
+            let members: Vec<(usize, u64)> = placements
+                .iter()
+                .filter(|p| p.1 == heap)
+                .map(|p| (p.0, p.2))
+                .collect();
+            if members.is_empty() {
+                continue;
+            }
+            let mut req = vk::MemoryRequirements {
+                size: 0,
+                alignment: 1,
+                memory_type_bits: u32::MAX,
+            };
+            for &(r, off) in &members {
+                let real = unbound[r].as_ref().expect("placed resources exist").1;
+                req.size = req.size.max(off + real.size);
+                req.alignment = req.alignment.max(real.alignment);
+                req.memory_type_bits &= real.memory_type_bits;
+            }
+            let local = vk::MemoryPropertyFlags::DEVICE_LOCAL;
+            let memory = allocate(gpu, req, local, &format!("transient {heap:?} heap"))?;
+            self.transient_bytes += req.size;
+            for &(r, off) in &members {
+                if let Some((u, _)) = &unbound[r] {
+                    let name = &plan.graph.resources[r].name;
+                    u.bind(&gpu.device, memory.raw(), off)
+                        .ctx(&format!("binding memory of `{name}`"))?;
                 }
             }
-            .ctx(&format!("binding memory of `{name}`"))
-        };
-        let local = vk::MemoryPropertyFlags::DEVICE_LOCAL;
-        if alias {
-            for heap in [HeapKind::Buffers, HeapKind::Images] {
-                let members: Vec<(usize, u64)> = placements
-                    .iter()
-                    .filter(|p| p.1 == heap)
-                    .map(|p| (p.0, p.2))
-                    .collect();
-                if members.is_empty() {
-                    continue;
-                }
-                let mut req = vk::MemoryRequirements {
-                    size: 0,
-                    alignment: 1,
-                    memory_type_bits: u32::MAX,
-                };
-                for &(r, off) in &members {
-                    let real = reqs[r].expect("placed resources exist");
-                    req.size = req.size.max(off + real.size);
-                    req.alignment = req.alignment.max(real.alignment);
-                    req.memory_type_bits &= real.memory_type_bits;
-                }
-                let memory = allocate(gpu, req, local, &format!("transient {heap:?} heap"))?;
-                self.allocations.push(memory);
-                self.transient_bytes += req.size;
-                for &(r, off) in &members {
-                    bind(r, memory, off)?;
-                }
-                // Pairs that share bytes, earlier lifetime first.
-                for (i, &(a, ao)) in members.iter().enumerate() {
-                    for &(b, bo) in &members[i + 1..] {
-                        let (ra, rb) = (request(a), request(b));
-                        let (Some(ra), Some(rb)) = (ra, rb) else {
-                            continue;
-                        };
-                        if ao < bo + rb.size && bo < ao + ra.size {
-                            if ra.end < rb.first {
-                                self.aliases.push((a, b));
-                            } else if rb.end < ra.first {
-                                self.aliases.push((b, a));
-                            }
-                        }
-                    }
-                }
-            }
+            self.allocations.push(memory);
+            self.aliases.extend(sharing_bytes(&members, requests));
         }
-        for (r, res) in g.resources.iter().enumerate() {
-            let Some(req) = reqs[r] else { continue };
+        Ok(())
+    }
+
+    /// Its own allocation for every resource not in a heap: imported and
+    /// history ones, and transients when not aliasing.
+    fn bind_separately(
+        &mut self,
+        gpu: &Gpu,
+        plan: &Plan,
+        unbound: &[Option<(Unbound, vk::MemoryRequirements)>],
+        alias: bool,
+    ) -> Result<(), AshError> {
+        for (r, res) in plan.graph.resources.iter().enumerate() {
+            let Some((u, req)) = &unbound[r] else {
+                continue;
+            };
             let transient = res.decl.lifetime() == LifetimeClass::Transient;
             if transient && alias {
                 continue;
             }
-            let memory = allocate(gpu, req, local, &format!("`{}`", res.name))?;
-            self.allocations.push(memory);
+            let local = vk::MemoryPropertyFlags::DEVICE_LOCAL;
+            let memory = allocate(gpu, *req, local, &format!("`{}`", res.name))?;
             if transient {
                 self.transient_bytes += req.size;
             } else {
                 self.owned_bytes += req.size;
             }
-            bind(r, memory, 0)?;
-        }
-        // Views, now that images have memory.
-        for res in self.res.iter_mut().flatten() {
-            if let Res::Image {
-                image,
-                view,
-                format,
-                extent,
-                depth,
-                ..
-            } = res
-            {
-                let aspect = if *depth {
-                    vk::ImageAspectFlags::DEPTH
-                } else {
-                    vk::ImageAspectFlags::COLOR
-                };
-                let info = vk::ImageViewCreateInfo::default()
-                    .image(*image)
-                    .view_type(if extent[2] > 1 {
-                        vk::ImageViewType::TYPE_2D_ARRAY
-                    } else {
-                        vk::ImageViewType::TYPE_2D
-                    })
-                    .format(*format)
-                    .subresource_range(full_range(aspect, extent[2]));
-                // SAFETY: the image is bound to memory.
-                *view = unsafe { d.create_image_view(&info, None) }.ctx("vkCreateImageView")?;
-            }
+            u.bind(&gpu.device, memory.raw(), 0)
+                .ctx(&format!("binding memory of `{}`", res.name))?;
+            self.allocations.push(memory);
         }
         Ok(())
     }
+}
 
-    pub fn destroy(&mut self, d: &ash::Device) {
-        // SAFETY: the device is idle (the session waits before dropping).
-        unsafe {
-            for res in self.res.iter_mut().filter_map(Option::take) {
-                match res {
-                    Res::Buffer { buffer, .. } => d.destroy_buffer(buffer, None),
-                    Res::Image { image, view, .. } => {
-                        if view != vk::ImageView::null() {
-                            d.destroy_image_view(view, None);
-                        }
-                        d.destroy_image(image, None);
-                    }
-                }
-            }
-            for m in self.allocations.drain(..) {
-                d.free_memory(m, None);
-            }
+/// Every resource that needs memory, created without it: live ones, and
+/// every imported or history one.
+fn create_unbound(
+    gpu: &Gpu,
+    plan: &Plan,
+    instance: &Instance,
+    used: &[bool],
+    families: &[u32],
+) -> Result<Vec<Option<(Unbound, vk::MemoryRequirements)>>, AshError> {
+    let g = &plan.graph;
+    let usage = image_usages(plan);
+    let creation = Creation {
+        gpu,
+        sharing: if families.len() > 1 {
+            vk::SharingMode::CONCURRENT
+        } else {
+            vk::SharingMode::EXCLUSIVE
+        },
+        families,
+    };
+    let mut out = Vec::with_capacity(g.resources.len());
+    for (r, res) in g.resources.iter().enumerate() {
+        let imported = res.decl.lifetime() != LifetimeClass::Transient;
+        if res.version_of.is_some() || !(used[r] || imported) {
+            out.push(None);
+            continue;
         }
+        let made = match &res.decl {
+            ResourceDecl::Buffer { .. } => creation.buffer(&res.name, instance.sizes[r].bytes)?,
+            ResourceDecl::Image { format: f, .. } => {
+                let extent = instance.sizes[r]
+                    .extent
+                    .unwrap_or([1, 1, 1])
+                    .map(|x| x.max(1));
+                creation.image(&res.name, *f, extent, usage[r])?
+            }
+        };
+        out.push(Some(made));
     }
+    Ok(out)
 }
 
 pub(crate) fn full_range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::ImageSubresourceRange {
@@ -490,99 +556,4 @@ fn check_format(
         }
     }
     Ok(())
-}
-
-/// A host-visible, coherent buffer, mapped.
-pub(crate) struct HostBuffer {
-    pub buffer: vk::Buffer,
-    memory: vk::DeviceMemory,
-    pub ptr: *mut u8,
-    pub size: u64,
-}
-
-impl HostBuffer {
-    pub fn new(
-        gpu: &Gpu,
-        size: u64,
-        usage: vk::BufferUsageFlags,
-        what: &str,
-    ) -> Result<Self, AshError> {
-        let d = &gpu.device;
-        let size = size.max(16).next_multiple_of(4);
-        let info = vk::BufferCreateInfo::default().size(size).usage(usage);
-        // SAFETY: valid device and info.
-        let buffer = unsafe { d.create_buffer(&info, None) }.ctx(what)?;
-        // SAFETY: the buffer was just created.
-        let req = unsafe { d.get_buffer_memory_requirements(buffer) };
-        let memory = match allocate(
-            gpu,
-            req,
-            vk::MemoryPropertyFlags::HOST_VISIBLE | vk::MemoryPropertyFlags::HOST_COHERENT,
-            what,
-        ) {
-            Ok(m) => m,
-            Err(e) => {
-                // SAFETY: unused buffer.
-                unsafe { d.destroy_buffer(buffer, None) };
-                return Err(e);
-            }
-        };
-        let mapped = (|| {
-            // SAFETY: fresh memory, bound once and mapped once.
-            unsafe {
-                d.bind_buffer_memory(buffer, memory, 0).ctx(what)?;
-                d.map_memory(memory, 0, vk::WHOLE_SIZE, vk::MemoryMapFlags::empty())
-                    .ctx(what)
-            }
-        })();
-        match mapped {
-            Ok(ptr) => Ok(Self {
-                buffer,
-                memory,
-                ptr: ptr.cast(),
-                size,
-            }),
-            Err(e) => {
-                // SAFETY: unused objects.
-                unsafe {
-                    d.destroy_buffer(buffer, None);
-                    d.free_memory(memory, None);
-                }
-                Err(e)
-            }
-        }
-    }
-
-    /// Writes `words` at byte `offset`.
-    pub fn write(&self, offset: u64, words: &[u32]) {
-        let bytes: &[u8] = bytemuck::cast_slice(words);
-        assert!(
-            offset + bytes.len() as u64 <= self.size,
-            "host buffer overflow"
-        );
-        // SAFETY: in bounds (checked above) of a coherent mapping this struct owns.
-        unsafe {
-            std::ptr::copy_nonoverlapping(
-                bytes.as_ptr(),
-                self.ptr.add(offset as usize),
-                bytes.len(),
-            )
-        };
-    }
-
-    pub fn read(&self, len: usize) -> Vec<u8> {
-        let len = len.min(self.size as usize);
-        let mut out = vec![0u8; len];
-        // SAFETY: in bounds of a coherent mapping this struct owns.
-        unsafe { std::ptr::copy_nonoverlapping(self.ptr, out.as_mut_ptr(), len) };
-        out
-    }
-
-    pub fn destroy(&mut self, d: &ash::Device) {
-        // SAFETY: the device is idle for this buffer.
-        unsafe {
-            d.destroy_buffer(self.buffer, None);
-            d.free_memory(self.memory, None);
-        }
-    }
 }

@@ -1,21 +1,23 @@
-//! Shader modules, descriptor sets, parameter blocks and pipelines of every
-//! pass, built once per session. Compute passes are compute pipelines;
-//! raster passes are one graphics pipeline per `Draw` of their
-//! `RasterState` (dynamic rendering, no vertex buffers), as on wgpu.
+//! Shader modules, pipeline layouts and pipelines of every pass, built once
+//! per session. Compute passes are compute pipelines with one dispatch per
+//! descriptor set; raster passes (raster.rs) are one graphics pipeline per
+//! `Draw` of their `RasterState`, as on wgpu. Descriptor sets and parameter
+//! blocks are descriptors.rs.
 
 use crate::barriers::SyncPlan;
+use crate::descriptors::{SetPlan, Sets, fill_sets};
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
-use crate::memory::{HostBuffer, Memory, Res};
+use crate::memory::{Memory, Res};
+use crate::owned::Owned;
 use crate::prepare::Prepared;
-use crate::spirv::translate;
+use crate::raster::raster_work;
+use crate::spirv::{Spirv, translate};
 use ash::vk;
-use std::collections::BTreeMap;
 use strandgraph_graph::resolve::PassId;
-use strandgraph_graph::schema::Usage;
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::Dispatch;
-use strandgraph_passes::draw::{Blend, Compare, RasterState};
+use strandgraph_passes::draw::RasterState;
 
 /// How a compute dispatch gets its workgroup count.
 #[derive(Debug, Clone, Copy)]
@@ -27,11 +29,12 @@ pub(crate) enum Launch {
 
 pub(crate) enum Work {
     Compute {
-        pipeline: vk::Pipeline,
+        pipeline: Owned<vk::Pipeline>,
+        /// Descriptor sets are filled in once every pass is built.
         dispatches: Vec<(vk::DescriptorSet, Launch)>,
     },
     Raster {
-        pipelines: Vec<vk::Pipeline>,
+        pipelines: Vec<Owned<vk::Pipeline>>,
         set: vk::DescriptorSet,
         /// Physical resource ids of the colour attachments and the depth one.
         color: Vec<usize>,
@@ -42,61 +45,41 @@ pub(crate) enum Work {
     },
 }
 
+/// One pass's pipelines and what they were made from. Fields drop in
+/// order: pipelines before their layouts, layouts before the module.
 pub(crate) struct Built {
     pub p: PassId,
     pub work: Work,
-    pub layout: vk::PipelineLayout,
-    set_layout: vk::DescriptorSetLayout,
-    module: vk::ShaderModule,
+    pub layout: Owned<vk::PipelineLayout>,
+    pub set_layout: Owned<vk::DescriptorSetLayout>,
+    _module: Owned<vk::ShaderModule>,
+    /// `(binding, type)` the shader declares, for its descriptor sets.
+    pub descriptors: Vec<(u32, vk::DescriptorType)>,
 }
 
 pub(crate) struct Pipelines {
     pub built: Vec<Built>,
-    pool: vk::DescriptorPool,
-    uniforms: Option<HostBuffer>,
+    /// The descriptor pool (its sets go with it) and the parameter blocks
+    /// the sets point into.
+    _sets: Sets,
 }
 
-impl Pipelines {
-    pub fn destroy(&mut self, d: &ash::Device) {
-        // SAFETY: the device is idle.
-        unsafe {
-            for b in self.built.drain(..) {
-                match b.work {
-                    Work::Compute { pipeline, .. } => d.destroy_pipeline(pipeline, None),
-                    Work::Raster { pipelines, .. } => {
-                        for p in pipelines {
-                            d.destroy_pipeline(p, None);
-                        }
-                    }
-                }
-                d.destroy_pipeline_layout(b.layout, None);
-                d.destroy_descriptor_set_layout(b.set_layout, None);
-                d.destroy_shader_module(b.module, None);
-            }
-            if self.pool != vk::DescriptorPool::null() {
-                d.destroy_descriptor_pool(self.pool, None);
-            }
-        }
-        if let Some(mut u) = self.uniforms.take() {
-            u.destroy(d);
+/// What building a pass needs of the session.
+pub(crate) struct Context<'a> {
+    pub gpu: &'a Gpu,
+    pub plan: &'a Plan,
+    pub instance: &'a Instance,
+    pub memory: &'a Memory,
+}
+
+impl Context<'_> {
+    /// An error naming pass `p`.
+    pub fn pass_error(&self, p: PassId, message: String) -> AshError {
+        AshError::Pass {
+            pass: self.plan.graph.passes[p].name.clone(),
+            message,
         }
     }
-}
-
-fn compare(c: Compare) -> vk::CompareOp {
-    match c {
-        Compare::Always => vk::CompareOp::ALWAYS,
-        Compare::Less => vk::CompareOp::LESS,
-        Compare::Equal => vk::CompareOp::EQUAL,
-    }
-}
-
-/// One descriptor set to allocate and fill: the pass, its parameter block
-/// and the bound resources for bindings 1.. in order.
-struct SetPlan {
-    built: usize,
-    params: Vec<u32>,
-    bound: Vec<usize>,
 }
 
 pub(crate) fn build(
@@ -107,500 +90,233 @@ pub(crate) fn build(
     memory: &Memory,
     sync: &SyncPlan,
 ) -> Result<Pipelines, AshError> {
-    let mut out = Pipelines {
-        built: Vec::new(),
-        pool: vk::DescriptorPool::null(),
-        uniforms: None,
+    let cx = Context {
+        gpu,
+        plan,
+        instance,
+        memory,
     };
-    match build_into(&mut out, gpu, plan, instance, prepared, memory, sync) {
-        Ok(()) => Ok(out),
-        Err(e) => {
-            out.destroy(&gpu.device);
-            Err(e)
-        }
+    let mut built = Vec::new();
+    let mut sets = Vec::new();
+    for prep in prepared {
+        let (b, pass_sets) = build_pass(&cx, prep, built.len())?;
+        built.push(b);
+        sets.extend(pass_sets);
     }
+    let sets = fill_sets(&cx, sync, &mut built, &sets)?;
+    Ok(Pipelines { built, _sets: sets })
 }
 
-#[allow(clippy::too_many_arguments)]
-fn build_into(
-    out: &mut Pipelines,
-    gpu: &Gpu,
-    plan: &Plan,
-    instance: &Instance,
-    prepared: &[Prepared<'_>],
-    memory: &Memory,
-    sync: &SyncPlan,
-) -> Result<(), AshError> {
+/// A NUL-terminated entry point name.
+pub(crate) fn entry_name(
+    cx: &Context<'_>,
+    p: PassId,
+    name: &str,
+) -> Result<std::ffi::CString, AshError> {
+    std::ffi::CString::new(name).map_err(|_| cx.pass_error(p, "entry name has a NUL".into()))
+}
+
+/// The shader module, layouts and pipelines of one pass (the `index`-th
+/// built), and the descriptor sets it needs.
+fn build_pass(
+    cx: &Context<'_>,
+    prep: &Prepared<'_>,
+    index: usize,
+) -> Result<(Built, Vec<SetPlan>), AshError> {
+    let gpu = cx.gpu;
     let d = &gpu.device;
-    let g = &plan.graph;
-    let q = &instance.quantities;
-    let mut sets: Vec<SetPlan> = Vec::new();
-    let mut descriptor_types: Vec<Vec<(u32, vk::DescriptorType)>> = Vec::new();
-    for prep in prepared {
-        let pass = &g.passes[prep.p];
-        let pass_error = |message: String| AshError::Pass {
-            pass: pass.name.clone(),
-            message,
-        };
-        let shader = prep.def.shader();
-        let mut entries = vec![shader.entry];
-        if let Some(state) = &prep.raster {
-            entries.extend(state.draws.iter().map(|d| d.fragment));
-        }
-        let spirv = translate(
-            &prep.composed,
-            &entries,
-            &gpu.spirv_caps,
-            gpu.zero_init_native,
-            &pass.name,
-            &gpu.name,
-        )?;
-        let info = vk::ShaderModuleCreateInfo::default().code(&spirv.words);
-        // SAFETY: valid SPIR-V words from naga.
-        let module = unsafe { d.create_shader_module(&info, None) }
-            .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?;
-        let stage_flags = if prep.raster.is_some() {
-            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT
-        } else {
-            vk::ShaderStageFlags::COMPUTE
-        };
-        let bindings: Vec<vk::DescriptorSetLayoutBinding<'_>> = spirv
-            .descriptors
-            .iter()
-            .map(|&(b, ty)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(b)
-                    .descriptor_type(ty)
-                    .descriptor_count(1)
-                    .stage_flags(stage_flags)
-            })
-            .collect();
-        let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
-        // SAFETY: valid device and info.
-        let set_layout = match unsafe { d.create_descriptor_set_layout(&info, None) } {
-            Ok(l) => l,
-            Err(e) => {
-                // SAFETY: unused module.
-                unsafe { d.destroy_shader_module(module, None) };
-                return Err(AshError::vk("vkCreateDescriptorSetLayout", e));
-            }
-        };
-        let layouts = [set_layout];
-        let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts);
-        // SAFETY: valid device and info.
-        let layout = match unsafe { d.create_pipeline_layout(&info, None) } {
-            Ok(l) => l,
-            Err(e) => {
-                // SAFETY: unused objects.
-                unsafe {
-                    d.destroy_descriptor_set_layout(set_layout, None);
-                    d.destroy_shader_module(module, None);
-                }
-                return Err(AshError::vk("vkCreatePipelineLayout", e));
-            }
-        };
-        let index = out.built.len();
-        // Registered before the pipelines so an error below still frees these.
-        out.built.push(Built {
-            p: prep.p,
-            work: Work::Compute {
-                pipeline: vk::Pipeline::null(),
-                dispatches: Vec::new(),
-            },
-            layout,
-            set_layout,
-            module,
-        });
-        descriptor_types.push(spirv.descriptors.clone());
-
-        if let Some(state) = &prep.raster {
-            let attachment = |usage: Usage| -> Vec<usize> {
-                prep.bindings
-                    .iter()
-                    .filter(|(_, _, u)| *u == usage)
-                    .map(|(_, r, _)| *r)
-                    .collect()
-            };
-            let color = attachment(Usage::Color);
-            let depth = attachment(Usage::Depth).first().copied();
-            let format_of = |r: usize| match &memory.res[r] {
-                Some(Res::Image { format, extent, .. }) => Ok((*format, *extent)),
-                _ => Err(pass_error(format!(
-                    "attachment `{}` is not an image",
-                    g.resources[r].name
-                ))),
-            };
-            let color_formats: Vec<vk::Format> = color
-                .iter()
-                .map(|&r| format_of(r).map(|f| f.0))
-                .collect::<Result<_, _>>()?;
-            let depth_format = depth.map(|r| format_of(r).map(|f| f.0)).transpose()?;
-            let extent = match color.first().or(depth.as_ref()) {
-                Some(&r) => {
-                    let e = format_of(r)?.1;
-                    [e[0], e[1]]
-                }
-                None => return Err(pass_error("a raster pass without attachments".into())),
-            };
-            let mut pipelines = Vec::new();
-            for draw in &state.draws {
-                let vs_name = std::ffi::CString::new(shader.entry)
-                    .map_err(|_| pass_error("entry name has a NUL".into()))?;
-                let fs_name = std::ffi::CString::new(draw.fragment)
-                    .map_err(|_| pass_error("entry name has a NUL".into()))?;
-                let stages = [
-                    vk::PipelineShaderStageCreateInfo::default()
-                        .stage(vk::ShaderStageFlags::VERTEX)
-                        .module(module)
-                        .name(&vs_name),
-                    vk::PipelineShaderStageCreateInfo::default()
-                        .stage(vk::ShaderStageFlags::FRAGMENT)
-                        .module(module)
-                        .name(&fs_name),
-                ];
-                let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
-                let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-                    .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-                let viewport = vk::PipelineViewportStateCreateInfo::default()
-                    .viewport_count(1)
-                    .scissor_count(1);
-                // Counter-clockwise front faces as wgpu-hal maps them, with
-                // the same negative-height viewport (record.rs).
-                let raster = vk::PipelineRasterizationStateCreateInfo::default()
-                    .polygon_mode(vk::PolygonMode::FILL)
-                    .cull_mode(if state.cull_back_faces {
-                        vk::CullModeFlags::BACK
-                    } else {
-                        vk::CullModeFlags::NONE
-                    })
-                    .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
-                    .line_width(1.0);
-                let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-                    .rasterization_samples(vk::SampleCountFlags::TYPE_1);
-                let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
-                    .depth_test_enable(depth.is_some())
-                    .depth_write_enable(depth.is_some() && draw.depth_write)
-                    .depth_compare_op(compare(draw.depth_compare));
-                let blend_attachment = |_: &vk::Format| {
-                    let mask = if draw.color_writes {
-                        vk::ColorComponentFlags::RGBA
-                    } else {
-                        vk::ColorComponentFlags::empty()
-                    };
-                    let a = vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask);
-                    match draw.blend {
-                        Blend::Replace => a,
-                        // colour = src + (1 − src.a)·dst; the attachment's alpha stays.
-                        Blend::PremultipliedOverKeepAlpha => a
-                            .blend_enable(true)
-                            .src_color_blend_factor(vk::BlendFactor::ONE)
-                            .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
-                            .color_blend_op(vk::BlendOp::ADD)
-                            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
-                            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-                            .alpha_blend_op(vk::BlendOp::ADD),
-                    }
-                };
-                let blends: Vec<vk::PipelineColorBlendAttachmentState> =
-                    color_formats.iter().map(blend_attachment).collect();
-                let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blends);
-                let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
-                let dynamic =
-                    vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
-                let mut rendering = vk::PipelineRenderingCreateInfo::default()
-                    .color_attachment_formats(&color_formats)
-                    .depth_attachment_format(depth_format.unwrap_or(vk::Format::UNDEFINED));
-                let info = vk::GraphicsPipelineCreateInfo::default()
-                    .stages(&stages)
-                    .vertex_input_state(&vertex_input)
-                    .input_assembly_state(&assembly)
-                    .viewport_state(&viewport)
-                    .rasterization_state(&raster)
-                    .multisample_state(&multisample)
-                    .depth_stencil_state(&depth_state)
-                    .color_blend_state(&blend)
-                    .dynamic_state(&dynamic)
-                    .layout(layout)
-                    .push_next(&mut rendering);
-                // SAFETY: every pointer in `info` lives on this stack frame.
-                let made = unsafe {
-                    d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None)
-                };
-                match made {
-                    Ok(p) => pipelines.extend(p),
-                    Err((p, e)) => {
-                        // SAFETY: pipelines that were created are unused.
-                        unsafe {
-                            for x in pipelines.into_iter().chain(p) {
-                                if x != vk::Pipeline::null() {
-                                    d.destroy_pipeline(x, None);
-                                }
-                            }
-                        }
-                        return Err(AshError::vk(
-                            format!("pass `{}`: vkCreateGraphicsPipelines", pass.name),
-                            e,
-                        ));
-                    }
-                }
-            }
-            let vertices = u32::try_from(state.vertices)
-                .map_err(|_| pass_error(format!("{} vertices are too many", state.vertices)))?;
-            out.built[index].work = Work::Raster {
-                pipelines,
-                set: vk::DescriptorSet::null(),
-                color,
-                depth,
-                state: state.clone(),
-                vertices,
-                extent,
-            };
-            let bound = prep
-                .bindings
-                .iter()
-                .filter(|(_, _, u)| !matches!(u, Usage::Color | Usage::Depth))
-                .map(|(_, r, _)| *r)
-                .collect();
-            sets.push(SetPlan {
-                built: index,
-                params: prep.params.clone(),
-                bound,
-            });
-            continue;
-        }
-
-        let entry = std::ffi::CString::new(shader.entry)
-            .map_err(|_| pass_error("entry name has a NUL".into()))?;
-        let stage = vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::COMPUTE)
-            .module(module)
-            .name(&entry);
-        let info = vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout);
-        // SAFETY: valid module and layout.
-        let pipeline =
-            match unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) } {
-                Ok(p) => p[0],
-                Err((_, e)) => {
-                    return Err(AshError::vk(
-                        format!("pass `{}`: vkCreateComputePipelines", pass.name),
-                        e,
-                    ));
-                }
-            };
-        let max_groups = gpu.props.limits.max_compute_work_group_count[0];
-        let check_groups = |groups: u64| {
-            u32::try_from(groups)
-                .ok()
-                .filter(|&n| n <= max_groups)
-                .ok_or_else(|| {
-                    pass_error(format!(
-                        "{groups} workgroups exceed the device's {max_groups} per dimension"
-                    ))
-                })
-        };
-        let words_of = |r: usize| instance.sizes[r].bytes.div_ceil(4);
-        let is_buffer = |r: usize| matches!(memory.res[r], Some(Res::Buffer { .. }));
-        let mut launches = Vec::new();
-        if prep.def.bindings().is_none() {
-            // One dispatch per written resource, its size in words in the last word.
-            let Dispatch::CoverWrites { words_per_group } = prep.def.dispatch() else {
-                return Err(pass_error(
-                    "a pass without fixed bindings must dispatch CoverWrites".into(),
-                ));
-            };
-            for (_, r, _) in &prep.bindings {
-                let words = words_of(*r);
-                let mut params = prep.params.clone();
-                if let Some(last) = params.last_mut() {
-                    *last = u32::try_from(words)
-                        .map_err(|_| pass_error(format!("{words} words to clear")))?;
-                }
-                let groups = check_groups(words.div_ceil(u64::from(words_per_group.max(1))))?;
-                launches.push(Launch::Direct(groups));
-                sets.push(SetPlan {
-                    built: index,
-                    params,
-                    bound: vec![*r],
-                });
-            }
-        } else {
-            let most = prep
-                .bindings
-                .iter()
-                .filter(|(_, r, _)| is_buffer(*r))
-                .map(|(_, r, _)| words_of(*r))
-                .max()
-                .unwrap_or(0);
-            let dispatch = prep.def.dispatch();
-            let launch = match (dispatch.direct_groups(q, most), dispatch) {
-                (Some(n), _) => Launch::Direct(check_groups(n)?),
-                (None, Dispatch::Indirect { binding, word }) => {
-                    let r = prep
-                        .bindings
-                        .iter()
-                        .find(|(n, _, _)| n == binding)
-                        .map(|(_, r, _)| *r)
-                        .ok_or_else(|| pass_error(format!("indirect `{binding}` is not bound")))?;
-                    Launch::Indirect(r, word as u64 * 4)
-                }
-                (None, _) => unreachable!("only indirect dispatches have no direct count"),
-            };
-            launches.push(launch);
-            sets.push(SetPlan {
-                built: index,
-                params: prep.params.clone(),
-                bound: prep.bindings.iter().map(|(_, r, _)| *r).collect(),
-            });
-        }
-        out.built[index].work = Work::Compute {
-            pipeline,
-            dispatches: launches
-                .into_iter()
-                .map(|l| (vk::DescriptorSet::null(), l))
-                .collect(),
-        };
+    let pass = &cx.plan.graph.passes[prep.p];
+    let shader = prep.def.shader();
+    let mut entries = vec![shader.entry];
+    if let Some(state) = &prep.raster {
+        entries.extend(state.draws.iter().map(|d| d.fragment));
     }
-
-    // Parameter blocks, one per set, in one host-visible buffer.
-    let align = gpu.props.limits.min_uniform_buffer_offset_alignment.max(16);
-    let mut offsets = Vec::new();
-    let mut cursor = 0u64;
-    for s in &sets {
-        offsets.push(cursor);
-        cursor += (s.params.len() as u64 * 4).max(16).next_multiple_of(align);
-    }
-    let uniforms = HostBuffer::new(
-        gpu,
-        cursor,
-        vk::BufferUsageFlags::UNIFORM_BUFFER,
-        "parameter blocks",
+    let spirv = translate(
+        &prep.composed,
+        &entries,
+        &gpu.spirv_caps,
+        gpu.zero_init_native,
+        &pass.name,
+        &gpu.name,
     )?;
-    for (s, &off) in sets.iter().zip(&offsets) {
-        uniforms.write(off, &s.params);
-    }
+    let info = vk::ShaderModuleCreateInfo::default().code(&spirv.words);
+    // SAFETY: valid SPIR-V words from naga.
+    let module = d.own(
+        unsafe { d.create_shader_module(&info, None) }
+            .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?,
+    );
+    let (set_layout, layout) = layouts(gpu, &spirv, prep.raster.is_some())?;
+    let (work, sets) = match &prep.raster {
+        Some(state) => raster_work(cx, prep, state, module.raw(), layout.raw(), index)?,
+        None => compute_work(cx, prep, module.raw(), layout.raw(), index)?,
+    };
+    let built = Built {
+        p: prep.p,
+        work,
+        layout,
+        set_layout,
+        _module: module,
+        descriptors: spirv.descriptors,
+    };
+    Ok((built, sets))
+}
 
-    // One pool for every set.
-    let mut counts: BTreeMap<i32, u32> = BTreeMap::new();
-    for s in &sets {
-        for (_, ty) in &descriptor_types[s.built] {
-            *counts.entry(ty.as_raw()).or_default() += 1;
-        }
-    }
-    let sizes: Vec<vk::DescriptorPoolSize> = counts
+/// The descriptor set layout of the shader's bindings, and a pipeline
+/// layout of that one set.
+fn layouts(
+    gpu: &Gpu,
+    spirv: &Spirv,
+    raster: bool,
+) -> Result<(Owned<vk::DescriptorSetLayout>, Owned<vk::PipelineLayout>), AshError> {
+    let d = &gpu.device;
+    let stage_flags = if raster {
+        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT
+    } else {
+        vk::ShaderStageFlags::COMPUTE
+    };
+    let bindings: Vec<vk::DescriptorSetLayoutBinding<'_>> = spirv
+        .descriptors
         .iter()
-        .map(|(&ty, &n)| vk::DescriptorPoolSize {
-            ty: vk::DescriptorType::from_raw(ty),
-            descriptor_count: n,
+        .map(|&(b, ty)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(b)
+                .descriptor_type(ty)
+                .descriptor_count(1)
+                .stage_flags(stage_flags)
         })
         .collect();
-    let info = vk::DescriptorPoolCreateInfo::default()
-        .max_sets(sets.len().max(1) as u32)
-        .pool_sizes(&sizes);
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
     // SAFETY: valid device and info.
-    out.pool = unsafe { d.create_descriptor_pool(&info, None) }.ctx("vkCreateDescriptorPool")?;
-    let layouts: Vec<vk::DescriptorSetLayout> =
-        sets.iter().map(|s| out.built[s.built].set_layout).collect();
-    let info = vk::DescriptorSetAllocateInfo::default()
-        .descriptor_pool(out.pool)
-        .set_layouts(&layouts);
-    // SAFETY: the pool was sized for these sets.
-    let allocated = unsafe { d.allocate_descriptor_sets(&info) }.ctx("vkAllocateDescriptorSets")?;
+    let set_layout = d.own(
+        unsafe { d.create_descriptor_set_layout(&info, None) }
+            .ctx("vkCreateDescriptorSetLayout")?,
+    );
+    let set_layouts = [set_layout.raw()];
+    let info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
+    // SAFETY: valid device and info.
+    let layout =
+        d.own(unsafe { d.create_pipeline_layout(&info, None) }.ctx("vkCreatePipelineLayout")?);
+    Ok((set_layout, layout))
+}
 
-    let mut next_dispatch: BTreeMap<usize, usize> = BTreeMap::new();
-    for ((s, &set), &off) in sets.iter().zip(&allocated).zip(&offsets) {
-        let built = &mut out.built[s.built];
-        let p = built.p;
-        let pass_name = &g.passes[p].name;
-        let mut buffer_infos: Vec<[vk::DescriptorBufferInfo; 1]> = Vec::new();
-        let mut image_infos: Vec<[vk::DescriptorImageInfo; 1]> = Vec::new();
-        let mut plan_writes: Vec<(u32, vk::DescriptorType, bool, usize)> = Vec::new();
-        for &(binding, ty) in &descriptor_types[s.built] {
-            if binding == 0 {
-                buffer_infos.push([vk::DescriptorBufferInfo {
-                    buffer: uniforms.buffer,
-                    offset: off,
-                    range: (s.params.len() as u64 * 4).max(16),
-                }]);
-                plan_writes.push((0, ty, true, buffer_infos.len() - 1));
-                continue;
-            }
-            let Some(&r) = s.bound.get(binding as usize - 1) else {
-                return Err(AshError::Pass {
-                    pass: pass_name.clone(),
-                    message: format!(
-                        "the shader uses binding {binding}, beyond the pass's bindings"
-                    ),
-                });
-            };
-            match (&memory.res[r], ty) {
-                (
-                    Some(Res::Buffer { buffer, .. }),
-                    vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER,
-                ) => {
-                    buffer_infos.push([vk::DescriptorBufferInfo {
-                        buffer: *buffer,
-                        offset: 0,
-                        range: vk::WHOLE_SIZE,
-                    }]);
-                    plan_writes.push((binding, ty, true, buffer_infos.len() - 1));
-                }
-                (
-                    Some(Res::Image { view, .. }),
-                    vk::DescriptorType::SAMPLED_IMAGE | vk::DescriptorType::STORAGE_IMAGE,
-                ) => {
-                    let layout = if ty == vk::DescriptorType::STORAGE_IMAGE {
-                        vk::ImageLayout::GENERAL
-                    } else {
-                        sync.layout_in
-                            .get(&(p, r))
-                            .copied()
-                            .unwrap_or(vk::ImageLayout::GENERAL)
-                    };
-                    image_infos.push([vk::DescriptorImageInfo {
-                        sampler: vk::Sampler::null(),
-                        image_view: *view,
-                        image_layout: layout,
-                    }]);
-                    plan_writes.push((binding, ty, false, image_infos.len() - 1));
-                }
-                _ => {
-                    return Err(AshError::Pass {
-                        pass: pass_name.clone(),
-                        message: format!(
-                            "binding {binding} ({ty:?}) cannot take `{}`",
-                            g.resources[r].name
-                        ),
-                    });
-                }
-            }
+/// A compute pass: its pipeline, and its dispatches with their sets.
+fn compute_work(
+    cx: &Context<'_>,
+    prep: &Prepared<'_>,
+    module: vk::ShaderModule,
+    layout: vk::PipelineLayout,
+    index: usize,
+) -> Result<(Work, Vec<SetPlan>), AshError> {
+    let d = &cx.gpu.device;
+    let entry = entry_name(cx, prep.p, prep.def.shader().entry)?;
+    let stage = vk::PipelineShaderStageCreateInfo::default()
+        .stage(vk::ShaderStageFlags::COMPUTE)
+        .module(module)
+        .name(&entry);
+    let info = vk::ComputePipelineCreateInfo::default()
+        .stage(stage)
+        .layout(layout);
+    // SAFETY: valid module and layout.
+    let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+    let pipeline = match made {
+        Ok(p) => d.own(p[0]),
+        Err((_, e)) => {
+            let what = format!(
+                "pass `{}`: vkCreateComputePipelines",
+                cx.plan.pass_name(prep.p)
+            );
+            return Err(AshError::vk(what, e));
         }
-        let writes: Vec<vk::WriteDescriptorSet<'_>> = plan_writes
-            .iter()
-            .map(|&(binding, ty, is_buffer, i)| {
-                let w = vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(binding)
-                    .descriptor_type(ty);
-                if is_buffer {
-                    w.buffer_info(&buffer_infos[i])
-                } else {
-                    w.image_info(&image_infos[i])
-                }
+    };
+    let (launches, sets) = launches(cx, prep, index)?;
+    let dispatches = launches
+        .into_iter()
+        .map(|l| (vk::DescriptorSet::null(), l))
+        .collect();
+    Ok((
+        Work::Compute {
+            pipeline,
+            dispatches,
+        },
+        sets,
+    ))
+}
+
+/// The dispatches of a compute pass and a descriptor set for each: one per
+/// written resource (its size in words in the last parameter word) for a
+/// pass without fixed bindings, else one by the pass's dispatch rule.
+fn launches(
+    cx: &Context<'_>,
+    prep: &Prepared<'_>,
+    index: usize,
+) -> Result<(Vec<Launch>, Vec<SetPlan>), AshError> {
+    let err = |m: String| cx.pass_error(prep.p, m);
+    let max_groups = cx.gpu.props.limits.max_compute_work_group_count[0];
+    let check_groups = |groups: u64| {
+        u32::try_from(groups)
+            .ok()
+            .filter(|&n| n <= max_groups)
+            .ok_or_else(|| {
+                err(format!(
+                    "{groups} workgroups exceed the device's {max_groups} per dimension"
+                ))
             })
-            .collect();
-        // SAFETY: every info outlives the call; the set is not in use.
-        unsafe { d.update_descriptor_sets(&writes, &[]) };
-        match &mut built.work {
-            Work::Compute { dispatches, .. } => {
-                let i = next_dispatch.entry(s.built).or_default();
-                dispatches[*i].0 = set;
-                *i += 1;
+    };
+    let words_of = |r: usize| cx.instance.sizes[r].bytes.div_ceil(4);
+    let mut launches = Vec::new();
+    let mut sets = Vec::new();
+    if prep.def.bindings().is_none() {
+        let Dispatch::CoverWrites { words_per_group } = prep.def.dispatch() else {
+            return Err(err(
+                "a pass without fixed bindings must dispatch CoverWrites".into(),
+            ));
+        };
+        for (_, r, _) in &prep.bindings {
+            let words = words_of(*r);
+            let mut params = prep.params.clone();
+            if let Some(last) = params.last_mut() {
+                *last = u32::try_from(words).map_err(|_| err(format!("{words} words to clear")))?;
             }
-            Work::Raster { set: slot, .. } => *slot = set,
+            let groups = check_groups(words.div_ceil(u64::from(words_per_group.max(1))))?;
+            launches.push(Launch::Direct(groups));
+            sets.push(SetPlan {
+                built: index,
+                params,
+                bound: vec![*r],
+            });
         }
+        return Ok((launches, sets));
     }
-    out.uniforms = Some(uniforms);
-    Ok(())
+    let is_buffer = |r: usize| matches!(cx.memory.res[r], Some(Res::Buffer { .. }));
+    let most = prep
+        .bindings
+        .iter()
+        .filter(|(_, r, _)| is_buffer(*r))
+        .map(|(_, r, _)| words_of(*r))
+        .max()
+        .unwrap_or(0);
+    let dispatch = prep.def.dispatch();
+    let launch = match (
+        dispatch.direct_groups(&cx.instance.quantities, most),
+        dispatch,
+    ) {
+        (Some(n), _) => Launch::Direct(check_groups(n)?),
+        (None, Dispatch::Indirect { binding, word }) => {
+            let r = prep
+                .bindings
+                .iter()
+                .find(|(n, _, _)| n == binding)
+                .map(|(_, r, _)| *r)
+                .ok_or_else(|| err(format!("indirect `{binding}` is not bound")))?;
+            Launch::Indirect(r, word as u64 * 4)
+        }
+        (None, _) => unreachable!("only indirect dispatches have no direct count"),
+    };
+    launches.push(launch);
+    sets.push(SetPlan {
+        built: index,
+        params: prep.params.clone(),
+        bound: prep.bindings.iter().map(|(_, r, _)| *r).collect(),
+    });
+    Ok((launches, sets))
 }

@@ -15,9 +15,11 @@ use crate::barriers::{Barrier, SyncPlan, Target};
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
 use crate::memory::{Memory, Res, full_range};
-use crate::pipelines::{Launch, Pipelines, Work};
+use crate::owned::{Device, Owned};
+use crate::pipelines::{Built, Launch, Pipelines, Work};
 use crate::timing::Timestamps;
 use ash::vk;
+use std::sync::Arc;
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::{Plan, Queue};
 use strandgraph_passes::draw::{ColorLoad, DepthLoad};
@@ -43,9 +45,10 @@ pub(crate) struct Lane {
     /// Backend queue index.
     pub queue: usize,
     pub passes: Vec<PassId>,
+    /// Command buffers from `pool`, freed with it.
     pub batches: Vec<Batch>,
-    pub semaphore: vk::Semaphore,
-    pool: vk::CommandPool,
+    pub semaphore: Owned<vk::Semaphore>,
+    pool: Owned<vk::CommandPool>,
 }
 
 impl Lane {
@@ -60,25 +63,27 @@ pub(crate) struct Lanes {
     pub lane_of: Vec<usize>,
 }
 
-impl Lanes {
-    pub fn destroy(&mut self, d: &ash::Device) {
-        for lane in self.lanes.drain(..) {
-            // SAFETY: the device is idle; command buffers go with their pool.
-            unsafe {
-                d.destroy_command_pool(lane.pool, None);
-                d.destroy_semaphore(lane.semaphore, None);
-            }
-        }
-    }
-}
-
-pub(crate) fn timeline(d: &ash::Device, what: &str) -> Result<vk::Semaphore, AshError> {
+/// A timeline semaphore starting at 0.
+pub(crate) fn timeline(d: &Arc<Device>, what: &str) -> Result<Owned<vk::Semaphore>, AshError> {
     let mut ty = vk::SemaphoreTypeCreateInfo::default()
         .semaphore_type(vk::SemaphoreType::TIMELINE)
         .initial_value(0);
     let info = vk::SemaphoreCreateInfo::default().push_next(&mut ty);
     // SAFETY: valid device and info.
-    unsafe { d.create_semaphore(&info, None) }.ctx(what)
+    Ok(d.own(unsafe { d.create_semaphore(&info, None) }.ctx(what)?))
+}
+
+/// A command pool of queue family `family`.
+pub(crate) fn command_pool(
+    d: &Arc<Device>,
+    family: u32,
+    flags: vk::CommandPoolCreateFlags,
+) -> Result<Owned<vk::CommandPool>, AshError> {
+    let info = vk::CommandPoolCreateInfo::default()
+        .flags(flags)
+        .queue_family_index(family);
+    // SAFETY: valid device and info.
+    Ok(d.own(unsafe { d.create_command_pool(&info, None) }.ctx("vkCreateCommandPool")?))
 }
 
 /// Splits the plan's passes into lanes per backend queue and batches.
@@ -87,43 +92,18 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
     let g = &plan.graph;
     let mut lane_of = vec![usize::MAX; g.passes.len()];
     let mut lanes: Vec<Lane> = Vec::new();
-    let mut out = Lanes {
-        lanes: Vec::new(),
-        lane_of: Vec::new(),
-    };
     for &p in &plan.order {
         let q = backend_queue(g.passes[p].queue, has_compute);
         let l = match lanes.iter().position(|l| l.queue == q) {
             Some(l) => l,
             None => {
-                let info =
-                    vk::CommandPoolCreateInfo::default().queue_family_index(gpu.queues[q].family);
-                // SAFETY: valid device and info.
-                let pool = unsafe { gpu.device.create_command_pool(&info, None) };
-                let pool = match pool {
-                    Ok(pool) => pool,
-                    Err(e) => {
-                        out.lanes = lanes;
-                        out.destroy(&gpu.device);
-                        return Err(AshError::vk("vkCreateCommandPool", e));
-                    }
-                };
-                let semaphore = match timeline(&gpu.device, "timeline semaphore") {
-                    Ok(s) => s,
-                    Err(e) => {
-                        // SAFETY: unused pool.
-                        unsafe { gpu.device.destroy_command_pool(pool, None) };
-                        out.lanes = lanes;
-                        out.destroy(&gpu.device);
-                        return Err(e);
-                    }
-                };
+                let family = gpu.queues[q].family;
                 lanes.push(Lane {
                     queue: q,
                     passes: Vec::new(),
                     batches: Vec::new(),
-                    semaphore,
-                    pool,
+                    pool: command_pool(&gpu.device, family, vk::CommandPoolCreateFlags::empty())?,
+                    semaphore: timeline(&gpu.device, "timeline semaphore")?,
                 });
                 lanes.len() - 1
             }
@@ -131,9 +111,31 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
         lanes[l].passes.push(p);
         lane_of[p] = l;
     }
-    // Cross-queue sync points of the plan, in backend lanes.
-    let points: Vec<(usize, usize, usize, usize)> = plan
-        .sync_points
+    let points = cross_points(plan, &lanes, &lane_of);
+    for (l, lane) in lanes.iter_mut().enumerate() {
+        lane.batches = batches(l, lane.passes.len(), &points);
+        let info = vk::CommandBufferAllocateInfo::default()
+            .command_pool(lane.pool.raw())
+            .level(vk::CommandBufferLevel::PRIMARY)
+            .command_buffer_count(lane.batches.len() as u32);
+        // SAFETY: valid pool; the buffers are freed with it.
+        let cmds = unsafe { gpu.device.allocate_command_buffers(&info) }
+            .ctx("vkAllocateCommandBuffers")?;
+        for (b, cmd) in lane.batches.iter_mut().zip(cmds) {
+            b.cmd = cmd;
+        }
+    }
+    Ok(Lanes { lanes, lane_of })
+}
+
+/// Cross-queue sync points of the plan in backend lanes:
+/// `(signalling lane, its position, waiting lane, its position)`.
+fn cross_points(
+    plan: &Plan,
+    lanes: &[Lane],
+    lane_of: &[usize],
+) -> Vec<(usize, usize, usize, usize)> {
+    plan.sync_points
         .iter()
         .filter(|s| lane_of[s.after] != lane_of[s.before])
         .map(|s| {
@@ -145,54 +147,38 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
                 lanes[lb].position(s.before).unwrap_or(0),
             )
         })
-        .collect();
-    for (l, lane) in lanes.iter_mut().enumerate() {
-        let n = lane.passes.len();
-        let mut start = 0;
-        for i in 0..n {
-            let signals = points.iter().any(|&(la, pa, _, _)| la == l && pa == i);
-            let next_waits = points.iter().any(|&(_, _, lb, pb)| lb == l && pb == i + 1);
-            if signals || next_waits || i + 1 == n {
-                let mut waits: Vec<(usize, u64)> = Vec::new();
-                for &(la, pa, _, _) in points
-                    .iter()
-                    .filter(|&&(_, _, lb, pb)| lb == l && pb == start)
-                {
-                    match waits.iter_mut().find(|w| w.0 == la) {
-                        Some(w) => w.1 = w.1.max(pa as u64 + 1),
-                        None => waits.push((la, pa as u64 + 1)),
-                    }
+        .collect()
+}
+
+/// Lane `l`'s `n` passes cut into batches: a batch ends after a pass another
+/// lane waits for, and before a pass that waits.
+fn batches(l: usize, n: usize, points: &[(usize, usize, usize, usize)]) -> Vec<Batch> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for i in 0..n {
+        let signals = points.iter().any(|&(la, pa, _, _)| la == l && pa == i);
+        let next_waits = points.iter().any(|&(_, _, lb, pb)| lb == l && pb == i + 1);
+        if signals || next_waits || i + 1 == n {
+            let mut waits: Vec<(usize, u64)> = Vec::new();
+            for &(la, pa, _, _) in points
+                .iter()
+                .filter(|&&(_, _, lb, pb)| lb == l && pb == start)
+            {
+                match waits.iter_mut().find(|w| w.0 == la) {
+                    Some(w) => w.1 = w.1.max(pa as u64 + 1),
+                    None => waits.push((la, pa as u64 + 1)),
                 }
-                lane.batches.push(Batch {
-                    cmd: vk::CommandBuffer::null(),
-                    first: start,
-                    last: i,
-                    waits,
-                });
-                start = i + 1;
             }
-        }
-        let info = vk::CommandBufferAllocateInfo::default()
-            .command_pool(lane.pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(lane.batches.len() as u32);
-        // SAFETY: valid pool.
-        let cmds = unsafe { gpu.device.allocate_command_buffers(&info) };
-        let cmds = match cmds {
-            Ok(c) => c,
-            Err(e) => {
-                out.lanes = std::mem::take(&mut lanes);
-                out.destroy(&gpu.device);
-                return Err(AshError::vk("vkAllocateCommandBuffers", e));
-            }
-        };
-        for (b, cmd) in lane.batches.iter_mut().zip(cmds) {
-            b.cmd = cmd;
+            out.push(Batch {
+                cmd: vk::CommandBuffer::null(),
+                first: start,
+                last: i,
+                waits,
+            });
+            start = i + 1;
         }
     }
-    out.lanes = lanes;
-    out.lane_of = lane_of;
-    Ok(out)
+    out
 }
 
 /// Converts barriers to Vulkan and records them in one `vkCmdPipelineBarrier2`.
@@ -227,7 +213,7 @@ pub(crate) fn record_barriers(
                             .dst_access_mask(b.dst.access)
                             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .buffer(*buffer)
+                            .buffer(buffer.raw())
                             .offset(0)
                             .size(vk::WHOLE_SIZE),
                     );
@@ -245,7 +231,7 @@ pub(crate) fn record_barriers(
                             .new_layout(new)
                             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .image(*image)
+                            .image(image.raw())
                             .subresource_range(full_range(res.aspect(), extent[2])),
                     );
                 }
@@ -272,13 +258,13 @@ pub(crate) fn record_all(
 ) -> Result<(), AshError> {
     let d = &gpu.device;
     for lane in &lanes.lanes {
-        let pool = timestamps.pools[lane.queue];
+        let pool = timestamps.pool(lane.queue);
         for batch in &lane.batches {
             let cmd = batch.cmd;
             let begin = vk::CommandBufferBeginInfo::default();
             // SAFETY: a fresh command buffer from this lane's pool.
             unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
-            if let Some((qp, _)) = pool {
+            if let Some(qp) = pool {
                 let first = 2 * batch.first as u32;
                 let count = 2 * (batch.last - batch.first + 1) as u32;
                 // SAFETY: outside any render pass.
@@ -298,22 +284,14 @@ pub(crate) fn record_all(
                 record_barriers(d, cmd, &sync.before[p], memory);
                 // SAFETY: recording; handles live for the session.
                 unsafe {
-                    if let Some((qp, _)) = pool {
-                        d.cmd_write_timestamp2(
-                            cmd,
-                            vk::PipelineStageFlags2::TOP_OF_PIPE,
-                            qp,
-                            2 * i as u32,
-                        );
+                    if let Some(qp) = pool {
+                        let top = vk::PipelineStageFlags2::TOP_OF_PIPE;
+                        d.cmd_write_timestamp2(cmd, top, qp, 2 * i as u32);
                     }
-                    record_work(d, cmd, built.layout, &built.work, memory, sync, p)?;
-                    if let Some((qp, _)) = pool {
-                        d.cmd_write_timestamp2(
-                            cmd,
-                            vk::PipelineStageFlags2::BOTTOM_OF_PIPE,
-                            qp,
-                            2 * i as u32 + 1,
-                        );
+                    record_work(d, cmd, built, memory, sync);
+                    if let Some(qp) = pool {
+                        let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
+                        d.cmd_write_timestamp2(cmd, bottom, qp, 2 * i as u32 + 1);
                     }
                 }
                 record_barriers(d, cmd, &sync.after[p], memory);
@@ -330,26 +308,19 @@ pub(crate) fn record_all(
 unsafe fn record_work(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
-    layout: vk::PipelineLayout,
-    work: &Work,
+    built: &Built,
     memory: &Memory,
     sync: &SyncPlan,
-    p: PassId,
-) -> Result<(), AshError> {
-    let layout_of = |r: usize| {
-        sync.layout_in
-            .get(&(p, r))
-            .copied()
-            .unwrap_or(vk::ImageLayout::GENERAL)
-    };
+) {
+    let layout = built.layout.raw();
     // SAFETY: per the function's contract.
     unsafe {
-        match work {
+        match &built.work {
             Work::Compute {
                 pipeline,
                 dispatches,
             } => {
-                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, *pipeline);
+                d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline.raw());
                 for (set, launch) in dispatches {
                     d.cmd_bind_descriptor_sets(
                         cmd,
@@ -363,106 +334,149 @@ unsafe fn record_work(
                         Launch::Direct(n) => d.cmd_dispatch(cmd, n, 1, 1),
                         Launch::Indirect(r, offset) => {
                             if let Some(Res::Buffer { buffer, .. }) = &memory.res[r] {
-                                d.cmd_dispatch_indirect(cmd, *buffer, offset);
+                                d.cmd_dispatch_indirect(cmd, buffer.raw(), offset);
                             }
                         }
                     }
                 }
             }
-            Work::Raster {
-                pipelines,
-                set,
-                color,
-                depth,
-                state,
-                vertices,
-                extent,
-            } => {
-                let view = |r: usize| match &memory.res[r] {
-                    Some(Res::Image { view, .. }) => *view,
-                    _ => vk::ImageView::null(),
-                };
-                let colors: Vec<vk::RenderingAttachmentInfo<'_>> = color
-                    .iter()
-                    .map(|&r| {
-                        let (op, clear) = match state.color_load {
-                            ColorLoad::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
-                            ColorLoad::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
-                        };
-                        vk::RenderingAttachmentInfo::default()
-                            .image_view(view(r))
-                            .image_layout(layout_of(r))
-                            .load_op(op)
-                            .store_op(vk::AttachmentStoreOp::STORE)
-                            .clear_value(vk::ClearValue {
-                                color: vk::ClearColorValue { float32: clear },
-                            })
-                    })
-                    .collect();
-                let depth_info = depth.map(|r| {
-                    let (op, clear) = match state.depth_load {
-                        DepthLoad::Load => (vk::AttachmentLoadOp::LOAD, 1.0),
-                        DepthLoad::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
-                    };
-                    vk::RenderingAttachmentInfo::default()
-                        .image_view(view(r))
-                        .image_layout(layout_of(r))
-                        .load_op(op)
-                        .store_op(vk::AttachmentStoreOp::STORE)
-                        .clear_value(vk::ClearValue {
-                            depth_stencil: vk::ClearDepthStencilValue {
-                                depth: clear,
-                                stencil: 0,
-                            },
-                        })
-                });
-                let area = vk::Rect2D {
-                    offset: vk::Offset2D { x: 0, y: 0 },
-                    extent: vk::Extent2D {
-                        width: extent[0],
-                        height: extent[1],
-                    },
-                };
-                let mut info = vk::RenderingInfo::default()
-                    .render_area(area)
-                    .layer_count(1)
-                    .color_attachments(&colors);
-                if let Some(di) = depth_info.as_ref() {
-                    info = info.depth_attachment(di);
-                }
-                d.cmd_begin_rendering(cmd, &info);
-                // WGSL's clip space has y up: a negative-height viewport
-                // (Vulkan 1.1) flips it, as wgpu-hal does.
-                d.cmd_set_viewport(
-                    cmd,
-                    0,
-                    &[vk::Viewport {
-                        x: 0.0,
-                        y: extent[1] as f32,
-                        width: extent[0] as f32,
-                        height: -(extent[1] as f32),
-                        min_depth: 0.0,
-                        max_depth: 1.0,
-                    }],
-                );
-                d.cmd_set_scissor(cmd, 0, &[area]);
-                for pipeline in pipelines {
-                    d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, *pipeline);
-                    d.cmd_bind_descriptor_sets(
-                        cmd,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        layout,
-                        0,
-                        &[*set],
-                        &[],
-                    );
-                    if *vertices > 0 {
-                        d.cmd_draw(cmd, *vertices, 1, 0, 0);
-                    }
-                }
-                d.cmd_end_rendering(cmd);
-            }
+            Work::Raster { .. } => record_raster(d, cmd, built, memory, sync),
         }
     }
-    Ok(())
+}
+
+/// The attachment infos of a raster pass, in the layouts the pass finds
+/// them in: colour ones, and the depth one.
+fn attachment_infos(
+    work: &Work,
+    memory: &Memory,
+    layout_of: &dyn Fn(usize) -> vk::ImageLayout,
+) -> (
+    Vec<vk::RenderingAttachmentInfo<'static>>,
+    Option<vk::RenderingAttachmentInfo<'static>>,
+) {
+    let Work::Raster {
+        color,
+        depth,
+        state,
+        ..
+    } = work
+    else {
+        return (Vec::new(), None);
+    };
+    let view = |r: usize| match &memory.res[r] {
+        Some(Res::Image { view, .. }) => view.raw(),
+        _ => vk::ImageView::null(),
+    };
+    let colors = color
+        .iter()
+        .map(|&r| {
+            let (op, clear) = match state.color_load {
+                ColorLoad::Load => (vk::AttachmentLoadOp::LOAD, [0.0; 4]),
+                ColorLoad::Clear(c) => (vk::AttachmentLoadOp::CLEAR, c),
+            };
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view(r))
+                .image_layout(layout_of(r))
+                .load_op(op)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: clear },
+                })
+        })
+        .collect();
+    let depth = depth.map(|r| {
+        let (op, clear) = match state.depth_load {
+            DepthLoad::Load => (vk::AttachmentLoadOp::LOAD, 1.0),
+            DepthLoad::Clear(v) => (vk::AttachmentLoadOp::CLEAR, v),
+        };
+        vk::RenderingAttachmentInfo::default()
+            .image_view(view(r))
+            .image_layout(layout_of(r))
+            .load_op(op)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: clear,
+                    stencil: 0,
+                },
+            })
+    });
+    (colors, depth)
+}
+
+/// # Safety
+/// `cmd` is recording and every handle is live; `built` is a raster pass.
+unsafe fn record_raster(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    built: &Built,
+    memory: &Memory,
+    sync: &SyncPlan,
+) {
+    let Work::Raster {
+        pipelines,
+        set,
+        vertices,
+        extent,
+        ..
+    } = &built.work
+    else {
+        return;
+    };
+    let layout_of = |r: usize| {
+        sync.layout_in
+            .get(&(built.p, r))
+            .copied()
+            .unwrap_or(vk::ImageLayout::GENERAL)
+    };
+    let (colors, depth) = attachment_infos(&built.work, memory, &layout_of);
+    let area = vk::Rect2D {
+        offset: vk::Offset2D { x: 0, y: 0 },
+        extent: vk::Extent2D {
+            width: extent[0],
+            height: extent[1],
+        },
+    };
+    let mut info = vk::RenderingInfo::default()
+        .render_area(area)
+        .layer_count(1)
+        .color_attachments(&colors);
+    if let Some(di) = depth.as_ref() {
+        info = info.depth_attachment(di);
+    }
+    // SAFETY: per the function's contract.
+    unsafe {
+        d.cmd_begin_rendering(cmd, &info);
+        // WGSL's clip space has y up: a negative-height viewport
+        // (Vulkan 1.1) flips it, as wgpu-hal does.
+        d.cmd_set_viewport(
+            cmd,
+            0,
+            &[vk::Viewport {
+                x: 0.0,
+                y: extent[1] as f32,
+                width: extent[0] as f32,
+                height: -(extent[1] as f32),
+                min_depth: 0.0,
+                max_depth: 1.0,
+            }],
+        );
+        d.cmd_set_scissor(cmd, 0, &[area]);
+        for pipeline in pipelines {
+            d.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline.raw());
+            d.cmd_bind_descriptor_sets(
+                cmd,
+                vk::PipelineBindPoint::GRAPHICS,
+                built.layout.raw(),
+                0,
+                &[*set],
+                &[],
+            );
+            if *vertices > 0 {
+                d.cmd_draw(cmd, *vertices, 1, 0, 0);
+            }
+        }
+        d.cmd_end_rendering(cmd);
+    }
 }

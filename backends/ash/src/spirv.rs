@@ -171,11 +171,11 @@ fn capability_name(_known: &[spv::Capability], raw: u32) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use strandgraph_passes::wgsl::{Shaders, default_dir};
+    use strandgraph_passes::wgsl::Shaders;
 
     #[test]
     fn clear_translates_with_a_uniform_and_a_storage_buffer() {
-        let mut shaders = Shaders::load(&default_dir()).unwrap();
+        let mut shaders = Shaders::embedded().unwrap();
         let composed = shaders.compose("common/clear.wgsl").unwrap();
         let entry = composed.module.entry_points[0].name.clone();
         let s = translate(
@@ -199,7 +199,7 @@ mod tests {
 
     #[test]
     fn a_capability_the_device_lacks_names_the_pass() {
-        let mut shaders = Shaders::load(&default_dir()).unwrap();
+        let mut shaders = Shaders::embedded().unwrap();
         let composed = shaders.compose("kulikov/lod.wgsl").unwrap();
         let entry = composed.module.entry_points[0].name.clone();
         // Float64 withheld.

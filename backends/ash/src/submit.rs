@@ -11,17 +11,34 @@
 
 use crate::barriers::Scope;
 use crate::error::{AshError, VkContext};
-use crate::memory::{Res, full_range};
 use crate::session::{Frame, Session};
 use crate::timing::PassTiming;
 use ash::vk;
-use strandgraph_graph::LifetimeClass;
 use strandgraph_passes::upload::Upload;
 
 impl Session {
     /// Uploads `inputs` (imported resources every frame, history resources on
     /// the first) and runs one frame; returns its per-pass GPU times.
     pub fn run(&mut self, inputs: &Upload) -> Result<Frame, AshError> {
+        self.stage_inputs(inputs)?;
+        let prologue = self.record_prologue(inputs)?;
+        self.submit_prologue(prologue)?;
+        self.submit_batches()?;
+        self.frames += 1;
+        let t0 = std::time::Instant::now();
+        self.wait_frame("the frame")?;
+        tracing::debug!(ms = t0.elapsed().as_secs_f64() * 1e3, "frame completed");
+        for (&r, &l) in &self.sync.last_layout {
+            self.layouts.insert(r, l);
+        }
+        let timings = self.collect_timings()?;
+        self.gpu.check("the frame")?;
+        self.timings = timings.clone();
+        Ok(Frame { timings })
+    }
+
+    /// Copies the given inputs into the staging buffer.
+    fn stage_inputs(&self, inputs: &Upload) -> Result<(), AshError> {
         let g = &self.plan.graph;
         for (name, words) in &inputs.resources {
             let Some(r) = g.resource_id(name) else {
@@ -43,75 +60,83 @@ impl Session {
             }
             self.staging.write(at, words);
         }
-        let f = self.frames;
-        let prologue = self.record_prologue(inputs)?;
-        let d = &self.gpu.device;
-        let gq = self.gpu.queues[0].queue;
+        Ok(())
+    }
 
-        // The prologue waits for the previous frame on every lane.
-        let mut waits: Vec<vk::SemaphoreSubmitInfo<'_>> = Vec::new();
-        if f > 0 {
-            for lane in &self.lanes.lanes {
-                waits.push(
-                    vk::SemaphoreSubmitInfo::default()
-                        .semaphore(lane.semaphore)
-                        .value((f - 1) * self.stride + lane.passes.len() as u64)
-                        .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS),
-                );
-            }
-        }
-        let signal = [vk::SemaphoreSubmitInfo::default()
-            .semaphore(self.upload_semaphore)
-            .value(f + 1)
-            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+    /// A wait for (or signal of) `value` on `semaphore`, covering all commands.
+    pub(crate) fn at(semaphore: vk::Semaphore, value: u64) -> vk::SemaphoreSubmitInfo<'static> {
+        vk::SemaphoreSubmitInfo::default()
+            .semaphore(semaphore)
+            .value(value)
+            .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+    }
+
+    /// Waits for every lane's last value of the last frame (none before the first).
+    pub(crate) fn after_last_frame(&self) -> Vec<vk::SemaphoreSubmitInfo<'static>> {
+        let Some(f) = self.frames.checked_sub(1) else {
+            return Vec::new();
+        };
+        self.lanes
+            .lanes
+            .iter()
+            .map(|lane| {
+                let last = f * self.stride + lane.passes.len() as u64;
+                Self::at(lane.semaphore.raw(), last)
+            })
+            .collect()
+    }
+
+    /// Submits the prologue: after every lane's previous frame; signals the
+    /// upload semaphore with `frame + 1`.
+    fn submit_prologue(&self, prologue: vk::CommandBuffer) -> Result<(), AshError> {
+        let waits = self.after_last_frame();
+        let signal = [Self::at(self.upload_semaphore.raw(), self.frames + 1)];
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(prologue)];
         let submit = vk::SubmitInfo2::default()
             .wait_semaphore_infos(&waits)
             .command_buffer_infos(&cmds)
             .signal_semaphore_infos(&signal);
+        let gq = self.gpu.queues[0].queue;
         // SAFETY: recorded command buffer; semaphores live.
-        unsafe { d.queue_submit2(gq, &[submit], vk::Fence::null()) }
-            .ctx("vkQueueSubmit2 (upload)")?;
+        unsafe {
+            self.gpu
+                .device
+                .queue_submit2(gq, &[submit], vk::Fence::null())
+        }
+        .ctx("vkQueueSubmit2 (upload)")
+    }
 
-        // Batches ordered by their first pass in plan order: a signal's
-        // batch ends at or before the pass its wait starts with.
+    /// Submits every batch of the frame, ordered by their first pass in plan
+    /// order: a signal's batch ends at or before the pass its wait starts
+    /// with, so every signal is submitted before its wait.
+    fn submit_batches(&self) -> Result<(), AshError> {
+        let f = self.frames;
         let pos = |p| self.plan.position(p).unwrap_or(usize::MAX);
         let mut order: Vec<(usize, usize)> = Vec::new();
         for (l, lane) in self.lanes.lanes.iter().enumerate() {
-            for b in 0..lane.batches.len() {
-                order.push((l, b));
-            }
+            order.extend((0..lane.batches.len()).map(|b| (l, b)));
         }
         order.sort_by_key(|&(l, b)| {
-            pos(self.lanes.lanes[l].passes[self.lanes.lanes[l].batches[b].first])
+            let lane = &self.lanes.lanes[l];
+            pos(lane.passes[lane.batches[b].first])
         });
         for (l, b) in order {
             let lane = &self.lanes.lanes[l];
             let batch = &lane.batches[b];
+            // ALL_COMMANDS: the plan's happens-before chains run through
+            // lane order after the wait (schedule.rs).
             let mut waits: Vec<vk::SemaphoreSubmitInfo<'_>> = batch
                 .waits
                 .iter()
                 .map(|&(other, k)| {
-                    // ALL_COMMANDS: the plan's happens-before chains run
-                    // through lane order after the wait (schedule.rs).
-                    vk::SemaphoreSubmitInfo::default()
-                        .semaphore(self.lanes.lanes[other].semaphore)
-                        .value(f * self.stride + k)
-                        .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
+                    Self::at(self.lanes.lanes[other].semaphore.raw(), f * self.stride + k)
                 })
                 .collect();
             if b == 0 {
-                waits.push(
-                    vk::SemaphoreSubmitInfo::default()
-                        .semaphore(self.upload_semaphore)
-                        .value(f + 1)
-                        .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS),
-                );
+                waits.push(Self::at(self.upload_semaphore.raw(), f + 1));
             }
-            let signal = [vk::SemaphoreSubmitInfo::default()
-                .semaphore(lane.semaphore)
-                .value(f * self.stride + batch.last as u64 + 1)
-                .stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+            let last = f * self.stride + batch.last as u64 + 1;
+            let signal = [Self::at(lane.semaphore.raw(), last)];
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(batch.cmd)];
             let submit = vk::SubmitInfo2::default()
                 .wait_semaphore_infos(&waits)
@@ -119,20 +144,14 @@ impl Session {
                 .signal_semaphore_infos(&signal);
             let queue = self.gpu.queues[lane.queue].queue;
             // SAFETY: recorded command buffers; the previous frame completed.
-            unsafe { d.queue_submit2(queue, &[submit], vk::Fence::null()) }
-                .ctx("vkQueueSubmit2")?;
+            unsafe {
+                self.gpu
+                    .device
+                    .queue_submit2(queue, &[submit], vk::Fence::null())
+            }
+            .ctx("vkQueueSubmit2")?;
         }
-        self.frames += 1;
-        let t0 = std::time::Instant::now();
-        self.wait_frame("the frame")?;
-        tracing::debug!(ms = t0.elapsed().as_secs_f64() * 1e3, "frame completed");
-        for (&r, &l) in &self.sync.last_layout {
-            self.layouts.insert(r, l);
-        }
-        let timings = self.collect_timings()?;
-        self.gpu.check("the frame")?;
-        self.timings = timings.clone();
-        Ok(Frame { timings })
+        Ok(())
     }
 
     /// Waits on the host for every lane's last value of the last frame.
@@ -141,7 +160,8 @@ impl Session {
             return Ok(());
         }
         let f = self.frames - 1;
-        let semaphores: Vec<vk::Semaphore> = self.lanes.lanes.iter().map(|l| l.semaphore).collect();
+        let semaphores: Vec<vk::Semaphore> =
+            self.lanes.lanes.iter().map(|l| l.semaphore.raw()).collect();
         let values: Vec<u64> = self
             .lanes
             .lanes
@@ -228,216 +248,6 @@ impl Session {
             });
         }
         Ok(out)
-    }
-
-    /// Records the frame's upload prologue into a fresh command buffer.
-    fn record_prologue(&mut self, inputs: &Upload) -> Result<vk::CommandBuffer, AshError> {
-        let d = &self.gpu.device;
-        let g = &self.plan.graph;
-        let first_frame = self.frames == 0;
-        // SAFETY: the previous frame (and its prologue) completed: nothing
-        // from this pool is pending.
-        unsafe { d.reset_command_pool(self.util_pool, vk::CommandPoolResetFlags::empty()) }
-            .ctx("vkResetCommandPool")?;
-        let info = vk::CommandBufferAllocateInfo::default()
-            .command_pool(self.util_pool)
-            .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(1);
-        // SAFETY: valid pool.
-        let cmd = unsafe { d.allocate_command_buffers(&info) }.ctx("vkAllocateCommandBuffers")?[0];
-        let begin = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-        // SAFETY: fresh command buffer.
-        unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
-        let wait_all = Scope {
-            stages: vk::PipelineStageFlags2::ALL_COMMANDS,
-            access: vk::AccessFlags2::NONE,
-        };
-        let copy_write = Scope {
-            stages: vk::PipelineStageFlags2::COPY | vk::PipelineStageFlags2::CLEAR,
-            access: vk::AccessFlags2::TRANSFER_WRITE,
-        };
-        let everything = Scope {
-            stages: vk::PipelineStageFlags2::ALL_COMMANDS,
-            access: vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
-        };
-        let mut to_dst = Vec::new();
-        let mut buffer_work = Vec::new();
-        let mut image_work = Vec::new();
-        for (&r, &at) in &self.staging_at {
-            let res = &g.resources[r];
-            let given = inputs.resources.get(&res.name).map(|w| w.len() as u64 * 4);
-            let history = res.decl.lifetime() == LifetimeClass::History;
-            let upload = given.filter(|_| first_frame || !history);
-            match &self.memory.res[r] {
-                Some(Res::Buffer { buffer, size, .. }) => {
-                    buffer_work.push((*buffer, *size, at, upload));
-                }
-                Some(res_img @ Res::Image { image, extent, .. }) => {
-                    let old = self
-                        .layouts
-                        .get(&r)
-                        .copied()
-                        .unwrap_or(vk::ImageLayout::UNDEFINED);
-                    let range = full_range(res_img.aspect(), extent[2]);
-                    if first_frame || upload.is_some() {
-                        to_dst.push(image_barrier(
-                            *image,
-                            range,
-                            if first_frame {
-                                vk::ImageLayout::UNDEFINED
-                            } else {
-                                old
-                            },
-                            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                            wait_all,
-                            copy_write,
-                        ));
-                    }
-                    image_work.push((r, *image, range, *extent, res_img.aspect(), at, upload, old));
-                }
-                None => {}
-            }
-        }
-        let cmd_barrier = |images: &[vk::ImageMemoryBarrier2<'_>],
-                           global: &[vk::MemoryBarrier2<'_>]| {
-            if images.is_empty() && global.is_empty() {
-                return;
-            }
-            let info = vk::DependencyInfo::default()
-                .image_memory_barriers(images)
-                .memory_barriers(global);
-            // SAFETY: recording.
-            unsafe { d.cmd_pipeline_barrier2(cmd, &info) };
-        };
-        // Everything the previous frame did is done (semaphore waits with
-        // ALL_COMMANDS); the copies follow that.
-        let start = [vk::MemoryBarrier2::default()
-            .src_stage_mask(wait_all.stages)
-            .dst_stage_mask(copy_write.stages)
-            .dst_access_mask(copy_write.access)];
-        cmd_barrier(&to_dst, &start);
-        // First frame: zero-fill (wgpu and the CPU backend start from zeros).
-        if first_frame {
-            for &(buffer, size, _, _) in &buffer_work {
-                // SAFETY: recording; size is a multiple of 4.
-                unsafe { d.cmd_fill_buffer(cmd, buffer, 0, size, 0) };
-            }
-            for &(_, image, range, _, aspect, _, _, _) in &image_work {
-                // SAFETY: recording; the image is in TRANSFER_DST_OPTIMAL.
-                unsafe {
-                    if aspect == vk::ImageAspectFlags::DEPTH {
-                        d.cmd_clear_depth_stencil_image(
-                            cmd,
-                            image,
-                            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                            &vk::ClearDepthStencilValue {
-                                depth: 0.0,
-                                stencil: 0,
-                            },
-                            &[range],
-                        );
-                    } else {
-                        d.cmd_clear_color_image(
-                            cmd,
-                            image,
-                            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                            &vk::ClearColorValue { uint32: [0; 4] },
-                            &[range],
-                        );
-                    }
-                }
-            }
-            let after_clear = [vk::MemoryBarrier2::default()
-                .src_stage_mask(copy_write.stages)
-                .src_access_mask(copy_write.access)
-                .dst_stage_mask(copy_write.stages)
-                .dst_access_mask(copy_write.access)];
-            cmd_barrier(&[], &after_clear);
-        }
-        for &(buffer, _, at, upload) in &buffer_work {
-            if let Some(bytes) = upload.filter(|&b| b > 0) {
-                let region = vk::BufferCopy {
-                    src_offset: at,
-                    dst_offset: 0,
-                    size: bytes,
-                };
-                // SAFETY: recording; in bounds (checked in `run`).
-                unsafe { d.cmd_copy_buffer(cmd, self.staging.buffer, buffer, &[region]) };
-            }
-        }
-        let mut to_first = Vec::new();
-        for &(r, image, range, extent, aspect, at, upload, old) in &image_work {
-            let first = self
-                .sync
-                .first_layout
-                .get(&r)
-                .copied()
-                .unwrap_or(vk::ImageLayout::GENERAL);
-            if let Some(bytes) = upload.filter(|&b| b > 0) {
-                let texel = match &self.memory.res[r] {
-                    Some(Res::Image { texel_bytes, .. }) => u64::from(*texel_bytes),
-                    _ => 4,
-                };
-                let row = u64::from(extent[0]) * texel;
-                let rows = (bytes.div_ceil(row.max(1)))
-                    .min(u64::from(extent[1]) * u64::from(extent[2]))
-                    as u32;
-                // Whole rows given: copy them (CPU layout: rows of texels, layers after each other).
-                let layers = (rows / extent[1].max(1)).max(u32::from(rows > 0));
-                let height = if layers > 1 {
-                    extent[1]
-                } else {
-                    rows.min(extent[1])
-                };
-                let region = vk::BufferImageCopy {
-                    buffer_offset: at,
-                    buffer_row_length: 0,
-                    buffer_image_height: 0,
-                    image_subresource: vk::ImageSubresourceLayers {
-                        aspect_mask: aspect,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: layers.min(extent[2]),
-                    },
-                    image_offset: vk::Offset3D::default(),
-                    image_extent: vk::Extent3D {
-                        width: extent[0],
-                        height,
-                        depth: 1,
-                    },
-                };
-                // SAFETY: recording; the image is in TRANSFER_DST_OPTIMAL.
-                unsafe {
-                    d.cmd_copy_buffer_to_image(
-                        cmd,
-                        self.staging.buffer,
-                        image,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &[region],
-                    )
-                };
-            }
-            let from = if first_frame || upload.is_some() {
-                vk::ImageLayout::TRANSFER_DST_OPTIMAL
-            } else {
-                old
-            };
-            if from != first || from == vk::ImageLayout::TRANSFER_DST_OPTIMAL {
-                to_first.push(image_barrier(
-                    image,
-                    range,
-                    from,
-                    first,
-                    copy_write.or(wait_all),
-                    everything,
-                ));
-            }
-        }
-        cmd_barrier(&to_first, &[]);
-        // SAFETY: recording.
-        unsafe { d.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
-        Ok(cmd)
     }
 }
 

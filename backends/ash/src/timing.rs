@@ -4,6 +4,7 @@
 
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
+use crate::owned::Owned;
 use ash::vk;
 use strandgraph_graph::Queue;
 use strandgraph_graph::resolve::PassId;
@@ -30,7 +31,7 @@ pub struct PassTiming {
 /// Query pools of the backend's queues.
 pub(crate) struct Timestamps {
     /// Per backend queue: the pool (if the family has timestamps) and its size.
-    pub pools: Vec<Option<(vk::QueryPool, u32)>>,
+    pools: Vec<Option<(Owned<vk::QueryPool>, u32)>>,
     bits: Vec<u32>,
 }
 
@@ -50,41 +51,37 @@ impl Timestamps {
             let info = vk::QueryPoolCreateInfo::default()
                 .query_type(vk::QueryType::TIMESTAMP)
                 .query_count(count);
+            let d = &gpu.device;
             // SAFETY: valid device and info.
-            match unsafe { gpu.device.create_query_pool(&info, None) } {
-                Ok(pool) => pools.push(Some((pool, count))),
-                Err(e) => {
-                    let mut made = Timestamps { pools, bits };
-                    made.destroy(&gpu.device);
-                    return Err(AshError::vk("vkCreateQueryPool", e));
-                }
-            }
+            let pool = d.own(unsafe { d.create_query_pool(&info, None) }.ctx("vkCreateQueryPool")?);
+            pools.push(Some((pool, count)));
         }
         Ok(Self { pools, bits })
     }
 
+    /// Queue `q`'s pool, if its family has timestamps and it runs passes.
+    pub fn pool(&self, q: usize) -> Option<vk::QueryPool> {
+        self.pools[q].as_ref().map(|(pool, _)| pool.raw())
+    }
+
     /// Raw ticks of every query of queue `q`'s pool, masked to the valid bits.
     pub fn read(&self, gpu: &Gpu, q: usize) -> Result<Option<Vec<u64>>, AshError> {
-        let Some((pool, count)) = self.pools[q] else {
+        let Some((pool, count)) = &self.pools[q] else {
             return Ok(None);
         };
-        let mut ticks = vec![0u64; count as usize];
+        let mut ticks = vec![0u64; *count as usize];
         // SAFETY: the frame that wrote these queries has completed (the host
         // waited on every queue's timeline before reading).
         unsafe {
             gpu.device.get_query_pool_results(
-                pool,
+                pool.raw(),
                 0,
                 &mut ticks,
                 vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
             )
         }
         .ctx("vkGetQueryPoolResults")?;
-        let mask = if self.bits[q] >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << self.bits[q]) - 1
-        };
+        let mask = self.mask(q);
         Ok(Some(ticks.into_iter().map(|t| t & mask).collect()))
     }
 
@@ -93,13 +90,6 @@ impl Timestamps {
             u64::MAX
         } else {
             (1u64 << self.bits[q]) - 1
-        }
-    }
-
-    pub fn destroy(&mut self, d: &ash::Device) {
-        for (pool, _) in self.pools.iter_mut().filter_map(Option::take) {
-            // SAFETY: the device is idle.
-            unsafe { d.destroy_query_pool(pool, None) };
         }
     }
 }

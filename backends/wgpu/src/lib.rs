@@ -8,7 +8,7 @@
 //!   and the plan's sync points hold trivially; wgpu tracks the plan's
 //!   barriers itself.
 //!
-//! Shaders are the WGSL under `shaders/`, composed with naga_oil
+//! Shaders are the WGSL under `shaders/` (built into the binary), composed with naga_oil
 //! (`strandgraph_passes::wgsl`) and handed to wgpu as naga modules. Binding 0 is the pass's
 //! parameter block ([`PassDef::gpu_params`]), then the pass's `bindings()`
 //! in order; raster passes (`Shader.fragment`) are render pipelines whose
@@ -74,8 +74,10 @@ pub enum WgpuError {
 /// How the wgpu backend runs.
 #[derive(Debug, Clone)]
 pub struct WgpuBackend {
-    /// The WGSL directory ([`strandgraph_passes::wgsl::default_dir`]).
-    pub shader_dir: PathBuf,
+    /// Read the WGSL from this directory instead of the shaders built into
+    /// the binary ([`strandgraph_passes::wgsl::EMBEDDED`]); by default
+    /// `$STRANDGRAPH_SHADERS` ([`strandgraph_passes::wgsl::override_dir`]).
+    pub shader_dir: Option<PathBuf>,
     /// Which wgpu backends to look for an adapter on (Vulkan by default).
     pub backends: wgpu::Backends,
 }
@@ -83,7 +85,7 @@ pub struct WgpuBackend {
 impl Default for WgpuBackend {
     fn default() -> Self {
         Self {
-            shader_dir: strandgraph_passes::wgsl::default_dir(),
+            shader_dir: strandgraph_passes::wgsl::override_dir(),
             backends: wgpu::Backends::VULKAN,
         }
     }

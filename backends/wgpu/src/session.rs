@@ -51,7 +51,7 @@ impl WgpuBackend {
         plan: &Plan,
         instance: &Instance,
     ) -> Result<Session, WgpuError> {
-        let mut shaders = Shaders::load(&self.shader_dir).map_err(WgpuError::Shader)?;
+        let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
         let prepared = prepare(defs, plan, instance, &mut shaders)?;
 
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
