@@ -5,9 +5,10 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::Path;
 use strandgraph_assets::Scene;
 use strandgraph_bake::BakeOutcome;
-use strandgraph_graph::{Instance, Plan, compile_file};
+use strandgraph_graph::unroll::MODEL_INDEX;
+use strandgraph_graph::{Instance, PassRegistry, Plan, compile_file};
 use strandgraph_passes::Registry;
-use strandgraph_passes::kulikov::shade::{SelfShadow, ShadeParams};
+use strandgraph_passes::kulikov::shade::{SHADE, SelfShadow};
 use strandgraph_passes::upload::{SHADOW_SH, Upload, bake_shadow_sh, upload};
 
 pub struct Prepared {
@@ -24,6 +25,18 @@ pub fn prepare(
     graph: Option<&Path>,
     size: Option<(u32, u32)>,
 ) -> Result<Prepared> {
+    prepare_with(scene_path, graph, size, &[])
+}
+
+/// [`prepare`] with `--param` overrides ([`override_param`]) applied to the
+/// compiled plan before the scene is packed and baked for it, so a bad
+/// override fails at once and a `"Baked"` override bakes once.
+pub fn prepare_with(
+    scene_path: &Path,
+    graph: Option<&Path>,
+    size: Option<(u32, u32)>,
+    overrides: &[String],
+) -> Result<Prepared> {
     let scene = Scene::load(scene_path).map_err(|e| miette::miette!("{e}"))?;
     let (w, h) = size.unwrap_or(scene.desc.resolution);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
@@ -33,7 +46,10 @@ pub fn prepare(
         ));
     }
     let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
-    let plan = compile_file(&graph_path, &Registry, scene.grooms.len() as u32)?;
+    let mut plan = compile_file(&graph_path, &Registry, scene.grooms.len() as u32)?;
+    for spec in overrides {
+        override_param(&mut plan, spec)?;
+    }
     let mut upload = upload(&scene, w, h);
     bake_shadows(&plan, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
@@ -65,12 +81,12 @@ pub fn bake_shadows(plan: &Plan, up: &mut Upload) -> Result<Option<BakeOutcome>>
         if !plan.live[p] || !reads || pass.kind != "kulikov.shade" {
             continue;
         }
-        let params = ShadeParams::from_ron(&pass.params).map_err(|e| miette::miette!("{e}"))?;
+        let params = SHADE.params(&pass.params).map_err(|e| miette::miette!("{e}"))?;
         if params.self_shadow != SelfShadow::Baked {
             continue;
         }
         let cache = strandgraph_bake::cache_dir();
-        let outcome = bake_shadow_sh(up, &params.bake, cache.as_deref())
+        let outcome = bake_shadow_sh(up, &params.bake(), cache.as_deref())
             .map_err(|e| miette::miette!("pass `{}`: {e}", pass.name))?;
         return Ok(Some(outcome));
     }
@@ -118,13 +134,40 @@ pub fn override_param(plan: &mut Plan, spec: &str) -> Result<()> {
         ));
     }
     for p in targets {
-        let params = &mut plan.graph.passes[p].params;
-        if !matches!(params, ron::Value::Map(_)) {
-            *params = ron::Value::Map(ron::Map::new());
-        }
-        if let ron::Value::Map(m) = params {
-            m.insert(ron::Value::String(param.trim().to_string()), value.clone());
-        }
+        let pass = &mut plan.graph.passes[p];
+        let mut params = match &pass.params {
+            ron::Value::Map(m) => m.clone(),
+            _ => ron::Map::new(),
+        };
+        params.insert(ron::Value::String(param.trim().to_string()), value.clone());
+        check_override(&pass.name, &pass.kind, &params, param.trim())
+            .map_err(|e| miette::miette!("--param {spec}: {e}"))?;
+        pass.params = ron::Value::Map(params);
     }
     Ok(())
+}
+
+/// Checks a pass's parameters after an override as the graph compiler
+/// checks the file's (unknown key with the closest valid one, type, range).
+/// `model_index`, which unrolling adds to per-model passes, is the block's
+/// to set, not the command line's.
+fn check_override(
+    pass: &str,
+    kind: &str,
+    params: &ron::Map,
+    param: &str,
+) -> std::result::Result<(), String> {
+    if param == MODEL_INDEX {
+        return Err(format!(
+            "pass `{pass}`: `{param}` is set by the per-model block"
+        ));
+    }
+    let mut written = params.clone();
+    written.remove(&ron::Value::String(MODEL_INDEX.into()));
+    Registry
+        .check_params(kind, &ron::Value::Map(written))
+        .map_err(|p| {
+            let key = if p.key.is_empty() { "params".into() } else { format!("parameter `{}`", p.key) };
+            format!("pass `{pass}` ({kind}): {key}: {}", p.message)
+        })
 }

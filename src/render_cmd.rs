@@ -3,7 +3,7 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
+use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{depth_to_view, motion_image, to_linear, to_picture};
 use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
@@ -58,13 +58,8 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let t0 = Instant::now();
-    let mut p = prepare(&args.scene, args.graph.as_deref(), size)?;
-    for spec in &args.params {
-        override_param(&mut p.plan, spec)?;
-    }
-    // An override may have selected the baked self-shadowing prepare did not
-    // bake for (a no-op when it did, or when nothing selects it).
-    bake_shadows(&p.plan, &mut p.upload)?;
+    // Overrides apply before packing and baking (a `"Baked"` override bakes).
+    let p = prepare_with(&args.scene, args.graph.as_deref(), size, &args.params)?;
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",

@@ -174,3 +174,44 @@ fn scene_sizes_the_plan_and_supplies_the_graph() {
     };
     assert_ne!(mem(&text), mem(&example));
 }
+
+/// `--param` is checked like the graph's own parameters: a misspelt key
+/// fails before anything renders, naming the pass, its kind and the closest
+/// valid key; so does a value of the wrong type.
+#[test]
+fn misspelt_param_override_names_the_closest_key() {
+    let out = strandgraph(&[
+        "render",
+        "scenes/showcase.ron",
+        "--size",
+        "64x36",
+        "--param",
+        "raster.loop_flatening=false",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    for expected in [
+        "raster.loop_flatening=false",
+        "kulikov.raster",
+        "`loop_flatening`",
+        "did you mean `loop_flattening`?",
+    ] {
+        assert!(err.contains(expected), "missing `{expected}` in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+
+    let out = strandgraph(&[
+        "render",
+        "scenes/showcase.ron",
+        "--size",
+        "64x36",
+        "--param",
+        "raster.loop_flattening=3",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`loop_flattening`") && err.contains("boolean"),
+        "{err}"
+    );
+}

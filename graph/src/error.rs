@@ -14,6 +14,8 @@ pub enum ErrorKind {
     DuplicateName,
     UnknownResource,
     UnknownPassKind,
+    /// A pass parameter its kind does not take, of the wrong type, or out of range.
+    BadParam,
     /// An access the resource type cannot take (sampling a buffer), or a bad usage prefix.
     BadAccess,
     /// A transient (or atomic update) read before any pass writes it.
@@ -36,6 +38,7 @@ impl ErrorKind {
             ErrorKind::DuplicateName => "graph::duplicate_name",
             ErrorKind::UnknownResource => "graph::unknown_resource",
             ErrorKind::UnknownPassKind => "graph::unknown_pass_kind",
+            ErrorKind::BadParam => "graph::bad_param",
             ErrorKind::BadAccess => "graph::bad_access",
             ErrorKind::ReadBeforeWrite => "graph::read_before_write",
             ErrorKind::Cycle => "graph::cycle",

@@ -38,6 +38,6 @@ pub mod unroll;
 pub use error::{ErrorKind, GraphError, GraphErrors};
 pub use instance::{Instance, Quantities};
 pub use plan::{Plan, compile_file, compile_str};
-pub use registry::{AnyKind, KindList, PassRegistry};
+pub use registry::{AnyKind, KindList, ParamProblem, PassRegistry};
 pub use schema::{AccessMode, GraphDesc, LifetimeClass, Queue, Repeat, Usage};
 pub use unroll::base_name;

@@ -1,7 +1,18 @@
 //! The pass-kind registry the compiler validates against.
 //!
 //! `graph/` knows no pass: `passes/` implements [`PassRegistry`] and the
-//! compiler only asks whether a kind exists. Tests use [`KindList`].
+//! compiler only asks whether a kind exists and whether a pass's parameters
+//! suit its kind. Tests use [`KindList`].
+
+/// What is wrong with a pass's parameters.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParamProblem {
+    /// The offending key, a path inside the pass's `params` (`"tile"`), or
+    /// empty when the whole block is wrong (not a map).
+    pub key: String,
+    /// What was expected; for an unknown key, the closest valid one.
+    pub message: String,
+}
 
 /// What the compiler may ask about a pass kind.
 pub trait PassRegistry {
@@ -9,6 +20,12 @@ pub trait PassRegistry {
     fn contains(&self, kind: &str) -> bool;
     /// Every registered kind, for "did you mean" suggestions.
     fn kinds(&self) -> Vec<&str>;
+    /// Checks a pass's parameters as the graph file wrote them. The default
+    /// accepts anything (registries that know only names).
+    fn check_params(&self, kind: &str, params: &ron::Value) -> Result<(), ParamProblem> {
+        let _ = (kind, params);
+        Ok(())
+    }
 }
 
 /// A registry that is just a list of names.

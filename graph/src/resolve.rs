@@ -2,7 +2,7 @@
 //! of ids, reporting every local error (names, usages, queues, kinds, outputs).
 
 use crate::error::{ErrorKind, GraphError, GraphErrors};
-use crate::registry::{PassRegistry, suggest};
+use crate::registry::{ParamProblem, PassRegistry, suggest};
 use crate::schema::{
     AccessMode, GraphDesc, ImageFormat, PassDecl, Queue, Repeat, ResourceDecl, Usage,
 };
@@ -164,6 +164,8 @@ pub fn resolve(
                 e = e.help(format!("did you mean `{s}`?"));
             }
             errors.push(e);
+        } else if let Err(problem) = registry.check_params(&decl.kind, &decl.params) {
+            errors.push(param_error(i, decl, &problem, src, loc));
         }
         let mut bind_as = Vec::new();
         let accesses = resolve_accesses(
@@ -461,6 +463,36 @@ fn declare_versions(
         }
     }
     // Whatever is left renames something unknown; access resolution reports it.
+}
+
+/// A parameter the pass's kind rejects, at its key (an unknown key), its
+/// value (a wrong type or range), or the whole `params` (not a map).
+fn param_error(
+    pass_index: usize,
+    decl: &PassDecl,
+    problem: &ParamProblem,
+    src: &Source,
+    loc: &Locator,
+) -> GraphError {
+    let params = format!("passes[{pass_index}].params");
+    let (span, message) = if problem.key.is_empty() {
+        (loc.span(&params), format!("params: {}", problem.message))
+    } else {
+        let path = format!("{params}.{}", problem.key);
+        let span = match loc.key_span(&path) {
+            Some(key) if problem.message.starts_with("unknown") => key,
+            _ => loc.span(&path),
+        };
+        let message = format!("parameter `{}`: {}", problem.key, problem.message);
+        (span, message)
+    };
+    GraphError::new(
+        ErrorKind::BadParam,
+        src,
+        span,
+        format!("pass `{}` ({}): {message}", decl.name, decl.kind),
+    )
+    .primary("rejected by the pass kind")
 }
 
 fn verb(mode: AccessMode) -> &'static str {

@@ -207,6 +207,8 @@ fn tokenize(text: &str) -> Vec<(Tok, Span)> {
 #[derive(Debug, Default, Clone)]
 pub struct Locator {
     spans: HashMap<String, Span>,
+    /// Spans of struct field names and map keys, by the path of their value.
+    keys: HashMap<String, Span>,
 }
 
 struct Frame {
@@ -224,6 +226,7 @@ impl Locator {
     pub fn new(text: &str) -> Self {
         let toks = tokenize(text);
         let mut spans = HashMap::new();
+        let mut keys = HashMap::new();
         let mut stack: Vec<Frame> = vec![Frame {
             path: String::new(),
             next_index: 0,
@@ -237,6 +240,12 @@ impl Locator {
             match tok {
                 Tok::Word(w) | Tok::Str(w) if next_is_colon => {
                     if let Some(top) = stack.last_mut() {
+                        let path = if top.path.is_empty() {
+                            w.clone()
+                        } else {
+                            format!("{}.{w}", top.path)
+                        };
+                        keys.insert(path, *span);
                         top.pending_key = Some(w.clone());
                     }
                     i += 2;
@@ -287,7 +296,12 @@ impl Locator {
             }
             i += 1;
         }
-        Self { spans }
+        Self { spans, keys }
+    }
+
+    /// The span of the key (field name or map key) whose value is at `path`.
+    pub fn key_span(&self, path: &str) -> Option<Span> {
+        self.keys.get(path).copied()
     }
 
     /// The span of the value at `path`, or of its nearest enclosing value.
@@ -336,6 +350,8 @@ Graph(
         assert_eq!(text_at("passes[0].params.tile"), "64");
         assert_eq!(text_at("passes[0].params.flags[1]"), "false");
         assert_eq!(text_at("passes[0].reads[1]"), "\"indirect:b\"");
+        let key = Locator::new(DOC).key_span("passes[0].params.tile").unwrap();
+        assert_eq!(&DOC[key.start..key.end], "\"tile\"");
     }
 
     #[test]

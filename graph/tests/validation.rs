@@ -439,3 +439,121 @@ fn versions_order_old_readers_before_the_in_place_writer() {
             .all(|l| plan.graph.resources[l.resource].version_of.is_none())
     );
 }
+
+/// A registry whose `test.produce` takes one parameter, `tile` (a number up
+/// to 64): the compiler must report what the registry says at the key.
+struct ParamRegistry(KindList);
+
+impl strandgraph_graph::PassRegistry for ParamRegistry {
+    fn contains(&self, kind: &str) -> bool {
+        self.0.contains(kind)
+    }
+    fn kinds(&self) -> Vec<&str> {
+        self.0.kinds()
+    }
+    fn check_params(
+        &self,
+        kind: &str,
+        params: &ron::Value,
+    ) -> Result<(), strandgraph_graph::ParamProblem> {
+        let problem = |key: &str, message: &str| strandgraph_graph::ParamProblem {
+            key: key.into(),
+            message: message.into(),
+        };
+        let ron::Value::Map(m) = params else {
+            return match params {
+                ron::Value::Unit => Ok(()),
+                _ => Err(problem("", "expected a map")),
+            };
+        };
+        for (k, v) in m.iter() {
+            let ron::Value::String(k) = k else { continue };
+            match (kind, k.as_str(), v) {
+                ("test.produce", "tile", ron::Value::Number(n)) if n.into_f64() <= 64.0 => {}
+                ("test.produce", "tile", _) => return Err(problem(k, "expected a number <= 64")),
+                _ => return Err(problem(k, "unknown, did you mean `tile`?")),
+            }
+        }
+        Ok(())
+    }
+}
+
+fn expect_param_error(src: &str, names: &[&str]) -> GraphError {
+    let registry = ParamRegistry(registry());
+    let errors = compile_str("bad.ron", src, &registry, 1).expect_err("graph compiled");
+    let err = errors.first().clone();
+    assert_eq!(err.kind, ErrorKind::BadParam, "{errors}");
+    assert_eq!(err.line, marker_line(src), "wrong line for: {err}");
+    for name in names {
+        assert!(
+            err.message.contains(name),
+            "`{}` lacks `{name}`",
+            err.message
+        );
+    }
+    err
+}
+
+#[test]
+fn misspelt_param_points_at_its_key_and_names_the_closest() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "test.produce", writes: ["out"],
+             params: {
+                 "tile": 16,
+                 "tiel": 32, // <-
+             }),
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_param_error(
+        src,
+        &["`p`", "test.produce", "`tiel`", "did you mean `tile`"],
+    );
+    // At the key itself: line 8, column 18.
+    assert_eq!(e.col, 18);
+    assert!(e.to_string().starts_with("bad.ron:8:18: pass `p`"), "{e}");
+}
+
+#[test]
+fn param_out_of_range_points_at_its_value() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "test.produce", writes: ["out"],
+             params: {"tile": 128}), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_param_error(src, &["`tile`", "<= 64"]);
+    assert_eq!(e.col, 31, "{e}");
+}
+
+#[test]
+fn params_that_are_not_a_map_point_at_the_params() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [
+        Pass(name: "p", kind: "test.produce", writes: ["out"],
+             params: [1, 2]), // <-
+    ],
+    outputs: ["out"],
+)"#;
+    let e = expect_param_error(src, &["`p`", "expected a map"]);
+    assert_eq!(e.col, 22, "{e}");
+}
+
+#[test]
+fn name_only_registries_accept_any_params() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [Buffer(name: "out", size: Bytes(16), lifetime: Imported)],
+    passes: [Pass(name: "p", kind: "test.produce", writes: ["out"], params: {"anything": 1})],
+    outputs: ["out"],
+)"#;
+    compile_str("ok.ron", src, &registry(), 1).unwrap();
+}

@@ -93,31 +93,55 @@ impl Shader {
     }
 }
 
-/// A pass parameter that is missing, mistyped or out of range.
+/// A pass parameter that is unknown, mistyped or out of range; `param` is
+/// the key, or empty when the whole parameter block is wrong.
 #[derive(Debug, Clone, thiserror::Error)]
-#[error("pass kind `{kind}`: parameter `{param}`: {message}")]
+#[error("pass kind `{kind}`: {}{message}", if param.is_empty() { String::new() } else { format!("parameter `{param}`: ") })]
 pub struct ParamError {
     pub kind: &'static str,
     pub param: String,
     pub message: String,
 }
 
-/// A pass kind, defined once.
+/// Field names and byte offsets of a GPU parameter block, and its size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GpuLayout {
+    pub fields: &'static [(&'static str, usize)],
+    pub size: usize,
+}
+
+/// What backends, the compiler and tests ask of a pass kind. Pass kinds
+/// implement it through their declaration ([`crate::describe::PassKind`]);
+/// tests may implement it by hand.
 pub trait PassDef: Send + Sync {
     fn kind(&self) -> &'static str;
+    /// One line on what the pass does.
+    fn summary(&self) -> &'static str {
+        ""
+    }
+    /// Where the algorithm comes from (paper and section).
+    fn source(&self) -> &'static str {
+        ""
+    }
     /// The bindings, or `None` when the pass binds whatever the graph gives it
     /// (`common.clear` clears every resource it writes).
     fn bindings(&self) -> Option<&'static [Binding]>;
     fn workgroup_size(&self) -> u32;
     fn dispatch(&self) -> Dispatch;
     fn shader(&self) -> Shader;
+    /// Checks parameters as a graph file or `--param` wrote them: unknown
+    /// keys (including `model_index`, which only the per-model block sets),
+    /// types and ranges. The error names the key.
+    fn check_params(&self, params: &ron::Value) -> Result<(), ParamError> {
+        let _ = params;
+        Ok(())
+    }
     /// Reads the graph's parameters and returns the CPU kernel configured by them.
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError>;
-    /// The WGSL parameter block (binding 0) as 32-bit words, in the field
-    /// order of the shader's params struct: the pass's switches read from the
-    /// graph's RON (with the CPU kernel's defaults and checks) and the scene
-    /// counts the shader needs. Its length is the WGSL struct's size / 4
-    /// (`passes/tests/gpu_params.rs` checks it with naga).
+    /// The WGSL parameter block (binding 0) as 32-bit words: the pass's
+    /// `#[repr(C)]` GPU block ([`crate::describe::GpuBlock`]) built from its
+    /// parameters and the scene counts, as bytes. [`PassDef::gpu_layout`]
+    /// gives its fields (`passes/tests/wgsl.rs` checks them with naga).
     ///
     /// For a pass whose `bindings()` is `None` (`common.clear`), the GPU
     /// backends dispatch once per written resource and put that resource's
@@ -131,6 +155,10 @@ pub trait PassDef: Send + Sync {
             param: "params".into(),
             message: "the pass has no GPU parameter block yet (PassDef::gpu_params)".into(),
         })
+    }
+    /// Field names, offsets and size of the GPU parameter block.
+    fn gpu_layout(&self) -> Option<GpuLayout> {
+        None
     }
     /// The draw state of a raster pass (`shader().fragment` is `Some`);
     /// `None` for compute passes.
@@ -166,7 +194,10 @@ pub trait CpuKernel: Send + Sync {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>);
 }
 
-/// Reads typed parameters out of a pass's RON map, with defaults.
+/// Reads parameters out of a pass's RON map, with defaults, for pass
+/// definitions written by hand (tests). Pass kinds declare typed,
+/// checked parameters instead ([`crate::params::PassParams`]): this reader
+/// ignores keys nobody asks for.
 pub struct Params<'a> {
     kind: &'static str,
     map: Option<&'a ron::Map>,

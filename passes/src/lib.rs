@@ -4,8 +4,9 @@
 //! graph compiler's [`PassRegistry`]: graph files name pass kinds such as
 //! `"kulikov.raster"`, and the compiler rejects kinds not listed here.
 //!
-//! Each entry says which pipeline it belongs to and which section of which
-//! paper specifies it, so `strandgraph graph` can show where a pass comes from.
+//! Each pass kind is declared once ([`PassKind`], listed in [`PASSES`]): its
+//! interface, typed parameters, CPU kernel and GPU parameter block, and
+//! which section of which paper specifies it.
 
 // Kernels write `!(a > b)` on purpose: it rejects NaN together with the
 // failing case, as their WGSL ports do.
@@ -14,56 +15,63 @@
 pub mod backend;
 pub mod bench;
 pub mod bind;
-mod catalogue;
 pub mod common;
 pub mod contract;
+pub mod describe;
 pub mod draw;
 pub mod kulikov;
 pub mod layout;
 pub mod lipp;
+pub mod params;
 pub mod scene;
 pub mod sim;
 pub mod spirv;
 pub mod upload;
 pub mod wgsl;
 
-pub use catalogue::{KINDS, PassKind};
-pub use contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+pub use contract::{Binding, CpuKernel, Dispatch, GpuLayout, ParamError, Params, PassDef, Shader};
+pub use describe::{GpuBlock, PassKind};
 pub use draw::RasterState;
+pub use params::{Invalid, NoParams, PassParams};
 use strandgraph_graph::PassRegistry;
+use strandgraph_graph::registry::ParamProblem;
 
-/// Pass kinds that have kernels so far. A kind listed in [`KINDS`] but not
-/// here compiles in graphs; backends refuse to run it and say so.
-static DEFINITIONS: &[&dyn PassDef] = &[
-    &common::clear::Clear,
-    &scene::depth_prepass::DepthPrepass,
-    &scene::opaque::Opaque,
-    &kulikov::lod::Lod,
-    &kulikov::skin::Skin,
-    &kulikov::hiz::DepthDownsample,
-    &kulikov::cull::Cull,
-    &kulikov::tiles::TileAlloc,
-    &kulikov::sort::SortScan,
-    &kulikov::sort::Sort,
-    &kulikov::raster::Raster,
-    &kulikov::debug_resolve::DebugResolve,
-    &kulikov::density::Density,
-    &kulikov::skin_shadow::SkinShadow,
-    &kulikov::shade_sort::ShadeSort,
-    &kulikov::shade::Shade,
-    &kulikov::compose::Compose,
-    &kulikov::history::Motion,
-    &kulikov::history::StoreHistory,
-    &kulikov::pixel_motion::PixelMotion,
-    &lipp::lod::Lod,
-    &lipp::raster::Raster,
-    &lipp::dom::DomDepth,
-    &lipp::dom::DomOpacity,
-    &lipp::shade::Shade,
-    &lipp::filter::Filter,
+/// Every pass kind, one declaration each (name, citation, interface,
+/// parameters, kernels): the only list of kinds.
+pub static PASSES: &[&dyn PassDef] = &[
+    // Shared by every pipeline.
+    &common::clear::CLEAR,
+    &scene::depth_prepass::DEPTH_PREPASS,
+    &scene::opaque::OPAQUE,
+    // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
+    &kulikov::lod::LOD,
+    &kulikov::skin::SKIN,
+    &kulikov::density::DENSITY,
+    &kulikov::hiz::DEPTH_DOWNSAMPLE,
+    &kulikov::cull::CULL,
+    &kulikov::tiles::TILE_ALLOC,
+    &kulikov::sort::SORT_SCAN,
+    &kulikov::sort::SORT,
+    &kulikov::raster::RASTER,
+    &kulikov::debug_resolve::DEBUG_RESOLVE,
+    &kulikov::shade_sort::SHADE_SORT,
+    &kulikov::shade::SHADE,
+    &kulikov::compose::COMPOSE,
+    &kulikov::pixel_motion::PIXEL_MOTION,
+    &kulikov::skin_shadow::SKIN_SHADOW,
+    &kulikov::history::STORE_HISTORY,
+    &kulikov::history::MOTION,
+    // Lipp et al., deferred software rasterization of hair meshes.
+    &lipp::lod::LOD,
+    &lipp::raster::RASTER,
+    &lipp::dom::DOM_DEPTH,
+    &lipp::dom::DOM_OPACITY,
+    &lipp::shade::SHADE,
+    &lipp::filter::FILTER,
+    // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,
-    &bench::Copy,
+    &bench::COPY,
 ];
 
 /// The built-in pass kinds.
@@ -71,20 +79,20 @@ static DEFINITIONS: &[&dyn PassDef] = &[
 pub struct Registry;
 
 impl Registry {
-    pub fn get(&self, kind: &str) -> Option<&'static PassKind> {
-        KINDS.iter().find(|k| k.name == kind)
+    pub fn get(&self, kind: &str) -> Option<&'static dyn PassDef> {
+        PASSES.iter().copied().find(|d| d.kind() == kind)
     }
 }
 
 /// Where backends look up pass definitions; tests supply their own.
 pub trait Definitions: Sync {
-    /// The definition (interface, dispatch, kernels) of `kind`, if it has one yet.
+    /// The definition (interface, dispatch, kernels) of `kind`.
     fn definition(&self, kind: &str) -> Option<&dyn PassDef>;
 }
 
 impl Definitions for Registry {
     fn definition(&self, kind: &str) -> Option<&dyn PassDef> {
-        DEFINITIONS.iter().copied().find(|d| d.kind() == kind)
+        self.get(kind)
     }
 }
 
@@ -93,7 +101,16 @@ impl PassRegistry for Registry {
         self.get(kind).is_some()
     }
     fn kinds(&self) -> Vec<&str> {
-        KINDS.iter().map(|k| k.name).collect()
+        PASSES.iter().map(|d| d.kind()).collect()
+    }
+    fn check_params(&self, kind: &str, params: &ron::Value) -> Result<(), ParamProblem> {
+        let Some(def) = self.get(kind) else {
+            return Ok(()); // the compiler reports the unknown kind
+        };
+        def.check_params(params).map_err(|e| ParamProblem {
+            key: e.param,
+            message: e.message,
+        })
     }
 }
 
@@ -103,29 +120,28 @@ mod tests {
 
     #[test]
     fn names_are_unique_and_namespaced() {
-        let mut names: Vec<&str> = KINDS.iter().map(|k| k.name).collect();
+        let mut names: Vec<&str> = PASSES.iter().map(|k| k.kind()).collect();
         names.sort_unstable();
         let before = names.len();
         names.dedup();
         assert_eq!(before, names.len(), "duplicate pass kind");
-        for k in KINDS {
-            assert!(k.name.contains('.'), "{} has no pipeline prefix", k.name);
+        for k in PASSES {
             assert!(
-                !k.source.is_empty() && !k.summary.is_empty(),
+                k.kind().contains('.'),
+                "{} has no pipeline prefix",
+                k.kind()
+            );
+            assert!(
+                !k.source().is_empty() && !k.summary().is_empty(),
                 "{} is undocumented",
-                k.name
+                k.kind()
             );
         }
     }
 
     #[test]
-    fn every_definition_is_in_the_catalogue() {
-        for d in DEFINITIONS {
-            assert!(
-                Registry.get(d.kind()).is_some(),
-                "{} is defined but not catalogued",
-                d.kind()
-            );
+    fn every_definition_has_its_entry_point() {
+        for d in PASSES {
             let wgsl = concat!(env!("CARGO_MANIFEST_DIR"), "/../shaders/");
             let path = std::path::Path::new(wgsl).join(d.shader().file);
             let text = std::fs::read_to_string(&path)

@@ -6,7 +6,7 @@
 //! with a `#define_import_path` is added to one `Composer` as a composable
 //! module, and each pass's file is composed into a naga module from there.
 //!
-//! For every kind in `KINDS` that `Registry` defines:
+//! For every kind in `PASSES`:
 //! - the shader file exists, composes and validates with the capabilities
 //!   its tier allows (`capabilities_of`), no more;
 //! - the entry point exists: a compute entry with `@workgroup_size` equal to
@@ -38,7 +38,7 @@ use std::path::{Path, PathBuf};
 use strandgraph_graph::AccessMode;
 use strandgraph_passes::layout::{FrameData, LightData, ModelData, TriangleData};
 use strandgraph_passes::wgsl::{Shaders, validate};
-use strandgraph_passes::{Definitions, KINDS, PassDef, Registry};
+use strandgraph_passes::{GpuLayout, PASSES, PassDef};
 
 /// What every shader may use: subgroup operations and subgroup barriers
 /// (the Kulikov raster's request stacks, the cull's wave-aggregated atomics).
@@ -381,14 +381,11 @@ fn every_definition_has_a_valid_shader_matching_its_interface() {
     let mut composer = composer();
     let mut checked = Vec::new();
     let mut failures = Vec::new();
-    for kind in KINDS {
-        let Some(def) = Registry.definition(kind.name) else {
-            continue; // catalogued, not defined yet: backends refuse it
-        };
+    for &def in PASSES {
         let file = def.shader().file;
         match check_definition(&mut composer, def) {
-            Ok(()) => checked.push(format!("{} ({file})", kind.name)),
-            Err(e) => failures.push(format!("{} ({file}): {e}", kind.name)),
+            Ok(()) => checked.push(format!("{} ({file})", def.kind())),
+            Err(e) => failures.push(format!("{} ({file}): {e}", def.kind())),
         }
     }
     eprintln!(
@@ -556,18 +553,46 @@ fn shared_layout_field_offsets_match() {
     assert_eq!(words, vec![0, 1, 2, 3, 4, 5, 6]);
 }
 
-/// `PassDef::gpu_params` fills the WGSL parameter block at binding 0: its
-/// length in bytes is the size naga's layouter gives the uniform struct.
+/// The members of the WGSL struct `ty` as (name, byte offset).
+fn members(module: &Module, ty: naga::Handle<naga::Type>) -> Vec<(String, usize)> {
+    match &module.types[ty].inner {
+        TypeInner::Struct { members, .. } => members
+            .iter()
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+/// What differs between a pass's Rust GPU block and the WGSL struct: names,
+/// order, offsets and size. Rust fields named `_pad…` may be padding the
+/// WGSL struct leaves implicit (its size rounds up to its alignment).
+fn layout_mismatch(rust: &GpuLayout, wgsl: &[(String, usize)], wgsl_size: usize) -> Option<String> {
+    let rust_fields: Vec<(String, usize)> = rust
+        .fields
+        .iter()
+        .filter(|(name, _)| !name.starts_with("_pad") || wgsl.iter().any(|(w, _)| w == name))
+        .map(|(name, offset)| (name.to_string(), *offset))
+        .collect();
+    if rust_fields != wgsl {
+        return Some(format!(
+            "Rust fields {rust_fields:?}, WGSL members {wgsl:?}"
+        ));
+    }
+    (rust.size != wgsl_size).then(|| format!("Rust block is {} bytes, WGSL {wgsl_size}", rust.size))
+}
+
+/// `PassDef::gpu_params` fills the WGSL parameter block at binding 0: the
+/// pass's `#[repr(C)]` GPU block has the uniform struct's member names, in
+/// order, at naga's offsets, and its size; the words are that many bytes.
 #[test]
 fn gpu_params_fill_the_wgsl_parameter_block() {
     let mut composer = composer();
     let q = strandgraph_graph::Quantities::example();
     let mut failures = Vec::new();
     let mut checked = 0;
-    for kind in KINDS {
-        let Some(def) = Registry.definition(kind.name) else {
-            continue;
-        };
+    for &def in PASSES {
+        let kind = def.kind();
         let shader = def.shader();
         let source = std::fs::read_to_string(shaders_dir().join(shader.file)).unwrap();
         let (module, info) = compose(&mut composer, shader.file, &source, all_capabilities())
@@ -593,20 +618,49 @@ fn gpu_params_fill_the_wgsl_parameter_block() {
                     .is_some_and(|b| b.group == 0 && b.binding == 0)
         });
         let Some((_, var)) = block else {
-            failures.push(format!("{}: no uniform at binding 0", kind.name));
+            failures.push(format!("{kind}: no uniform at binding 0"));
             continue;
         };
         let wgsl_bytes = layouter[var.ty].size as usize;
+        let Some(layout) = def.gpu_layout() else {
+            failures.push(format!("{kind}: no GPU block layout"));
+            continue;
+        };
+        if let Some(e) = layout_mismatch(&layout, &members(&module, var.ty), wgsl_bytes) {
+            failures.push(format!("{kind}: {e}"));
+            continue;
+        }
         match def.gpu_params(&ron::Value::Unit, &q) {
             Ok(words) if words.len() * 4 == wgsl_bytes => checked += 1,
             Ok(words) => failures.push(format!(
-                "{}: gpu_params gives {} words, the WGSL block is {wgsl_bytes} bytes",
-                kind.name,
+                "{kind}: gpu_params gives {} words, the WGSL block is {wgsl_bytes} bytes",
                 words.len()
             )),
-            Err(e) => failures.push(format!("{}: {e}", kind.name)),
+            Err(e) => failures.push(format!("{kind}: {e}")),
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
-    assert!(checked > 0, "no definition was checked");
+    assert_eq!(checked, PASSES.len(), "every pass's block is checked");
+}
+
+/// The check catches a swapped field, a renamed one and a size mismatch.
+#[test]
+fn layout_mismatches_are_reported() {
+    let wgsl = vec![("a".to_string(), 0), ("b".to_string(), 4)];
+    let ok = GpuLayout {
+        fields: &[("a", 0), ("b", 4), ("_pad0", 8), ("_pad1", 12)],
+        size: 16,
+    };
+    assert_eq!(layout_mismatch(&ok, &wgsl, 16), None);
+    let swapped = GpuLayout {
+        fields: &[("b", 0), ("a", 4)],
+        size: 8,
+    };
+    assert!(layout_mismatch(&swapped, &wgsl, 8).is_some());
+    let renamed = GpuLayout {
+        fields: &[("a", 0), ("c", 4)],
+        size: 8,
+    };
+    assert!(layout_mismatch(&renamed, &wgsl, 8).is_some());
+    assert!(layout_mismatch(&ok, &wgsl, 32).is_some());
 }

@@ -15,4 +15,4 @@
 
 mod roofline;
 
-pub use roofline::{ATOMIC_MIN32, ATOMIC_MIN64, AtomicMin, Copy, pcg};
+pub use roofline::{ATOMIC_MIN32, ATOMIC_MIN64, COPY, RooflineParams, pcg};

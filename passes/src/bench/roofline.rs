@@ -1,7 +1,9 @@
 //! The roofline passes: definitions and CPU kernels
 //! (WGSL: `shaders/bench/`).
 
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, count};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
+use crate::params::{Invalid, NoParams, PassParams, in_range};
 use crate::sim::{CounterValues, Ctx};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
@@ -24,17 +26,40 @@ pub fn pcg(v: u32) -> u32 {
 const VALUE_SALT: u32 = 0x9e37_79b9;
 const HIGH_SALT: u32 = 0x85eb_ca6b;
 
-/// `ops_per_invocation`, checked.
-fn ops(kind: &'static str, params: &ron::Value) -> Result<u32, ParamError> {
-    let ops = Params::new(kind, params)?.u32("ops_per_invocation", OPS)?;
-    if (1..=256).contains(&ops) {
-        Ok(ops)
-    } else {
-        Err(ParamError {
-            kind,
-            param: "ops_per_invocation".into(),
-            message: format!("{ops} is outside 1..=256"),
-        })
+/// The atomic roofline passes' parameters.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RooflineParams {
+    /// Atomics per invocation (1..=256).
+    pub ops_per_invocation: u32,
+}
+
+impl Default for RooflineParams {
+    fn default() -> Self {
+        Self {
+            ops_per_invocation: OPS,
+        }
+    }
+}
+
+impl PassParams for RooflineParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("ops_per_invocation", self.ops_per_invocation, 1..=256)
+    }
+}
+
+crate::gpu_block! {
+    /// `RooflineParams`: ops per invocation, invocations (pixels).
+    pub struct RooflineGpu {
+        ops: u32,
+        invocations: u32,
+    }
+}
+
+fn roofline_gpu(p: &RooflineParams, q: &Quantities) -> RooflineGpu {
+    RooflineGpu {
+        ops: p.ops_per_invocation,
+        invocations: count(q.count(Quantity::Pixels)),
     }
 }
 
@@ -61,61 +86,39 @@ fn invocations(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<u32> {
     start..start.saturating_add(GROUP).min(pixels)
 }
 
-/// `bench.atomic_min32` and `bench.atomic_min64`: one definition, two widths.
-pub struct AtomicMin {
-    kind: &'static str,
-    bindings: &'static [Binding],
-    shader: Shader,
-    /// 64-bit atomics ([`Min64`]) rather than 32-bit ([`Min32`]).
-    wide: bool,
-}
-
-pub static ATOMIC_MIN32: AtomicMin = AtomicMin {
+pub static ATOMIC_MIN32: PassKind<RooflineParams, RooflineGpu> = PassKind {
     kind: "bench.atomic_min32",
-    bindings: &[Binding::atomic("atomics_u32")],
+    summary: "random-address 32-bit atomicMin into a visibility-atlas-sized buffer (roofline)",
+    source: "strandgraph bench; Kulikov 2025 'Rasterization' (the operation measured)",
+    bindings: Some(&[Binding::atomic("atomics_u32")]),
+    workgroup_size: GROUP,
+    dispatch: PER_PIXEL,
     shader: Shader::compute("bench/atomic_min32.wgsl", "atomic_min32"),
-    wide: false,
-};
-
-pub static ATOMIC_MIN64: AtomicMin = AtomicMin {
-    kind: "bench.atomic_min64",
-    bindings: &[Binding::atomic("atomics_u64")],
-    shader: Shader::compute("bench/atomic_min64.wgsl", "atomic_min64"),
-    wide: true,
-};
-
-impl PassDef for AtomicMin {
-    fn kind(&self) -> &'static str {
-        self.kind
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(self.bindings)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        PER_PIXEL
-    }
-    fn shader(&self) -> Shader {
-        self.shader
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let ops = ops(self.kind, params)?;
-        Ok(if self.wide {
-            Box::new(Min64 { ops })
-        } else {
-            Box::new(Min32 { ops })
+    kernel: |p| {
+        Box::new(Min32 {
+            ops: p.ops_per_invocation,
         })
-    }
-    /// `RooflineParams`: ops per invocation, invocations (pixels).
-    fn gpu_params(&self, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![
-            ops(self.kind, params)?,
-            count(q.count(Quantity::Pixels)),
-        ])
-    }
-}
+    },
+    gpu: roofline_gpu,
+    raster: None,
+};
+
+pub static ATOMIC_MIN64: PassKind<RooflineParams, RooflineGpu> = PassKind {
+    kind: "bench.atomic_min64",
+    summary: "random-address 64-bit atomicMin, result unused, into a screen-sized 64-bit buffer (roofline)",
+    source: "strandgraph bench; Lipp §3.1 (the operation measured)",
+    bindings: Some(&[Binding::atomic("atomics_u64")]),
+    workgroup_size: GROUP,
+    dispatch: PER_PIXEL,
+    shader: Shader::compute("bench/atomic_min64.wgsl", "atomic_min64"),
+    kernel: |p| {
+        Box::new(Min64 {
+            ops: p.ops_per_invocation,
+        })
+    },
+    gpu: roofline_gpu,
+    raster: None,
+};
 
 struct Min32 {
     ops: u32,
@@ -164,40 +167,31 @@ impl CpuKernel for Min64 {
     }
 }
 
-pub struct Copy;
-
 /// Words per invocation of `bench.copy` (one `vec4<u32>`).
 const COPY_WORDS: u32 = 4;
 
-impl PassDef for Copy {
-    fn kind(&self) -> &'static str {
-        "bench.copy"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[Binding::read("copy_src"), Binding::write("copy_dst")];
-        Some(B)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::CoverWrites {
-            words_per_group: GROUP * COPY_WORDS,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("bench/copy.wgsl", "copy")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Params::new(self.kind(), params)?;
-        Ok(Box::new(CopyKernel))
-    }
+crate::gpu_block! {
     /// `CopyParams`: unused padding (the shader sizes itself by arrayLength).
-    fn gpu_params(&self, params: &ron::Value, _: &Quantities) -> Result<Vec<u32>, ParamError> {
-        Params::new(self.kind(), params)?;
-        Ok(vec![0, 0])
+    pub struct CopyGpu {
+        unused0: u32,
+        unused1: u32,
     }
 }
+
+pub static COPY: PassKind<NoParams, CopyGpu> = PassKind {
+    kind: "bench.copy",
+    summary: "buffer-to-buffer copy in a compute shader (bandwidth roofline)",
+    source: "strandgraph bench",
+    bindings: Some(&[Binding::read("copy_src"), Binding::write("copy_dst")]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::CoverWrites {
+        words_per_group: GROUP * COPY_WORDS,
+    },
+    shader: Shader::compute("bench/copy.wgsl", "copy"),
+    kernel: |_| Box::new(CopyKernel),
+    gpu: |_, _| CopyGpu::default(),
+    raster: None,
+};
 
 struct CopyKernel;
 
@@ -277,7 +271,9 @@ mod tests {
     #[test]
     fn ops_out_of_range_is_refused() {
         let v: ron::Value = ron::from_str(r#"{"ops_per_invocation": 0}"#).unwrap();
-        let e = ATOMIC_MIN32.cpu_kernel(&v).err().expect("0 ops refused");
+        let e = crate::PassDef::cpu_kernel(&ATOMIC_MIN32, &v)
+            .err()
+            .expect("0 ops refused");
         assert!(e.to_string().contains("ops_per_invocation"), "{e}");
     }
 }

@@ -4,10 +4,10 @@
 //! `atomicAdd` counters at zero. (wgpu's `clear_buffer` only writes zeros,
 //! so the GPU backends run this as a compute pass; ash may use `vkCmdFillBuffer`.)
 
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
+use crate::params::PassParams;
 use crate::sim::Ctx;
-
-pub struct Clear;
 
 const GROUP: u32 = 256;
 /// Words each lane clears, `GROUP` apart (coalesced). A 1080p 8-sample
@@ -16,40 +16,40 @@ const GROUP: u32 = 256;
 /// buffers up to 1 GiB in one dimension.
 pub const WORDS_PER_LANE: u32 = 16;
 
-impl PassDef for Clear {
-    fn kind(&self) -> &'static str {
-        "common.clear"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        None
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::CoverWrites {
-            words_per_group: GROUP * WORDS_PER_LANE,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("common/clear.wgsl", "clear")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(Box::new(ClearKernel {
-            value: p.u32("value", 0)?,
-        }))
-    }
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ClearParams {
+    /// The word every written resource is filled with.
+    pub value: u32,
+}
+
+impl PassParams for ClearParams {}
+
+crate::gpu_block! {
     /// `ClearParams`: value, words (the backend fills `words` per resource).
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(vec![p.u32("value", 0)?, 0])
+    pub struct ClearGpu {
+        value: u32,
+        words: u32,
     }
 }
+
+pub static CLEAR: PassKind<ClearParams, ClearGpu> = PassKind {
+    kind: "common.clear",
+    summary: "fill buffers or images with a constant (all-ones for atomicMin targets)",
+    source: "strandgraph",
+    bindings: None,
+    workgroup_size: GROUP,
+    dispatch: Dispatch::CoverWrites {
+        words_per_group: GROUP * WORDS_PER_LANE,
+    },
+    shader: Shader::compute("common/clear.wgsl", "clear"),
+    kernel: |p| Box::new(ClearKernel { value: p.value }),
+    gpu: |p, _| ClearGpu {
+        value: p.value,
+        words: 0,
+    },
+    raster: None,
+};
 
 struct ClearKernel {
     value: u32,

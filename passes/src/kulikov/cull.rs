@@ -8,17 +8,18 @@
 //! bins are filled here too ("Populate sorting bins in visibility culling pass").
 
 use super::{ModelLod, Scene, TILE, clip_to_screen, transform};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
 use crate::layout::ModelData;
+use crate::params::PassParams;
 use crate::sim::{CounterValues, Ctx, Words};
 use std::collections::BTreeMap;
 use strandgraph_graph::schema::Quantity;
 
-pub struct Cull;
-
 pub const GROUP: u32 = 256;
 
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct CullParams {
     pub frustum: bool,
     pub occlusion: bool,
@@ -27,61 +28,61 @@ pub struct CullParams {
     pub wave_aggregated_atomics: bool,
 }
 
-impl PassDef for Cull {
-    fn kind(&self) -> &'static str {
-        "kulikov.cull"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("clip_positions"),
-            Binding::read("hiz"),
-            Binding::atomic("segment_visibility"),
-            Binding::atomic("screen_bounds"),
-            Binding::atomic("sort_bins"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Segments,
-            per_group: GROUP,
+impl Default for CullParams {
+    fn default() -> Self {
+        Self {
+            frustum: true,
+            occlusion: true,
+            fedora: true,
+            wave_aggregated_atomics: true,
         }
     }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/cull.wgsl", "cull")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(Box::new(CullKernel(CullParams {
-            frustum: p.bool("frustum", true)?,
-            occlusion: p.bool("occlusion", true)?,
-            fedora: p.bool("fedora", true)?,
-            wave_aggregated_atomics: p.bool("wave_aggregated_atomics", true)?,
-        })))
-    }
+}
+
+impl PassParams for CullParams {}
+
+crate::gpu_block! {
     /// `CullParams`: the four switches, then the segment count.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        let flag = |name| p.bool(name, true).map(crate::contract::flag);
-        Ok(vec![
-            flag("frustum")?,
-            flag("occlusion")?,
-            flag("fedora")?,
-            flag("wave_aggregated_atomics")?,
-            crate::contract::count(q.segments),
-        ])
+    pub struct CullGpu {
+        frustum: u32,
+        occlusion: u32,
+        fedora: u32,
+        wave_aggregated_atomics: u32,
+        /// Scene quantity: segments in the full numbering.
+        segments: u32,
     }
 }
+
+pub static CULL: PassKind<CullParams, CullGpu> = PassKind {
+    kind: "kulikov.cull",
+    summary: "frustum, occlusion and fedora culling; visibility bits, screen bounds and sort bins",
+    source: "Kulikov 2025, 'Culling', 'L2 cache is your friend'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("clip_positions"),
+        Binding::read("hiz"),
+        Binding::atomic("segment_visibility"),
+        Binding::atomic("screen_bounds"),
+        Binding::atomic("sort_bins"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/cull.wgsl", "cull"),
+    kernel: |p| Box::new(CullKernel(*p)),
+    gpu: |p, q| CullGpu {
+        frustum: flag(p.frustum),
+        occlusion: flag(p.occlusion),
+        fedora: flag(p.fedora),
+        wave_aggregated_atomics: flag(p.wave_aggregated_atomics),
+        segments: count(q.segments),
+    },
+    raster: None,
+};
 
 struct CullKernel(CullParams);
 

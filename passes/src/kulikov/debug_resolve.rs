@@ -9,58 +9,49 @@
 use super::payload::{EMPTY, depth_of, total_coverage};
 use super::raster::LAYERS;
 use super::{Scene, TILE_TEXELS};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
+use crate::params::NoParams;
 use crate::sim::{Ctx, Words};
 use half::f16;
 use strandgraph_graph::schema::Quantity;
 
-pub struct DebugResolve;
-
 const GROUP: u32 = 256;
 
-impl PassDef for DebugResolve {
-    fn kind(&self) -> &'static str {
-        "kulikov.debug_resolve"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("atlas_tiles"),
-            Binding::read("vis_atlas"),
-            Binding::read("coverage_atlas"),
-            Binding::write("output"),
-            Binding::write("debug_layers"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: GROUP,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/debug_resolve.wgsl", "resolve")
-    }
-    fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(ResolveKernel))
-    }
+crate::gpu_block! {
     /// `ResolveParams`: screen width and pixel count.
-    fn gpu_params(
-        &self,
-        _: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![
-            q.width,
-            crate::contract::count(u64::from(q.width) * u64::from(q.height)),
-        ])
+    pub struct ResolveGpu {
+        width: u32,
+        pixels: u32,
     }
 }
+
+pub static DEBUG_RESOLVE: PassKind<NoParams, ResolveGpu> = PassKind {
+    kind: "kulikov.debug_resolve",
+    summary: "resolve the visibility atlas to screen: coverage over the opaque image, layer depths",
+    source: "Kulikov 2025, 'Visibility buffer' (debug view)",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("atlas_tiles"),
+        Binding::read("vis_atlas"),
+        Binding::read("coverage_atlas"),
+        Binding::write("output"),
+        Binding::write("debug_layers"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/debug_resolve.wgsl", "resolve"),
+    kernel: |_| Box::new(ResolveKernel),
+    gpu: |_, q| ResolveGpu {
+        width: q.width,
+        pixels: count(u64::from(q.width) * u64::from(q.height)),
+    },
+    raster: None,
+};
 
 struct ResolveKernel;
 

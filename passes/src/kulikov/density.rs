@@ -13,12 +13,12 @@
 
 use super::cull::{GROUP, drawn_segment};
 use super::{Scene, world_of_clip};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
 use crate::layout::ModelData;
+use crate::params::{Invalid, PassParams};
 use crate::sim::Ctx;
 use strandgraph_graph::schema::Quantity;
-
-pub struct Density;
 
 /// Largest grid edge; `density_grid` holds `MAX_RESOLUTION³` words per model.
 pub const MAX_RESOLUTION: u32 = 48;
@@ -27,74 +27,78 @@ pub const GRID_WORDS: u32 = MAX_RESOLUTION * MAX_RESOLUTION * MAX_RESOLUTION;
 /// Fixed-point unit of the splatted area: 1e-9 m² (0.001 mm²).
 pub const AREA_UNIT: f32 = 1e-9;
 
-impl PassDef for Density {
-    fn kind(&self) -> &'static str {
-        "kulikov.density"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("clip_positions"),
-            Binding::read("groom.vertices"),
-            Binding::atomic("density_grid"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Segments,
-            per_group: GROUP,
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DensityParams {
+    /// Grid edge (1..=48).
+    pub resolution: u32,
+}
+
+impl Default for DensityParams {
+    fn default() -> Self {
+        Self {
+            resolution: MAX_RESOLUTION,
         }
     }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/density.wgsl", "density")
-    }
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Self::uniform(params, q)
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(DensityKernel {
-            resolution: resolution(self.kind(), params)?,
-        }))
+}
+
+impl PassParams for DensityParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        check_resolution(self.resolution)
     }
 }
 
-impl Density {
-    /// The WGSL `DensityParams` block (binding 0): resolution, segments.
-    pub fn uniform(
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![
-            resolution("kulikov.density", params)?,
-            u32::try_from(q.segments).unwrap_or(u32::MAX),
-        ])
-    }
-}
-
-/// Reads and checks the `resolution` parameter (1..=48).
-pub fn resolution(kind: &'static str, params: &ron::Value) -> Result<u32, ParamError> {
-    let r = Params::new(kind, params)?.u32("resolution", MAX_RESOLUTION)?;
+/// Checks a `resolution` parameter (1..=48), for every pass that reads the grid.
+pub fn check_resolution(r: u32) -> Result<(), Invalid> {
     if r == 0 || r > MAX_RESOLUTION {
-        return Err(ParamError {
-            kind,
-            param: "resolution".into(),
-            message: format!(
+        return Err(Invalid::new(
+            "resolution",
+            format!(
                 "expected 1..={MAX_RESOLUTION} (density_grid holds {MAX_RESOLUTION}³ voxels per model), got {r}"
             ),
-        });
+        ));
     }
-    Ok(r)
+    Ok(())
 }
+
+crate::gpu_block! {
+    /// The WGSL `DensityParams` block (binding 0).
+    pub struct DensityGpu {
+        resolution: u32,
+        /// Scene quantity: segments in the full numbering.
+        segments: u32,
+    }
+}
+
+pub static DENSITY: PassKind<DensityParams, DensityGpu> = PassKind {
+    kind: "kulikov.density",
+    summary: "splat drawn segments' projected area into a 48^3 density grid per model (atomicAdd)",
+    source: "Kulikov 2025, 'Simulation' (density output), 'Hair volumetric shadows'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("clip_positions"),
+        Binding::read("groom.vertices"),
+        Binding::atomic("density_grid"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/density.wgsl", "density"),
+    kernel: |p| {
+        Box::new(DensityKernel {
+            resolution: p.resolution,
+        })
+    },
+    gpu: |p, q| DensityGpu {
+        resolution: p.resolution,
+        segments: count(q.segments),
+    },
+    raster: None,
+};
 
 /// A model's grid: its world bounds split into `resolution³` voxels.
 #[derive(Debug, Clone, Copy)]
@@ -241,7 +245,7 @@ mod tests {
             .buffer("clip_positions", clip)
             .buffer("groom.vertices", verts)
             .buffer("density_grid", vec![0; GRID_WORDS as usize]);
-        let k = Density.cpu_kernel(&ron::Value::Unit).unwrap();
+        let k = crate::PassDef::cpu_kernel(&DENSITY, &ron::Value::Unit).unwrap();
         hs.run(k.as_ref(), 1, GROUP);
         assert_eq!(hs.out_of_bounds(), 0);
         let grid = hs.read("density_grid");
@@ -271,11 +275,9 @@ mod tests {
         assert_eq!(g.voxel([f32::NAN, 0.0, 0.0]), None);
         assert!((g.voxel_volume() - 8.0 / 64.0).abs() < 1e-6);
         assert!(
-            resolution(
-                "kulikov.density",
-                &ron::from_str("{\"resolution\": 64}").unwrap()
-            )
-            .is_err()
+            DENSITY
+                .params(&ron::from_str("{\"resolution\": 64}").unwrap())
+                .is_err()
         );
     }
 }

@@ -15,8 +15,10 @@
 //! near plane: the graph clears `clip_positions` before skinning, so a
 //! vertex the LOD skipped reads w = 0.
 
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, count};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
 use crate::layout::{FrameData, read};
+use crate::params::NoParams;
 use crate::sim::Ctx;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
@@ -60,51 +62,63 @@ pub fn motion(prev: u32, c: [f32; 4], near: f32, width: f32, height: f32) -> [f3
     [(nx - px) * 0.5 * width, (py - ny) * 0.5 * height]
 }
 
-fn per_vertex() -> Dispatch {
-    Dispatch::PerElement {
-        quantity: Quantity::Vertices,
-        per_group: GROUP,
+const PER_VERTEX: Dispatch = Dispatch::PerElement {
+    quantity: Quantity::Vertices,
+    per_group: GROUP,
+};
+
+crate::gpu_block! {
+    /// `HistoryParams`: vertex count, three pad words.
+    pub struct HistoryGpu {
+        vertices: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
     }
 }
 
-/// `HistoryParams`: vertex count, three pad words.
-fn params(kind: &'static str, params: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-    Params::new(kind, params)?;
-    Ok(vec![count(q.vertices), 0, 0, 0])
-}
-
-pub struct StoreHistory;
-
-impl PassDef for StoreHistory {
-    fn kind(&self) -> &'static str {
-        "kulikov.store_history"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("clip_positions"),
-            Binding::write("prev_clip_positions"),
-            Binding::write("prev_frame"),
-        ];
-        Some(B)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        per_vertex()
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/history.wgsl", "store_history")
-    }
-    fn cpu_kernel(&self, p: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Params::new(self.kind(), p)?;
-        Ok(Box::new(StoreKernel))
-    }
-    fn gpu_params(&self, p: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-        params(self.kind(), p, q)
+fn history_gpu(_: &NoParams, q: &Quantities) -> HistoryGpu {
+    HistoryGpu {
+        vertices: count(q.vertices),
+        ..HistoryGpu::default()
     }
 }
+
+pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
+    kind: "kulikov.store_history",
+    summary: "compress this frame's post-transform NDC (clamped UNORM16 x, y) for next frame's motion vectors",
+    source: "Kulikov 2025, 'Motion vectors'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("clip_positions"),
+        Binding::write("prev_clip_positions"),
+        Binding::write("prev_frame"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: PER_VERTEX,
+    shader: Shader::compute("kulikov/history.wgsl", "store_history"),
+    kernel: |_| Box::new(StoreKernel),
+    gpu: history_gpu,
+    raster: None,
+};
+
+pub static MOTION: PassKind<NoParams, HistoryGpu> = PassKind {
+    kind: "kulikov.motion",
+    summary: "per-vertex screen motion from last frame's compressed NDC (none where either frame skipped the vertex)",
+    source: "Kulikov 2025, 'Motion vectors'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("clip_positions"),
+        Binding::read("prev_clip_positions"),
+        Binding::write("vertex_motion"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: PER_VERTEX,
+    shader: Shader::compute("kulikov/history.wgsl", "motion"),
+    kernel: |_| Box::new(MotionKernel),
+    gpu: history_gpu,
+    raster: None,
+};
 
 /// The vertices of workgroup `group` (clamped to the vertex count).
 fn vertices(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<usize> {
@@ -131,39 +145,6 @@ impl CpuKernel for StoreKernel {
                 prev.store(k, now.load(k));
             }
         }
-    }
-}
-
-pub struct Motion;
-
-impl PassDef for Motion {
-    fn kind(&self) -> &'static str {
-        "kulikov.motion"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("clip_positions"),
-            Binding::read("prev_clip_positions"),
-            Binding::write("vertex_motion"),
-        ];
-        Some(B)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        per_vertex()
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/history.wgsl", "motion")
-    }
-    fn cpu_kernel(&self, p: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Params::new(self.kind(), p)?;
-        Ok(Box::new(MotionKernel))
-    }
-    fn gpu_params(&self, p: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-        params(self.kind(), p, q)
     }
 }
 

@@ -4,48 +4,42 @@
 //! axis) ... just using 16x downscaled depth buffer was enough." A segment is
 //! occluded when it is behind the farthest depth of every block it touches.
 
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
+use crate::params::NoParams;
 use crate::sim::Ctx;
 use strandgraph_graph::schema::Quantity;
-
-pub struct DepthDownsample;
 
 /// Block edge in pixels.
 pub const FACTOR: u32 = 16;
 const GROUP: u32 = 64;
 
-impl PassDef for DepthDownsample {
-    fn kind(&self) -> &'static str {
-        "kulikov.depth_downsample"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[Binding::read("scene.depth"), Binding::write("hiz")];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Tiles(FACTOR),
-            per_group: GROUP,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/hiz.wgsl", "downsample")
-    }
-    fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(DownsampleKernel))
-    }
+crate::gpu_block! {
     /// `HizParams`: the full-resolution screen size.
-    fn gpu_params(
-        &self,
-        _: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![q.width, q.height])
+    pub struct HizGpu {
+        width: u32,
+        height: u32,
     }
 }
+
+pub static DEPTH_DOWNSAMPLE: PassKind<NoParams, HizGpu> = PassKind {
+    kind: "kulikov.depth_downsample",
+    summary: "1/16 downscaled max depth for segment occlusion culling",
+    source: "Kulikov 2025, 'Culling'",
+    bindings: Some(&[Binding::read("scene.depth"), Binding::write("hiz")]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Tiles(FACTOR),
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/hiz.wgsl", "downsample"),
+    kernel: |_| Box::new(DownsampleKernel),
+    gpu: |_, q| HizGpu {
+        width: q.width,
+        height: q.height,
+    },
+    raster: None,
+};
 
 struct DownsampleKernel;
 

@@ -13,90 +13,100 @@
 
 use super::payload::MAX_SEGMENTS_PER_MODEL;
 use super::{ModelLod, Scene, drawn_segments, transform};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
+use crate::describe::PassKind;
 use crate::layout::{MODEL_LOD_ENABLED, ModelData};
+use crate::params::{Invalid, PassParams, in_range, non_negative};
 use crate::sim::Ctx;
-
-pub struct Lod;
 
 /// Skinning workgroup size; the LOD pass writes the skinning dispatch.
 pub const SKIN_GROUP: u32 = 64;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct LodParams {
     pub enabled: bool,
+    /// The per-asset cap ("Max 65k strands (PC High ...)").
     pub max_strands: u32,
+    /// Models with at most this many strands are not capped.
     pub small_model_strands: u32,
+    /// "an upper boundary of 2000 segments per 64x64 tile".
     pub segments_per_tile: u32,
     pub tile_size: u32,
+    /// "limit it at 2 million segments".
     pub segment_budget: u32,
     pub thickness_compensation: bool,
     pub max_thickness_scale: f32,
+    /// Beyond this view distance every other vertex is skipped.
     pub skip_vertices_beyond_m: f32,
 }
 
-impl LodParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("kulikov.lod", v)?;
-        Ok(Self {
-            enabled: p.bool("enabled", true)?,
-            max_strands: p.u32("max_strands", 65536)?,
-            small_model_strands: p.u32("small_model_strands", 4096)?,
-            segments_per_tile: p.u32("segments_per_tile", 2000)?,
-            tile_size: p.u32("tile_size", 64)?.max(1),
-            segment_budget: p.u32("segment_budget", 2_000_000)?,
-            thickness_compensation: p.bool("thickness_compensation", true)?,
-            max_thickness_scale: p.f32("max_thickness_scale", 4.0)?,
-            skip_vertices_beyond_m: p.f32("skip_vertices_beyond_m", 8.0)?,
-        })
+impl Default for LodParams {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            max_strands: 65536,
+            small_model_strands: 4096,
+            segments_per_tile: 2000,
+            tile_size: 64,
+            segment_budget: 2_000_000,
+            thickness_compensation: true,
+            max_thickness_scale: 4.0,
+            skip_vertices_beyond_m: 8.0,
+        }
     }
 }
 
-impl PassDef for Lod {
-    fn kind(&self) -> &'static str {
-        "kulikov.lod"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::write("lod_models"),
-            Binding::write("skin_args"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        1
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Fixed(1)
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/lod.wgsl", "lod")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(LodKernel(LodParams::from_ron(params)?)))
-    }
-    /// `LodParams` in shaders/kulikov/lod.wgsl.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = LodParams::from_ron(params)?;
-        Ok(vec![
-            crate::contract::flag(p.enabled),
-            p.max_strands,
-            p.small_model_strands,
-            p.segments_per_tile,
-            p.tile_size,
-            p.segment_budget,
-            crate::contract::flag(p.thickness_compensation),
-            p.max_thickness_scale.to_bits(),
-            p.skip_vertices_beyond_m.to_bits(),
-        ])
+impl PassParams for LodParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("tile_size", self.tile_size, 1..=u32::MAX)?;
+        non_negative("max_thickness_scale", self.max_thickness_scale)?;
+        non_negative("skip_vertices_beyond_m", self.skip_vertices_beyond_m)
     }
 }
+
+crate::gpu_block! {
+    /// `LodParams` in shaders/kulikov/lod.wgsl.
+    pub struct LodGpu {
+        enabled: u32,
+        max_strands: u32,
+        small_model_strands: u32,
+        segments_per_tile: u32,
+        tile_size: u32,
+        segment_budget: u32,
+        thickness_compensation: u32,
+        max_thickness_scale: f32,
+        skip_vertices_beyond_m: f32,
+    }
+}
+
+pub static LOD: PassKind<LodParams, LodGpu> = PassKind {
+    kind: "kulikov.lod",
+    summary: "per-model strand count: asset cap, segments per 64x64 tile, 2M-segment budget, thickness compensation",
+    source: "Kulikov 2025, 'LODs'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::write("lod_models"),
+        Binding::write("skin_args"),
+    ]),
+    workgroup_size: 1,
+    dispatch: Dispatch::Fixed(1),
+    shader: Shader::compute("kulikov/lod.wgsl", "lod"),
+    kernel: |p| Box::new(LodKernel(*p)),
+    gpu: |p, _| LodGpu {
+        enabled: flag(p.enabled),
+        max_strands: p.max_strands,
+        small_model_strands: p.small_model_strands,
+        segments_per_tile: p.segments_per_tile,
+        tile_size: p.tile_size,
+        segment_budget: p.segment_budget,
+        thickness_compensation: flag(p.thickness_compensation),
+        max_thickness_scale: p.max_thickness_scale,
+        skip_vertices_beyond_m: p.skip_vertices_beyond_m,
+    },
+    raster: None,
+};
 
 struct LodKernel(LodParams);
 
@@ -269,7 +279,7 @@ mod tests {
     }
 
     fn params() -> LodParams {
-        LodParams::from_ron(&ron::Value::Unit).unwrap()
+        LodParams::default()
     }
 
     #[test]

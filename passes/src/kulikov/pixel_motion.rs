@@ -28,64 +28,61 @@ use super::cull::drawn_segment;
 use super::payload::{EMPTY, segment_of};
 use super::raster::{LAYERS, segment_trapezoid};
 use super::{Scene, TILE};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
 use crate::layout::{FrameData, read};
+use crate::params::NoParams;
 use crate::sim::Ctx;
 use glam::{Mat4, Vec4};
-use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
-pub struct PixelMotion;
-
-const KIND: &str = "kulikov.pixel_motion";
 const GROUP: u32 = 64;
 /// How close (NDC depth) a front layer must be to the pixel's depth to be
 /// the hair composition wrote there: composition computed the same value,
 /// up to the rounding of another shader stage.
 pub const DEPTH_MATCH: f32 = 1e-6;
 
-impl PassDef for PixelMotion {
-    fn kind(&self) -> &'static str {
-        KIND
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const B: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("prev_frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("atlas_tiles"),
-            Binding::read("vis_atlas"),
-            Binding::read("clip_positions"),
-            Binding::read("groom.vertices"),
-            Binding::read("vertex_motion"),
-            Binding::read("scene.depth"),
-            Binding::write("pixel_motion"),
-        ];
-        Some(B)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: GROUP,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/pixel_motion.wgsl", "resolve_motion")
-    }
+crate::gpu_block! {
     /// `PixelMotionParams`: width, height, two pad words.
-    fn gpu_params(&self, p: &ron::Value, q: &Quantities) -> Result<Vec<u32>, ParamError> {
-        Params::new(KIND, p)?;
-        Ok(vec![q.width, q.height, 0, 0])
-    }
-    fn cpu_kernel(&self, p: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Params::new(KIND, p)?;
-        Ok(Box::new(PixelMotionKernel))
+    pub struct PixelMotionGpu {
+        width: u32,
+        height: u32,
+        _pad0: u32,
+        _pad1: u32,
     }
 }
+
+pub static PIXEL_MOTION: PassKind<NoParams, PixelMotionGpu> = PassKind {
+    kind: "kulikov.pixel_motion",
+    summary: "per-pixel motion: the front hair segment's interpolated vertex motion where composition wrote its depth, else the depth reprojected with last frame's camera",
+    source: "Kulikov 2025, 'Composition', 'Motion vectors'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("prev_frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("atlas_tiles"),
+        Binding::read("vis_atlas"),
+        Binding::read("clip_positions"),
+        Binding::read("groom.vertices"),
+        Binding::read("vertex_motion"),
+        Binding::read("scene.depth"),
+        Binding::write("pixel_motion"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/pixel_motion.wgsl", "resolve_motion"),
+    kernel: |_| Box::new(PixelMotionKernel),
+    gpu: |_, q| PixelMotionGpu {
+        width: q.width,
+        height: q.height,
+        ..PixelMotionGpu::default()
+    },
+    raster: None,
+};
 
 /// Motion of the surface at pixel `(x, y)` with NDC depth `z` under a pure
 /// camera move from `prev` to `now`; `None` without a previous camera or

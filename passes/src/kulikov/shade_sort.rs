@@ -13,68 +13,68 @@
 //! 0 is raised with `atomicMax` by every subgroup, so no scan pass is needed.
 //! `wave_aggregated_atomics: false` appends one lane at a time (the ablation).
 
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
+use crate::params::PassParams;
 use crate::sim::{CounterValues, Ctx, subgroup};
 use strandgraph_graph::schema::Quantity;
-
-pub struct ShadeSort;
 
 pub const GROUP: u32 = 256;
 /// Segments per workgroup of `kulikov.shade` (the indirect count's divisor).
 pub const SHADE_GROUP: u32 = 64;
 
-impl PassDef for ShadeSort {
-    fn kind(&self) -> &'static str {
-        "kulikov.shade_sort"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("segment_visibility"),
-            Binding::atomic("shade_args"),
-            Binding::write("shading_segments"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Segments,
-            per_group: GROUP,
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ShadeSortParams {
+    /// One `atomicAdd` per subgroup; off, one per lane (the ablation).
+    pub wave_aggregated_atomics: bool,
+}
+
+impl Default for ShadeSortParams {
+    fn default() -> Self {
+        Self {
+            wave_aggregated_atomics: true,
         }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/shade_sort.wgsl", "shade_sort")
-    }
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Self::uniform(params, q)
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(Box::new(ShadeSortKernel {
-            aggregated: p.bool("wave_aggregated_atomics", true)?,
-        }))
     }
 }
 
-impl ShadeSort {
+impl PassParams for ShadeSortParams {}
+
+crate::gpu_block! {
     /// The WGSL `ShadeSortParams` block (binding 0): switch, segments.
-    pub fn uniform(
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = Params::new("kulikov.shade_sort", params)?;
-        Ok(vec![
-            u32::from(p.bool("wave_aggregated_atomics", true)?),
-            u32::try_from(q.segments).unwrap_or(u32::MAX),
-        ])
+    pub struct ShadeSortGpu {
+        wave_aggregated_atomics: u32,
+        /// Scene quantity: segments in the full numbering.
+        segments: u32,
     }
 }
+
+pub static SHADE_SORT: PassKind<ShadeSortParams, ShadeSortGpu> = PassKind {
+    kind: "kulikov.shade_sort",
+    summary: "re-sort visible segments to natural order for strand-space shading",
+    source: "Kulikov 2025, 'Strand-space shading needs different segment order'",
+    bindings: Some(&[
+        Binding::read("segment_visibility"),
+        Binding::atomic("shade_args"),
+        Binding::write("shading_segments"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/shade_sort.wgsl", "shade_sort"),
+    kernel: |p| {
+        Box::new(ShadeSortKernel {
+            aggregated: p.wave_aggregated_atomics,
+        })
+    },
+    gpu: |p, q| ShadeSortGpu {
+        wave_aggregated_atomics: flag(p.wave_aggregated_atomics),
+        segments: count(q.segments),
+    },
+    raster: None,
+};
 
 struct ShadeSortKernel {
     aggregated: bool,
@@ -164,7 +164,7 @@ mod tests {
             .buffer("shading_segments", vec![u32::MAX; segments as usize + 4]);
         let params: ron::Value =
             ron::from_str(&format!("{{\"wave_aggregated_atomics\": {aggregated}}}")).unwrap();
-        let k = ShadeSort.cpu_kernel(&params).unwrap();
+        let k = crate::PassDef::cpu_kernel(&SHADE_SORT, &params).unwrap();
         let c = hs.run(k.as_ref(), segments.div_ceil(GROUP), GROUP);
         let args = hs.read("shade_args");
         let mut list = hs.read("shading_segments")[..args[3] as usize].to_vec();

@@ -9,56 +9,46 @@
 
 use super::lod::SKIN_GROUP;
 use super::{Scene, transform};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
 use crate::layout::{ModelData, TriangleData, read};
+use crate::params::NoParams;
 use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3};
 use strandgraph_assets::octahedral::{unpack_barycentrics, unpack_unit_vector};
 
-pub struct Skin;
-
-impl PassDef for Skin {
-    fn kind(&self) -> &'static str {
-        "kulikov.skin"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("skin_args"),
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("groom.vertices"),
-            Binding::read("groom.strands"),
-            Binding::read("groom.skinning"),
-            Binding::read("mesh.triangles"),
-            Binding::write("clip_positions"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        SKIN_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Indirect {
-            binding: "skin_args",
-            word: 0,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/skin.wgsl", "skin")
-    }
-    fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(SkinKernel))
-    }
+crate::gpu_block! {
     /// `SkinParams`: one reserved word.
-    fn gpu_params(
-        &self,
-        _: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(vec![0])
+    pub struct SkinGpu {
+        reserved: u32,
     }
 }
+
+pub static SKIN: PassKind<NoParams, SkinGpu> = PassKind {
+    kind: "kulikov.skin",
+    summary: "skin roots to triangles (hairRootSkinningInfo_t) and cache post-transform positions",
+    source: "Kulikov 2025, 'Skinning'",
+    bindings: Some(&[
+        Binding::read("skin_args"),
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("groom.vertices"),
+        Binding::read("groom.strands"),
+        Binding::read("groom.skinning"),
+        Binding::read("mesh.triangles"),
+        Binding::write("clip_positions"),
+    ]),
+    workgroup_size: SKIN_GROUP,
+    dispatch: Dispatch::Indirect {
+        binding: "skin_args",
+        word: 0,
+    },
+    shader: Shader::compute("kulikov/skin.wgsl", "skin"),
+    kernel: |_| Box::new(SkinKernel),
+    gpu: |_, _| SkinGpu::default(),
+    raster: None,
+};
 
 struct SkinKernel;
 

@@ -21,64 +21,47 @@
 //! G-buffer normal, we have a depth prepass only.
 
 use super::Scene;
-use super::density::{AREA_UNIT, GRID_WORDS, Grid, resolution};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use super::density::{AREA_UNIT, GRID_WORDS, Grid, MAX_RESOLUTION, check_resolution};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
 use crate::layout::{LightData, read};
+use crate::params::{Invalid, PassParams, in_range, non_negative};
 use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3, Vec4};
 use strandgraph_graph::schema::Quantity;
 
-pub struct SkinShadow;
-
-const KIND: &str = "kulikov.skin_shadow";
 const GROUP: u32 = 64;
 /// Lights with a shadow byte in the mask word.
 pub const MASK_LIGHTS: usize = 3;
 /// The mask of a pixel nothing shadows (and of background pixels).
 pub const LIT: u32 = 0xFFFF_FFFF;
 
-impl PassDef for SkinShadow {
-    fn kind(&self) -> &'static str {
-        KIND
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lights"),
-            Binding::read("density_grid"),
-            Binding::read("scene.depth"),
-            Binding::write("skin_shadow"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: GROUP,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/skin_shadow.wgsl", "march_skin")
-    }
-    /// The WGSL `SkinShadowParams` block ([`SkinShadowParams::uniform`]).
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(SkinShadowParams::from_ron(params)?.uniform(q.width, q.height))
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(SkinShadowParams::from_ron(params)?))
-    }
-}
+pub static SKIN_SHADOW: PassKind<SkinShadowParams, SkinShadowGpu> = PassKind {
+    kind: "kulikov.skin_shadow",
+    summary: "hair shadows and AO on opaque pixels: march the density grids towards each light (6 steps) and along the normal (2 steps), into a per-pixel mask scene.opaque reads",
+    source: "Kulikov 2025, 'Hair volumetric shadows'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lights"),
+        Binding::read("density_grid"),
+        Binding::read("scene.depth"),
+        Binding::write("skin_shadow"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("kulikov/skin_shadow.wgsl", "march_skin"),
+    kernel: |p| Box::new(*p),
+    gpu: |p, q| p.uniform(q.width, q.height),
+    raster: None,
+};
 
 /// The pass's parameters, with the talk's values as defaults.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct SkinShadowParams {
     /// Grid edge of `density_grid` (as written by `kulikov.density`).
     pub resolution: u32,
@@ -95,52 +78,57 @@ pub struct SkinShadowParams {
     pub ao_absorption: f32,
 }
 
-impl SkinShadowParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new(KIND, v)?;
-        let bounded = |name: &str, value: u32, max: u32| {
-            if value > max {
-                return Err(error(name, format!("expected 0..={max}, got {value}")));
-            }
-            Ok(value)
-        };
-        let non_negative = |name: &str, value: f32| {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(error(name, format!("expected a number >= 0, got {value}")));
-            }
-            Ok(value)
-        };
-        Ok(Self {
-            resolution: resolution(KIND, v)?,
-            steps: bounded("steps", p.u32("steps", 6)?, 64)?,
-            ao_steps: bounded("ao_steps", p.u32("ao_steps", 2)?, 64)?,
-            ao_distance: non_negative("ao_distance", p.f32("ao_distance", 0.05)?)?,
-            absorption: non_negative("absorption", p.f32("absorption", 1.0)?)?,
-            ao_absorption: non_negative("ao_absorption", p.f32("ao_absorption", 1.0)?)?,
-        })
-    }
-
-    /// The WGSL block: width, height, resolution, steps, ao_steps,
-    /// ao_distance, absorption, ao_absorption.
-    pub fn uniform(&self, width: u32, height: u32) -> Vec<u32> {
-        vec![
-            width,
-            height,
-            self.resolution,
-            self.steps,
-            self.ao_steps,
-            self.ao_distance.to_bits(),
-            self.absorption.to_bits(),
-            self.ao_absorption.to_bits(),
-        ]
+impl Default for SkinShadowParams {
+    fn default() -> Self {
+        Self {
+            resolution: MAX_RESOLUTION,
+            steps: 6,
+            ao_steps: 2,
+            ao_distance: 0.05,
+            absorption: 1.0,
+            ao_absorption: 1.0,
+        }
     }
 }
 
-fn error(param: &str, message: String) -> ParamError {
-    ParamError {
-        kind: KIND,
-        param: param.to_string(),
-        message,
+impl PassParams for SkinShadowParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        check_resolution(self.resolution)?;
+        in_range("steps", self.steps, 0..=64)?;
+        in_range("ao_steps", self.ao_steps, 0..=64)?;
+        non_negative("ao_distance", self.ao_distance)?;
+        non_negative("absorption", self.absorption)?;
+        non_negative("ao_absorption", self.ao_absorption)
+    }
+}
+
+crate::gpu_block! {
+    /// The WGSL `SkinShadowParams` block.
+    pub struct SkinShadowGpu {
+        width: u32,
+        height: u32,
+        resolution: u32,
+        steps: u32,
+        ao_steps: u32,
+        ao_distance: f32,
+        absorption: f32,
+        ao_absorption: f32,
+    }
+}
+
+impl SkinShadowParams {
+    /// The WGSL block for a `width` × `height` screen.
+    pub fn uniform(&self, width: u32, height: u32) -> SkinShadowGpu {
+        SkinShadowGpu {
+            width,
+            height,
+            resolution: self.resolution,
+            steps: self.steps,
+            ao_steps: self.ao_steps,
+            ao_distance: self.ao_distance,
+            absorption: self.absorption,
+            ao_absorption: self.ao_absorption,
+        }
     }
 }
 
@@ -419,9 +407,8 @@ mod tests {
     }
 
     fn run(hs: &Harness, params: &str) -> Vec<u32> {
-        let kernel = SkinShadow
-            .cpu_kernel(&ron::from_str(params).unwrap())
-            .unwrap();
+        let kernel =
+            crate::PassDef::cpu_kernel(&SKIN_SHADOW, &ron::from_str(params).unwrap()).unwrap();
         let (w, h) = (hs.quantities.width, hs.quantities.height);
         hs.run(kernel.as_ref(), (w * h).div_ceil(GROUP), GROUP);
         hs.read("skin_shadow")
@@ -470,7 +457,7 @@ mod tests {
 
     #[test]
     fn params_are_checked() {
-        let p = |s: &str| SkinShadowParams::from_ron(&ron::from_str(s).unwrap());
+        let p = |s: &str| SKIN_SHADOW.params(&ron::from_str(s).unwrap());
         assert_eq!(p("{}").unwrap().steps, 6);
         assert_eq!(p("{}").unwrap().ao_steps, 2);
         assert!(p("{\"steps\": 65}").is_err());

@@ -9,46 +9,89 @@
 
 use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
 use super::{Scene, clip_to_screen};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
+use crate::params::{NoParams, PassParams};
 use crate::sim::Ctx;
+use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
-pub struct SortScan;
-pub struct Sort;
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SortParams {
+    /// Off: segments keep arrival order (the talk's "unsorted" baseline).
+    pub enabled: bool,
+}
 
-impl PassDef for SortScan {
-    fn kind(&self) -> &'static str {
-        "kulikov.sort_scan"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("sort_bins"),
-            Binding::write("sort_offsets"),
-            Binding::write("raster_args"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        1
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Fixed(1)
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/sort.wgsl", "scan")
-    }
-    fn cpu_kernel(&self, _: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(ScanKernel))
-    }
-    /// `SortParams` (shared with `kulikov.sort`; `enabled` unused by the scan).
-    fn gpu_params(
-        &self,
-        _: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(sort_params(true, q))
+impl Default for SortParams {
+    fn default() -> Self {
+        Self { enabled: true }
     }
 }
+
+impl PassParams for SortParams {}
+
+crate::gpu_block! {
+    /// The WGSL `SortParams` block of both entry points in shaders/kulikov/sort.wgsl.
+    pub struct SortGpu {
+        /// kulikov.sort `enabled` (scatter only).
+        enabled: u32,
+        /// Scene quantity: segments in the full numbering.
+        segments: u32,
+        /// Sort bins (64x64 screen tiles).
+        bins: u32,
+    }
+}
+
+fn sort_gpu(enabled: bool, q: &Quantities) -> SortGpu {
+    SortGpu {
+        enabled: flag(enabled),
+        segments: count(q.segments),
+        bins: count(q.count(Quantity::Tiles(super::TILE))),
+    }
+}
+
+pub static SORT_SCAN: PassKind<NoParams, SortGpu> = PassKind {
+    kind: "kulikov.sort_scan",
+    summary: "prefix sum over sort buckets; writes the raster's indirect dispatch",
+    source: "Kulikov 2025, 'Sort everything!'",
+    bindings: Some(&[
+        Binding::read("sort_bins"),
+        Binding::write("sort_offsets"),
+        Binding::write("raster_args"),
+    ]),
+    workgroup_size: 1,
+    dispatch: Dispatch::Fixed(1),
+    shader: Shader::compute("kulikov/sort.wgsl", "scan"),
+    kernel: |_| Box::new(ScanKernel),
+    // `enabled` is unused by the scan.
+    gpu: |_, q| sort_gpu(true, q),
+    raster: None,
+};
+
+pub static SORT: PassKind<SortParams, SortGpu> = PassKind {
+    kind: "kulikov.sort",
+    summary: "global counting sort of visible segments by screen bucket",
+    source: "Kulikov 2025, 'Sort everything!'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("clip_positions"),
+        Binding::read("segment_visibility"),
+        Binding::atomic("sort_offsets"),
+        Binding::write("sorted_segments"),
+    ]),
+    workgroup_size: CULL_GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: CULL_GROUP,
+    },
+    shader: Shader::compute("kulikov/sort.wgsl", "scatter"),
+    kernel: |p| Box::new(ScatterKernel { enabled: p.enabled }),
+    gpu: |p, q| sort_gpu(p.enabled, q),
+    raster: None,
+};
 
 struct ScanKernel;
 
@@ -72,60 +115,6 @@ impl CpuKernel for ScanKernel {
         args.store(2, 1);
         args.store(3, sum);
     }
-}
-
-impl PassDef for Sort {
-    fn kind(&self) -> &'static str {
-        "kulikov.sort"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("clip_positions"),
-            Binding::read("segment_visibility"),
-            Binding::atomic("sort_offsets"),
-            Binding::write("sorted_segments"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        CULL_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Segments,
-            per_group: CULL_GROUP,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/sort.wgsl", "scatter")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(Box::new(ScatterKernel {
-            enabled: p.bool("enabled", true)?,
-        }))
-    }
-    /// `SortParams`: enabled, segments, bins.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        Ok(sort_params(p.bool("enabled", true)?, q))
-    }
-}
-
-/// The WGSL `SortParams` block of both entry points in shaders/kulikov/sort.wgsl.
-fn sort_params(enabled: bool, q: &strandgraph_graph::Quantities) -> Vec<u32> {
-    vec![
-        crate::contract::flag(enabled),
-        crate::contract::count(q.segments),
-        crate::contract::count(q.count(Quantity::Tiles(super::TILE))),
-    ]
 }
 
 struct ScatterKernel {

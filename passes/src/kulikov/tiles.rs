@@ -6,10 +6,79 @@
 //! each tile until everything fits." The atlas holds 2M pixels (512 tiles).
 
 use super::TILE;
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{Ctx, Words};
 
-pub struct TileAlloc;
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TileParams {
+    /// Atlas capacity in tiles (Kulikov: 2M pixels, 512 tiles).
+    pub atlas_tiles: u32,
+    /// "Downscale resolution for each tile until everything fits", at most this far.
+    pub max_downscale: u32,
+    /// Only 64: the atlas layout is built for it.
+    pub tile_size: u32,
+}
+
+impl Default for TileParams {
+    fn default() -> Self {
+        Self {
+            atlas_tiles: 512,
+            max_downscale: 8,
+            tile_size: TILE,
+        }
+    }
+}
+
+impl PassParams for TileParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        if self.tile_size != TILE {
+            return Err(Invalid::new(
+                "tile_size",
+                format!("the atlas layout is built for {TILE}x{TILE} tiles"),
+            ));
+        }
+        in_range("max_downscale", self.max_downscale, 1..=u32::MAX)
+    }
+}
+
+crate::gpu_block! {
+    /// `TileParams`: atlas tiles, max downscale, hair models.
+    pub struct TileGpu {
+        atlas_tiles: u32,
+        max_downscale: u32,
+        /// Scene quantity: hair models.
+        models: u32,
+    }
+}
+
+pub static TILE_ALLOC: PassKind<TileParams, TileGpu> = PassKind {
+    kind: "kulikov.tile_alloc",
+    summary: "allocate 64x64 atlas tiles per model from screen bounds, downscaling until they fit",
+    source: "Kulikov 2025, 'Visibility buffer: tile allocation, downscale'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("screen_bounds"),
+        Binding::write("atlas_tiles"),
+    ]),
+    workgroup_size: 1,
+    dispatch: Dispatch::Fixed(1),
+    shader: Shader::compute("kulikov/tiles.wgsl", "allocate"),
+    kernel: |p| {
+        Box::new(AllocKernel {
+            atlas_tiles: p.atlas_tiles,
+            max_downscale: p.max_downscale,
+        })
+    },
+    gpu: |p, q| TileGpu {
+        atlas_tiles: p.atlas_tiles,
+        max_downscale: p.max_downscale,
+        models: count(q.models),
+    },
+    raster: None,
+};
 
 /// One model's part of the atlas (`atlas_tiles`, 8 words per model).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -143,57 +212,6 @@ pub fn allocate(
             t
         })
         .collect()
-}
-
-impl PassDef for TileAlloc {
-    fn kind(&self) -> &'static str {
-        "kulikov.tile_alloc"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("screen_bounds"),
-            Binding::write("atlas_tiles"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        1
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Fixed(1)
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/tiles.wgsl", "allocate")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        let p = Params::new(self.kind(), params)?;
-        if p.u32("tile_size", TILE)? != TILE {
-            return Err(ParamError {
-                kind: "kulikov.tile_alloc",
-                param: "tile_size".into(),
-                message: format!("the atlas layout is built for {TILE}x{TILE} tiles"),
-            });
-        }
-        Ok(Box::new(AllocKernel {
-            atlas_tiles: p.u32("atlas_tiles", 512)?,
-            max_downscale: p.u32("max_downscale", 8)?.max(1),
-        }))
-    }
-    /// `TileParams`: atlas tiles, max downscale, hair models (checked as the CPU kernel does).
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        self.cpu_kernel(params)?;
-        let p = Params::new(self.kind(), params)?;
-        Ok(vec![
-            p.u32("atlas_tiles", 512)?,
-            p.u32("max_downscale", 8)?.max(1),
-            crate::contract::count(q.models),
-        ])
-    }
 }
 
 struct AllocKernel {

@@ -28,9 +28,12 @@ use super::{
     BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, cross, dot,
     frame, normalize, scale, sub,
 };
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
 use crate::layout::{LightData, ModelData, read};
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{Ctx, Words};
+use strandgraph_graph::Quantities;
 
 /// Fixed-point scale of the opacity layers.
 pub const OPACITY_SCALE: f32 = 1024.0;
@@ -39,9 +42,12 @@ pub const NO_HIT: u32 = u32::MAX;
 /// Lights with a deep opacity map (the rest are unshadowed).
 pub const MAX_DOM_LIGHTS: usize = 4;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct DomParams {
+    /// Texels per side of each light's map (16..=4096).
     pub resolution: u32,
+    /// Opacity layers behind the first hit (1..=8).
     pub layers: u32,
     /// Metres per opacity layer.
     pub layer_thickness: f32,
@@ -52,53 +58,61 @@ pub struct DomParams {
     pub styling: bool,
 }
 
-impl DomParams {
-    pub fn from_ron(kind: &'static str, v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new(kind, v)?;
-        let out = Self {
-            resolution: p.u32("resolution", 512)?,
-            layers: p.u32("layers", 4)?,
-            layer_thickness: p.f32("layer_thickness", 0.02)?,
-            strand_opacity: p.f32("strand_opacity", 0.02)?,
-            density_compensation: p.bool("density_compensation", true)?,
-            cooperative_assembly: p.bool("cooperative_assembly", true)?,
-            styling: p.bool("styling", true)?,
-        };
-        let bad = |param: &str, message: String| ParamError {
-            kind,
-            param: param.into(),
-            message,
-        };
-        if !(16..=4096).contains(&out.resolution) {
-            return Err(bad(
-                "resolution",
-                format!("{} is outside 16..=4096", out.resolution),
-            ));
+impl Default for DomParams {
+    fn default() -> Self {
+        Self {
+            resolution: 512,
+            layers: 4,
+            layer_thickness: 0.02,
+            strand_opacity: 0.02,
+            density_compensation: true,
+            cooperative_assembly: true,
+            styling: true,
         }
-        if !(1..=8).contains(&out.layers) {
-            return Err(bad("layers", format!("{} is outside 1..=8", out.layers)));
-        }
-        if !(out.layer_thickness.is_finite() && out.layer_thickness > 0.0) {
-            return Err(bad("layer_thickness", "must be positive".into()));
-        }
-        if !(out.strand_opacity.is_finite() && out.strand_opacity >= 0.0) {
-            return Err(bad("strand_opacity", "must be >= 0".into()));
-        }
-        Ok(out)
     }
+}
 
+impl PassParams for DomParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("resolution", self.resolution, 16..=4096)?;
+        in_range("layers", self.layers, 1..=8)?;
+        if !(self.layer_thickness.is_finite() && self.layer_thickness > 0.0) {
+            return Err(Invalid::new("layer_thickness", "must be positive"));
+        }
+        if !(self.strand_opacity.is_finite() && self.strand_opacity >= 0.0) {
+            return Err(Invalid::new("strand_opacity", "must be >= 0"));
+        }
+        Ok(())
+    }
+}
+
+crate::gpu_block! {
+    /// `DomParams` in shaders/lipp/raster.wgsl.
+    pub struct DomGpu {
+        resolution: u32,
+        layers: u32,
+        layer_thickness: f32,
+        strand_opacity: f32,
+        density_compensation: u32,
+        cooperative_assembly: u32,
+        styling: u32,
+        bundles: u32,
+    }
+}
+
+impl DomParams {
     /// The WGSL `DomParams` block.
-    pub fn words(&self, q: &strandgraph_graph::Quantities) -> Vec<u32> {
-        vec![
-            self.resolution,
-            self.layers,
-            self.layer_thickness.to_bits(),
-            self.strand_opacity.to_bits(),
-            flag(self.density_compensation),
-            flag(self.cooperative_assembly),
-            flag(self.styling),
-            crate::contract::count(q.bundles),
-        ]
+    pub fn uniform(&self, q: &Quantities) -> DomGpu {
+        DomGpu {
+            resolution: self.resolution,
+            layers: self.layers,
+            layer_thickness: self.layer_thickness,
+            strand_opacity: self.strand_opacity,
+            density_compensation: flag(self.density_compensation),
+            cooperative_assembly: flag(self.cooperative_assembly),
+            styling: flag(self.styling),
+            bundles: count(q.bundles),
+        }
     }
 }
 
@@ -251,85 +265,66 @@ pub enum Stage {
     Opacity,
 }
 
-pub struct DomDepth;
-pub struct DomOpacity;
+pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = PassKind {
+    kind: "lipp.dom_depth",
+    summary: "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
+    source: "Lipp §3.4; Yuksel and Keyser 2008",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("raster_args"),
+        Binding::read("bundle_lod"),
+        Binding::read("hairmesh.bundles"),
+        Binding::read("hairmesh.layers"),
+        Binding::read("models"),
+        Binding::read("lights"),
+        Binding::atomic("dom_depth"),
+    ]),
+    workgroup_size: RASTER_GROUP,
+    dispatch: DOM_DISPATCH,
+    shader: Shader::compute("lipp/raster.wgsl", "dom_depth_pass"),
+    kernel: |p| {
+        Box::new(DomKernel {
+            stage: Stage::Depth,
+            p: *p,
+        })
+    },
+    gpu: |p, q| p.uniform(q),
+    raster: None,
+};
 
-const DEPTH_BINDINGS: &[Binding] = &[
-    Binding::read("frame"),
-    Binding::read("raster_args"),
-    Binding::read("bundle_lod"),
-    Binding::read("hairmesh.bundles"),
-    Binding::read("hairmesh.layers"),
-    Binding::read("models"),
-    Binding::read("lights"),
-    Binding::atomic("dom_depth"),
-];
+pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = PassKind {
+    kind: "lipp.dom_opacity",
+    summary: "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
+    source: "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("raster_args"),
+        Binding::read("bundle_lod"),
+        Binding::read("hairmesh.bundles"),
+        Binding::read("hairmesh.layers"),
+        Binding::read("models"),
+        Binding::read("lights"),
+        Binding::read("dom_depth"),
+        Binding::atomic("dom_layers"),
+    ]),
+    workgroup_size: RASTER_GROUP,
+    dispatch: DOM_DISPATCH,
+    shader: Shader::compute("lipp/raster.wgsl", "dom_opacity_pass"),
+    kernel: |p| {
+        Box::new(DomKernel {
+            stage: Stage::Opacity,
+            p: *p,
+        })
+    },
+    gpu: |p, q| p.uniform(q),
+    raster: None,
+};
 
-const OPACITY_BINDINGS: &[Binding] = &[
-    Binding::read("frame"),
-    Binding::read("raster_args"),
-    Binding::read("bundle_lod"),
-    Binding::read("hairmesh.bundles"),
-    Binding::read("hairmesh.layers"),
-    Binding::read("models"),
-    Binding::read("lights"),
-    Binding::read("dom_depth"),
-    Binding::atomic("dom_layers"),
-];
-
-macro_rules! dom_pass {
-    ($ty:ident, $kind:literal, $entry:literal, $bindings:ident, $stage:expr) => {
-        impl PassDef for $ty {
-            fn kind(&self) -> &'static str {
-                $kind
-            }
-            fn bindings(&self) -> Option<&'static [Binding]> {
-                Some($bindings)
-            }
-            fn workgroup_size(&self) -> u32 {
-                RASTER_GROUP
-            }
-            fn dispatch(&self) -> Dispatch {
-                Dispatch::Indirect {
-                    binding: "raster_args",
-                    word: 0,
-                }
-            }
-            fn shader(&self) -> Shader {
-                Shader::compute("lipp/raster.wgsl", $entry)
-            }
-            fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-                Ok(Box::new(DomKernel {
-                    stage: $stage,
-                    p: DomParams::from_ron($kind, params)?,
-                }))
-            }
-            /// `DomParams` in shaders/lipp/raster.wgsl.
-            fn gpu_params(
-                &self,
-                params: &ron::Value,
-                q: &strandgraph_graph::Quantities,
-            ) -> Result<Vec<u32>, ParamError> {
-                Ok(DomParams::from_ron($kind, params)?.words(q))
-            }
-        }
-    };
-}
-
-dom_pass!(
-    DomDepth,
-    "lipp.dom_depth",
-    "dom_depth_pass",
-    DEPTH_BINDINGS,
-    Stage::Depth
-);
-dom_pass!(
-    DomOpacity,
-    "lipp.dom_opacity",
-    "dom_opacity_pass",
-    OPACITY_BINDINGS,
-    Stage::Opacity
-);
+/// One workgroup per drawn strand, as the main view's rasterizer.
+const DOM_DISPATCH: Dispatch = Dispatch::Indirect {
+    binding: "raster_args",
+    word: 0,
+};
 
 struct DomKernel {
     stage: Stage,
@@ -480,7 +475,7 @@ mod tests {
             r#"{"layer_thickness": 0.0}"#,
         ] {
             let v: ron::Value = ron::from_str(bad).unwrap();
-            assert!(DomParams::from_ron("lipp.dom_depth", &v).is_err(), "{bad}");
+            assert!(DOM_DEPTH.params(&v).is_err(), "{bad}");
         }
     }
 }

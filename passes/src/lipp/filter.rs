@@ -34,18 +34,19 @@
 use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::shade::world_position;
 use super::{add, frame, normalize, scale, transform};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
+use crate::describe::PassKind;
 use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::layout::FrameData;
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{Ctx, Words};
 use strandgraph_graph::schema::Quantity;
-
-pub struct Filter;
 
 pub const FILTER_GROUP: u32 = 64;
 pub const MAX_RADIUS: u32 = 8;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct FilterParams {
     pub enabled: bool,
     pub reconnect: bool,
@@ -65,104 +66,104 @@ pub struct FilterParams {
     pub depth_alpha: f32,
 }
 
-impl FilterParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("lipp.filter", v)?;
-        let out = Self {
-            enabled: p.bool("enabled", true)?,
-            reconnect: p.bool("reconnect", true)?,
-            opacity_reconstruction: p.bool("opacity_reconstruction", true)?,
-            radius: p.u32("radius", 5)?,
-            s_parallel: p.f32("s_parallel", 0.5)?,
-            s_perp: p.f32("s_perp", 0.1)?,
-            sigma_c: p.f32("sigma_c", 0.9)?,
-            strip_width: p.f32("strip_width", 0.5)?,
-            depth_threshold: p.f32("depth_threshold", 0.05)?,
-            front_threshold: p.f32("front_threshold", 0.01)?,
-            msaa: p.u32("msaa", 0)?,
-            depth_alpha: p.f32("depth_alpha", 0.5)?,
-        };
-        let bad = |param: &str, message: String| ParamError {
-            kind: "lipp.filter",
-            param: param.into(),
-            message,
-        };
-        if ![0, 1, 2, 4, 8].contains(&out.msaa) {
-            return Err(bad("msaa", format!("{} is not 0, 1, 2, 4 or 8", out.msaa)));
+impl Default for FilterParams {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            reconnect: true,
+            opacity_reconstruction: true,
+            radius: 5,
+            s_parallel: 0.5,
+            s_perp: 0.1,
+            sigma_c: 0.9,
+            strip_width: 0.5,
+            depth_threshold: 0.05,
+            front_threshold: 0.01,
+            msaa: 0,
+            depth_alpha: 0.5,
         }
-        if !(1..=MAX_RADIUS).contains(&out.radius) {
-            return Err(bad(
-                "radius",
-                format!("{} is outside 1..={MAX_RADIUS}", out.radius),
-            ));
-        }
-        for (name, v) in [
-            ("s_parallel", out.s_parallel),
-            ("s_perp", out.s_perp),
-            ("sigma_c", out.sigma_c),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(name, format!("{v} must be positive")));
-            }
-        }
-        Ok(out)
     }
 }
 
-impl PassDef for Filter {
-    fn kind(&self) -> &'static str {
-        "lipp.filter"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("gbuffer"),
-            Binding::read("shaded"),
-            Binding::write("output"),
-            Binding::write("hair_depth"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        FILTER_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: FILTER_GROUP,
+impl PassParams for FilterParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        if ![0, 1, 2, 4, 8].contains(&self.msaa) {
+            return Err(Invalid::new(
+                "msaa",
+                format!("{} is not 0, 1, 2, 4 or 8", self.msaa),
+            ));
         }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("lipp/filter.wgsl", "filter_pixels")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(FilterKernel(FilterParams::from_ron(params)?)))
-    }
-    /// `FilterParams` in shaders/lipp/filter.wgsl.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = FilterParams::from_ron(params)?;
-        Ok(vec![
-            flag(p.enabled),
-            flag(p.reconnect),
-            flag(p.opacity_reconstruction),
-            p.radius,
-            p.s_parallel.to_bits(),
-            p.s_perp.to_bits(),
-            p.sigma_c.to_bits(),
-            p.strip_width.to_bits(),
-            p.depth_threshold.to_bits(),
-            p.front_threshold.to_bits(),
-            q.width,
-            q.height,
-            p.msaa,
-            p.depth_alpha.to_bits(),
-        ])
+        in_range("radius", self.radius, 1..=MAX_RADIUS)?;
+        for (name, v) in [
+            ("s_parallel", self.s_parallel),
+            ("s_perp", self.s_perp),
+            ("sigma_c", self.sigma_c),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Invalid::new(name, format!("{v} must be positive")));
+            }
+        }
+        Ok(())
     }
 }
+
+crate::gpu_block! {
+    /// `FilterParams` in shaders/lipp/filter.wgsl.
+    pub struct FilterGpu {
+        enabled: u32,
+        reconnect: u32,
+        opacity_reconstruction: u32,
+        radius: u32,
+        s_parallel: f32,
+        s_perp: f32,
+        sigma_c: f32,
+        strip_width: f32,
+        depth_threshold: f32,
+        front_threshold: f32,
+        /// Scene quantities.
+        width: u32,
+        height: u32,
+        msaa: u32,
+        depth_alpha: f32,
+    }
+}
+
+pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
+    kind: "lipp.filter",
+    summary: "reconnection and opacity reconstruction filter over centre and conservative layers",
+    source: "Lipp §3.3, Appendix B Code 2",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("gbuffer"),
+        Binding::read("shaded"),
+        Binding::write("output"),
+        Binding::write("hair_depth"),
+    ]),
+    workgroup_size: FILTER_GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: FILTER_GROUP,
+    },
+    shader: Shader::compute("lipp/filter.wgsl", "filter_pixels"),
+    kernel: |p| Box::new(FilterKernel(*p)),
+    gpu: |p, q| FilterGpu {
+        enabled: flag(p.enabled),
+        reconnect: flag(p.reconnect),
+        opacity_reconstruction: flag(p.opacity_reconstruction),
+        radius: p.radius,
+        s_parallel: p.s_parallel,
+        s_perp: p.s_perp,
+        sigma_c: p.sigma_c,
+        strip_width: p.strip_width,
+        depth_threshold: p.depth_threshold,
+        front_threshold: p.front_threshold,
+        width: q.width,
+        height: q.height,
+        msaa: p.msaa,
+        depth_alpha: p.depth_alpha,
+    },
+    raster: None,
+};
 
 /// Linear view depth of NDC depth `z` (glam's `perspective_rh`, z in [0, 1]).
 pub fn linear_depth(f: &FrameData, z: f32) -> f32 {
@@ -438,10 +439,10 @@ mod tests {
 
     #[test]
     fn params_are_checked() {
-        assert!(FilterParams::from_ron(&ron::Value::Unit).is_ok());
+        assert!(FILTER.params(&ron::Value::Unit).is_ok());
         let v: ron::Value = ron::from_str(r#"{"radius": 0}"#).unwrap();
-        assert!(FilterParams::from_ron(&v).is_err());
+        assert!(FILTER.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"sigma_c": 0.0}"#).unwrap();
-        assert!(FilterParams::from_ron(&v).is_err());
+        assert!(FILTER.params(&v).is_err());
     }
 }

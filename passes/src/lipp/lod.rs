@@ -29,11 +29,11 @@ use super::{
     BUNDLE_WORDS, BundleLod, BundleRecord, Corner, LOD_CULLED, LOD_OTHER_GROOM, MAX_CONTROL_POINTS,
     MAX_GROUPS_X, bundle_count, frame, pcg, transform, unit,
 };
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
 use crate::layout::FrameData;
+use crate::params::{Invalid, PassParams};
 use crate::sim::{Ctx, Words};
-
-pub struct Lod;
 
 /// Threads of the single LOD workgroup (WGSL).
 pub const LOD_GROUP: u32 = 256;
@@ -41,7 +41,8 @@ pub const LOD_GROUP: u32 = 256;
 /// `LodParams.model` in WGSL when the pass decides for every groom.
 const ALL_MODELS: u32 = u32::MAX;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct LodParams {
     /// Off: every bundle draws N strands of C_max points (frustum culling still applies).
     pub enabled: bool,
@@ -56,96 +57,98 @@ pub struct LodParams {
     pub strand_lod: bool,
     /// §3.2.2 dynamic strand resolution (Eq. 4-5); off, C from L = 1.
     pub resolution_lod: bool,
-    /// Only this groom's bundles (the per-model block); `None`: all.
+    /// Only this groom's bundles (the per-model block sets `model_index`); `None`: all.
+    #[serde(rename = "model_index", deserialize_with = "crate::params::some")]
     pub model: Option<u32>,
 }
 
-impl LodParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("lipp.lod", v)?;
-        let out = Self {
-            enabled: p.bool("enabled", true)?,
-            lambda: p.f32("lambda", 1.0)?,
-            random_delta: p.bool("random_delta", true)?,
-            max_control_points: p.u32("max_control_points", 127)?,
-            frustum_cull: p.bool("frustum_cull", true)?,
-            strand_lod: p.bool("strand_lod", true)?,
-            resolution_lod: p.bool("resolution_lod", true)?,
-            model: p.model_index()?,
-        };
-        let err = |param: &str, message: String| ParamError {
-            kind: "lipp.lod",
-            param: param.into(),
-            message,
-        };
-        if !(3..=MAX_CONTROL_POINTS).contains(&out.max_control_points) {
-            return Err(err(
-                "max_control_points",
-                format!(
-                    "{} is outside 3..={MAX_CONTROL_POINTS} (32 lanes x 4 points per lane)",
-                    out.max_control_points
-                ),
-            ));
+impl Default for LodParams {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            lambda: 1.0,
+            random_delta: true,
+            max_control_points: 127,
+            frustum_cull: true,
+            strand_lod: true,
+            resolution_lod: true,
+            model: None,
         }
-        if !(out.lambda.is_finite() && out.lambda >= 0.0) {
-            return Err(err(
-                "lambda",
-                format!("{} is not a finite λ >= 0", out.lambda),
-            ));
-        }
-        Ok(out)
     }
 }
 
-impl PassDef for Lod {
-    fn kind(&self) -> &'static str {
-        "lipp.lod"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("hairmesh.bundles"),
-            Binding::read("hairmesh.layers"),
-            Binding::write("bundle_lod"),
-            Binding::write("raster_args"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        LOD_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Fixed(1)
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("lipp/lod.wgsl", "lod")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(LodKernel(LodParams::from_ron(params)?)))
-    }
-    /// `LodParams` in shaders/lipp/lod.wgsl.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = LodParams::from_ron(params)?;
-        Ok(vec![
-            flag(p.enabled),
-            p.lambda.to_bits(),
-            flag(p.random_delta),
-            p.max_control_points,
-            flag(p.frustum_cull),
-            flag(p.strand_lod),
-            flag(p.resolution_lod),
-            crate::contract::count(q.bundles),
-            p.model.unwrap_or(ALL_MODELS),
-            0,
-            0,
-            0,
-        ])
+impl PassParams for LodParams {
+    const READS_MODEL_INDEX: bool = true;
+
+    fn validate(&self) -> Result<(), Invalid> {
+        if !(3..=MAX_CONTROL_POINTS).contains(&self.max_control_points) {
+            return Err(Invalid::new(
+                "max_control_points",
+                format!(
+                    "{} is outside 3..={MAX_CONTROL_POINTS} (32 lanes x 4 points per lane)",
+                    self.max_control_points
+                ),
+            ));
+        }
+        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+            return Err(Invalid::new(
+                "lambda",
+                format!("{} is not a finite λ >= 0", self.lambda),
+            ));
+        }
+        Ok(())
     }
 }
+
+crate::gpu_block! {
+    /// `LodParams` in shaders/lipp/lod.wgsl.
+    pub struct LodGpu {
+        enabled: u32,
+        lambda: f32,
+        random_delta: u32,
+        max_control_points: u32,
+        frustum_cull: u32,
+        strand_lod: u32,
+        resolution_lod: u32,
+        /// Scene quantity: bundles packed.
+        bundles: u32,
+        /// Only this groom's bundles; `ALL_MODELS`: every groom.
+        model: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
+    }
+}
+
+pub static LOD: PassKind<LodParams, LodGpu> = PassKind {
+    kind: "lipp.lod",
+    summary: "per-bundle LOD: screen AABB (Eq. 3), L (Eq. 2), N_LOD (Eq. 1), control points (Eq. 4-5), indirect args",
+    source: "Lipp §3.2",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("hairmesh.bundles"),
+        Binding::read("hairmesh.layers"),
+        Binding::write("bundle_lod"),
+        Binding::write("raster_args"),
+    ]),
+    workgroup_size: LOD_GROUP,
+    dispatch: Dispatch::Fixed(1),
+    shader: Shader::compute("lipp/lod.wgsl", "lod"),
+    kernel: |p| Box::new(LodKernel(*p)),
+    gpu: |p, q| LodGpu {
+        enabled: flag(p.enabled),
+        lambda: p.lambda,
+        random_delta: flag(p.random_delta),
+        max_control_points: p.max_control_points,
+        frustum_cull: flag(p.frustum_cull),
+        strand_lod: flag(p.strand_lod),
+        resolution_lod: flag(p.resolution_lod),
+        bundles: count(q.bundles),
+        model: p.model.unwrap_or(ALL_MODELS),
+        ..LodGpu::default()
+    },
+    raster: None,
+};
 
 /// Lipp Eq. 5: C_raw snapped up to 2^k + 1, at most C_max (C_raw >= 3).
 pub fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
@@ -347,7 +350,7 @@ mod tests {
 
     #[test]
     fn the_grooms_strength_multiplies_lambda_and_zero_means_full_detail() {
-        let p = LodParams::from_ron(&ron::Value::Unit).unwrap();
+        let p = LodParams::default();
         let p = LodParams {
             random_delta: false,
             ..p
@@ -371,7 +374,7 @@ mod tests {
     fn a_per_groom_pass_skips_other_grooms_bundles() {
         let p = LodParams {
             model: Some(1),
-            ..LodParams::from_ron(&ron::Value::Unit).unwrap()
+            ..LodParams::default()
         };
         let other = decide(&p, 1.0, 0, 0.02);
         assert_eq!((other.strands, other.flags), (0, LOD_OTHER_GROOM));
@@ -381,10 +384,10 @@ mod tests {
     #[test]
     fn bad_params_are_errors() {
         let v: ron::Value = ron::from_str(r#"{"max_control_points": 300}"#).unwrap();
-        assert!(LodParams::from_ron(&v).is_err());
+        assert!(LOD.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"lambda": -1.0}"#).unwrap();
-        assert!(LodParams::from_ron(&v).is_err());
+        assert!(LOD.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"enabled": 3}"#).unwrap();
-        assert!(LodParams::from_ron(&v).is_err());
+        assert!(LOD.params(&v).is_err());
     }
 }

@@ -45,112 +45,117 @@ use super::{
     BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, frame, mix,
     normalize, transform,
 };
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
 use crate::layout::FrameData;
+use crate::params::{Invalid, PassParams};
 use crate::sim::{CounterValues, Ctx, Words};
-
-pub struct Raster;
 
 /// Sub-pixel snap grid (as the Kulikov raster's `SNAP`).
 pub const SNAP: f32 = 256.0;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct RasterParams {
     pub cooperative_assembly: bool,
     pub styling: bool,
     /// Pixels; the centre-sample layer's acceptance diameter.
     pub centre_diameter: f32,
     pub conservative_layer: bool,
+    /// MSAA reference mode: 2, 4 or 8 sample layers (0 or 1: off).
     pub msaa: u32,
     /// The groom this pass draws, in the graph's per-model block; grooms
     /// after the first also test `hair_depth`.
     pub model_index: u32,
 }
 
-impl RasterParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("lipp.raster", v)?;
-        let out = Self {
-            cooperative_assembly: p.bool("cooperative_assembly", true)?,
-            styling: p.bool("styling", true)?,
-            centre_diameter: p.f32("centre_diameter", 0.5)?,
-            conservative_layer: p.bool("conservative_layer", true)?,
-            msaa: p.u32("msaa", 0)?,
-            model_index: p.model_index()?.unwrap_or(0),
-        };
-        let err = |param: &str, message: &str| ParamError {
-            kind: "lipp.raster",
-            param: param.into(),
-            message: message.into(),
-        };
-        if !(out.centre_diameter > 0.0 && out.centre_diameter <= 2.0) {
-            return Err(err(
+impl Default for RasterParams {
+    fn default() -> Self {
+        Self {
+            cooperative_assembly: true,
+            styling: true,
+            centre_diameter: 0.5,
+            conservative_layer: true,
+            msaa: 0,
+            model_index: 0,
+        }
+    }
+}
+
+impl PassParams for RasterParams {
+    const READS_MODEL_INDEX: bool = true;
+
+    fn validate(&self) -> Result<(), Invalid> {
+        if !(self.centre_diameter > 0.0 && self.centre_diameter <= 2.0) {
+            return Err(Invalid::new(
                 "centre_diameter",
                 "expected a diameter in (0, 2] pixels",
             ));
         }
-        if ![0, 1, 2, 4, 8].contains(&out.msaa) {
-            return Err(err("msaa", "expected 0 or 1 (off), 2, 4 or 8 samples"));
+        if ![0, 1, 2, 4, 8].contains(&self.msaa) {
+            return Err(Invalid::new(
+                "msaa",
+                "expected 0 or 1 (off), 2, 4 or 8 samples",
+            ));
         }
-        Ok(out)
+        Ok(())
     }
 }
 
-impl PassDef for Raster {
-    fn kind(&self) -> &'static str {
-        "lipp.raster"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("raster_args"),
-            Binding::read("bundle_lod"),
-            Binding::read("hairmesh.bundles"),
-            Binding::read("hairmesh.layers"),
-            Binding::read("scene.depth"),
-            Binding::read("hair_depth"),
-            Binding::atomic("gbuffer"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        RASTER_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Indirect {
-            binding: "raster_args",
-            word: 0,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("lipp/raster.wgsl", "raster")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))
-    }
+crate::gpu_block! {
     /// `RasterParams` in shaders/lipp/raster.wgsl.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = RasterParams::from_ron(params)?;
-        Ok(vec![
-            flag(p.cooperative_assembly),
-            flag(p.styling),
-            p.centre_diameter.to_bits(),
-            flag(p.conservative_layer),
-            crate::contract::count(q.bundles),
-            q.width,
-            q.height,
-            p.msaa,
-            p.model_index,
-            0,
-            0,
-            0,
-        ])
+    pub struct RasterGpu {
+        cooperative_assembly: u32,
+        styling: u32,
+        centre_diameter: f32,
+        conservative_layer: u32,
+        /// Scene quantities.
+        bundles: u32,
+        width: u32,
+        height: u32,
+        msaa: u32,
+        model_index: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
     }
 }
+
+pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
+    kind: "lipp.raster",
+    summary: "cooperative strand assembly (Code 1) and DDA line rasterization into centre and conservative 64-bit G-buffers",
+    source: "Lipp §3.1, Appendix B Code 1",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("raster_args"),
+        Binding::read("bundle_lod"),
+        Binding::read("hairmesh.bundles"),
+        Binding::read("hairmesh.layers"),
+        Binding::read("scene.depth"),
+        Binding::read("hair_depth"),
+        Binding::atomic("gbuffer"),
+    ]),
+    workgroup_size: RASTER_GROUP,
+    dispatch: Dispatch::Indirect {
+        binding: "raster_args",
+        word: 0,
+    },
+    shader: Shader::compute("lipp/raster.wgsl", "raster"),
+    kernel: |p| Box::new(RasterKernel(*p)),
+    gpu: |p, q| RasterGpu {
+        cooperative_assembly: flag(p.cooperative_assembly),
+        styling: flag(p.styling),
+        centre_diameter: p.centre_diameter,
+        conservative_layer: flag(p.conservative_layer),
+        bundles: count(q.bundles),
+        width: q.width,
+        height: q.height,
+        msaa: p.msaa,
+        model_index: p.model_index,
+        ..RasterGpu::default()
+    },
+    raster: None,
+};
 
 struct RasterKernel(RasterParams);
 

@@ -4,7 +4,7 @@
 use super::*;
 use crate::contract::PassDef;
 use crate::layout::words_of;
-use crate::lipp::lod::Lod;
+use crate::lipp::lod::LOD;
 use crate::lipp::payload::{EMPTY, unpack};
 use crate::sim::harness::Harness;
 use bytemuck::Zeroable;
@@ -75,12 +75,12 @@ fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
         .buffer("raster_args", vec![0; 8])
         .buffer("scene.depth", vec![1.0f32.to_bits(); (W * H) as usize])
         .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
-    let lod = Lod
+    let lod = LOD
         .cpu_kernel(&ron::from_str(r#"{"enabled": false}"#).unwrap())
         .unwrap();
     h.run(lod.as_ref(), 1, 256);
     let groups = h.read("raster_args")[0];
-    let k = Raster.cpu_kernel(&ron::from_str(raster).unwrap()).unwrap();
+    let k = crate::PassDef::cpu_kernel(&RASTER, &ron::from_str(raster).unwrap()).unwrap();
     h.run(k.as_ref(), groups, RASTER_GROUP);
     (h, groups)
 }
@@ -140,7 +140,7 @@ fn depth_test_against_the_scene_rejects_hidden_strands() {
     let (mut h, groups) = harness("{}", 32);
     h.buffer("scene.depth", vec![0.0f32.to_bits(); (W * H) as usize])
         .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
-    let k = Raster.cpu_kernel(&ron::Value::Unit).unwrap();
+    let k = crate::PassDef::cpu_kernel(&RASTER, &ron::Value::Unit).unwrap();
     let c = h.run(k.as_ref(), groups, RASTER_GROUP);
     assert_eq!(c.pixels_written, 0);
     assert!(payloads(&h).iter().all(|&x| x == EMPTY));
@@ -154,7 +154,7 @@ fn bad_params_are_errors() {
         r#"{"styling": 1}"#,
     ] {
         assert!(
-            Raster.cpu_kernel(&ron::from_str(bad).unwrap()).is_err(),
+            crate::PassDef::cpu_kernel(&RASTER, &ron::from_str(bad).unwrap()).is_err(),
             "{bad}"
         );
     }
@@ -165,7 +165,7 @@ fn msaa_reference_mode_fills_one_layer_per_sample() {
     let (mut h, groups) = harness("{}", 32);
     let layers = 4usize;
     h.buffer("gbuffer", vec![u32::MAX; 2 * layers * (W * H) as usize]);
-    let k = Raster
+    let k = RASTER
         .cpu_kernel(&ron::from_str(r#"{"msaa": 4}"#).unwrap())
         .unwrap();
     h.run(k.as_ref(), groups, RASTER_GROUP);

@@ -33,18 +33,27 @@ use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
 use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
+use crate::describe::PassKind;
 use crate::layout::{FrameData, LightData, ModelData, read};
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{Ctx, Words};
 use strandgraph_graph::schema::Quantity;
-
-pub struct Shade;
 
 pub const SHADE_GROUP: u32 = 64;
 const PI: f32 = std::f32::consts::PI;
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+crate::string_enum! {
+    /// The hair scattering model (only Chiang 2016 so far).
+    pub enum HairModel {
+        Chiang16,
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ShadeParams {
+    pub model: HairModel,
     pub multiple_scattering: bool,
     pub probe_lighting: bool,
     /// With `probe_lighting`: the prefiltered GGX lookup for R + TRT.
@@ -63,102 +72,99 @@ pub struct ShadeParams {
     pub model_index: u32,
 }
 
-impl ShadeParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("lipp.shade", v)?;
-        let err = |param: &str, message: &str| ParamError {
-            kind: "lipp.shade",
-            param: param.into(),
-            message: message.into(),
-        };
-        let model = p.string("model", "Chiang16")?;
-        if model != "Chiang16" {
-            return Err(err("model", "only \"Chiang16\" is implemented"));
+impl Default for ShadeParams {
+    fn default() -> Self {
+        Self {
+            model: HairModel::Chiang16,
+            multiple_scattering: true,
+            probe_lighting: true,
+            probe_specular: true,
+            specular: 1.0,
+            dom_shadows: true,
+            lod_depth_correction: true,
+            dom_resolution: 512,
+            dom_layers: 4,
+            dom_layer_thickness: 0.02,
+            model_index: 0,
         }
-        let out = Self {
-            multiple_scattering: p.bool("multiple_scattering", true)?,
-            probe_lighting: p.bool("probe_lighting", true)?,
-            probe_specular: p.bool("probe_specular", true)?,
-            specular: p.f32("specular", 1.0)?,
-            dom_shadows: p.bool("dom_shadows", true)?,
-            lod_depth_correction: p.bool("lod_depth_correction", true)?,
-            dom_resolution: p.u32("dom_resolution", 512)?,
-            dom_layers: p.u32("dom_layers", 4)?,
-            dom_layer_thickness: p.f32("dom_layer_thickness", 0.02)?,
-            model_index: p.model_index()?.unwrap_or(0),
-        };
-        if !(16..=4096).contains(&out.dom_resolution) {
-            return Err(err("dom_resolution", "expected 16..=4096 texels"));
-        }
-        if !(1..=8).contains(&out.dom_layers) {
-            return Err(err("dom_layers", "expected 1..=8 layers"));
-        }
-        if !(out.dom_layer_thickness.is_finite() && out.dom_layer_thickness > 0.0) {
-            return Err(err("dom_layer_thickness", "must be positive"));
-        }
-        Ok(out)
     }
 }
 
-impl PassDef for Shade {
-    fn kind(&self) -> &'static str {
-        "lipp.shade"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lights"),
-            Binding::read("env.sh"),
-            Binding::read("gbuffer"),
-            Binding::read("raster_args"),
-            Binding::read("dom_depth"),
-            Binding::read("dom_layers"),
-            Binding::write("shaded"),
-            Binding::read("env.prefiltered"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        SHADE_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: SHADE_GROUP,
+impl PassParams for ShadeParams {
+    const READS_MODEL_INDEX: bool = true;
+
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("dom_resolution", self.dom_resolution, 16..=4096)?;
+        in_range("dom_layers", self.dom_layers, 1..=8)?;
+        if !(self.dom_layer_thickness.is_finite() && self.dom_layer_thickness > 0.0) {
+            return Err(Invalid::new("dom_layer_thickness", "must be positive"));
         }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("lipp/shade.wgsl", "shade")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(ShadeKernel(ShadeParams::from_ron(params)?)))
-    }
-    /// `ShadeParams` in shaders/lipp/shade.wgsl.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = ShadeParams::from_ron(params)?;
-        Ok(vec![
-            flag(p.multiple_scattering),
-            flag(p.probe_lighting),
-            p.specular.to_bits(),
-            q.width,
-            q.height,
-            crate::contract::count(q.lights),
-            flag(p.dom_shadows),
-            flag(p.lod_depth_correction),
-            p.dom_resolution,
-            p.dom_layers,
-            p.dom_layer_thickness.to_bits(),
-            p.model_index,
-            flag(p.probe_specular),
-            0,
-        ])
+        Ok(())
     }
 }
+
+crate::gpu_block! {
+    /// `ShadeParams` in shaders/lipp/shade.wgsl.
+    pub struct ShadeGpu {
+        multiple_scattering: u32,
+        probe_lighting: u32,
+        specular: f32,
+        /// Scene quantities.
+        width: u32,
+        height: u32,
+        lights: u32,
+        dom_shadows: u32,
+        lod_depth_correction: u32,
+        dom_resolution: u32,
+        dom_layers: u32,
+        dom_layer_thickness: f32,
+        model_index: u32,
+        probe_specular: u32,
+        _pad2: u32,
+    }
+}
+
+pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
+    kind: "lipp.shade",
+    summary: "deferred shading: Chiang 2016 R/TT/TRT, Kajiya-Kay multiple scattering, DOM shadows, probe lighting",
+    source: "Lipp §3.4",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lights"),
+        Binding::read("env.sh"),
+        Binding::read("gbuffer"),
+        Binding::read("raster_args"),
+        Binding::read("dom_depth"),
+        Binding::read("dom_layers"),
+        Binding::write("shaded"),
+        Binding::read("env.prefiltered"),
+    ]),
+    workgroup_size: SHADE_GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: SHADE_GROUP,
+    },
+    shader: Shader::compute("lipp/shade.wgsl", "shade"),
+    kernel: |p| Box::new(ShadeKernel(*p)),
+    gpu: |p, q| ShadeGpu {
+        multiple_scattering: flag(p.multiple_scattering),
+        probe_lighting: flag(p.probe_lighting),
+        specular: p.specular,
+        width: q.width,
+        height: q.height,
+        lights: count(q.lights),
+        dom_shadows: flag(p.dom_shadows),
+        lod_depth_correction: flag(p.lod_depth_correction),
+        dom_resolution: p.dom_resolution,
+        dom_layers: p.dom_layers,
+        dom_layer_thickness: p.dom_layer_thickness,
+        model_index: p.model_index,
+        probe_specular: flag(p.probe_specular),
+        _pad2: 0,
+    },
+    raster: None,
+};
 
 /// Irradiance from L2 SH radiance coefficients at unit normal `n`
 /// (Ramamoorthi and Hanrahan 2001, Eq. 13).
@@ -388,6 +394,6 @@ mod tests {
         assert!(depth_correction(10, 100) > depth_correction(50, 100));
         assert_eq!(depth_correction(0, 100), 0.0);
         let v: ron::Value = ron::from_str(r#"{"dom_layers": 0}"#).unwrap();
-        assert!(ShadeParams::from_ron(&v).is_err());
+        assert!(SHADE.params(&v).is_err());
     }
 }

@@ -13,71 +13,55 @@
 //! compare `Less`, writes on, `FrontFace::Ccw`, `CullMode::Back`.
 
 use super::{GROUP, View, clear, dispatch};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Shader};
+use crate::describe::PassKind;
 use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use crate::params::NoParams;
 use crate::sim::{CounterValues, Ctx};
+use strandgraph_graph::Quantities;
 
-pub struct DepthPrepass;
-
-impl PassDef for DepthPrepass {
-    fn kind(&self) -> &'static str {
-        "scene.depth_prepass"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("mesh.triangles"),
-            Binding::write("scene.depth"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        dispatch()
-    }
-    fn shader(&self) -> Shader {
-        Shader {
-            file: "scene/depth_prepass.wgsl",
-            entry: "vs_main",
-            fragment: Some("fs_main"),
-        }
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        // No parameters yet; still reject a malformed parameter block.
-        Params::new(self.kind(), params)?;
-        Ok(Box::new(PrepassKernel))
-    }
+crate::gpu_block! {
     /// `DepthPrepassParams`: one unused word.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Params::new(self.kind(), params)?;
-        Ok(vec![0])
+    pub struct DepthPrepassGpu {
+        unused: u32,
     }
-    /// The prologue's clear to 1.0, then `fetch_min` of depth: Less, written.
-    fn raster(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Option<RasterState>, ParamError> {
-        Params::new(self.kind(), params)?;
-        Ok(Some(RasterState {
-            vertices: q.triangles * 3,
-            cull_back_faces: true,
-            color_load: ColorLoad::Load,
-            depth_load: DepthLoad::Clear(1.0),
-            draws: vec![Draw {
-                fragment: "fs_main",
-                blend: Blend::Replace,
-                color_writes: true,
-                depth_compare: Compare::Less,
-                depth_write: true,
-            }],
-        }))
+}
+
+pub static DEPTH_PREPASS: PassKind<NoParams, DepthPrepassGpu> = PassKind {
+    kind: "scene.depth_prepass",
+    summary: "rasterize opaque meshes (heads, bodies) into scene depth",
+    source: "strandgraph",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("mesh.triangles"),
+        Binding::write("scene.depth"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: dispatch(),
+    shader: Shader {
+        file: "scene/depth_prepass.wgsl",
+        entry: "vs_main",
+        fragment: Some("fs_main"),
+    },
+    kernel: |_| Box::new(PrepassKernel),
+    gpu: |_, _| DepthPrepassGpu::default(),
+    raster: Some(draw),
+};
+
+/// The prologue's clear to 1.0, then `fetch_min` of depth: Less, written.
+fn draw(_: &NoParams, q: &Quantities) -> RasterState {
+    RasterState {
+        vertices: q.triangles * 3,
+        cull_back_faces: true,
+        color_load: ColorLoad::Load,
+        depth_load: DepthLoad::Clear(1.0),
+        draws: vec![Draw {
+            fragment: "fs_main",
+            blend: Blend::Replace,
+            color_writes: true,
+            depth_compare: Compare::Less,
+            depth_write: true,
+        }],
     }
 }
 
@@ -137,7 +121,7 @@ mod tests {
         let mut results = Vec::new();
         for tris in [[near, far], [far, near]] {
             let hs = harness(f, &tris, &[]);
-            run(&hs, &DepthPrepass);
+            run(&hs, &DEPTH_PREPASS);
             assert_eq!(hs.out_of_bounds(), 0);
             results.push(hs.read("scene.depth"));
         }
@@ -165,7 +149,7 @@ mod tests {
         );
         let covered = |t| {
             let hs = harness(f, &[t], &[]);
-            run(&hs, &DepthPrepass);
+            run(&hs, &DEPTH_PREPASS);
             hs.read("scene.depth")
                 .iter()
                 .filter(|&&d| d != 1.0f32.to_bits())
@@ -186,7 +170,7 @@ mod tests {
             Vec3::Z,
         );
         let hs = harness(f, &[t], &[]);
-        run(&hs, &DepthPrepass);
+        run(&hs, &DEPTH_PREPASS);
         assert!(
             hs.read("scene.depth")
                 .iter()
@@ -201,7 +185,7 @@ mod tests {
         let f = frame(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 35.0, 128, 128);
         let tris = head();
         let hs = harness(f, &tris, &[]);
-        run(&hs, &DepthPrepass);
+        run(&hs, &DEPTH_PREPASS);
         assert_eq!(hs.out_of_bounds(), 0);
         let depth = hs.read("scene.depth");
         let covered = depth.iter().filter(|&&d| d != 1.0f32.to_bits()).count();

@@ -25,7 +25,7 @@ pub const GROUP: u32 = 64;
 /// Words per `TriangleData` record.
 const TRIANGLE_WORDS: usize = std::mem::size_of::<TriangleData>() / 4;
 
-fn dispatch() -> Dispatch {
+const fn dispatch() -> Dispatch {
     Dispatch::PerElement {
         quantity: Quantity::Triangles,
         per_group: GROUP,

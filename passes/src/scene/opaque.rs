@@ -27,88 +27,63 @@
 //! `CullMode::Back`; [`OpaqueParams::uniform`] fills its parameter block.
 
 use super::{GROUP, View, corner_normals, corners, dispatch};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Shader};
+use crate::describe::PassKind;
 use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::kulikov::skin_shadow::{ambient_visibility, light_visibility};
 use crate::layout::{LightData, read};
+use crate::params::{Invalid, PassParams, non_negative};
 use crate::sim::{CounterValues, Ctx, Words};
 use glam::Vec3;
 use half::f16;
+use strandgraph_graph::Quantities;
 
-pub struct Opaque;
+pub static OPAQUE: PassKind<OpaqueParams, OpaqueGpu> = PassKind {
+    kind: "scene.opaque",
+    summary: "shade opaque meshes, including hair shadows on skin",
+    source: "Kulikov 2025, 'Hair shadows on skin'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("mesh.triangles"),
+        Binding::read("lights"),
+        Binding::read("skin_shadow"),
+        Binding::read("scene.depth"),
+        Binding::write("output"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: dispatch(),
+    shader: Shader {
+        file: "scene/opaque.wgsl",
+        entry: "vs_main",
+        fragment: Some("fs_main"),
+    },
+    kernel: |p| Box::new(OpaqueKernel { params: *p }),
+    gpu: |p, _| p.uniform(),
+    raster: Some(draw),
+};
 
-const KIND: &str = "scene.opaque";
-
-impl PassDef for Opaque {
-    fn kind(&self) -> &'static str {
-        KIND
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("frame"),
-            Binding::read("mesh.triangles"),
-            Binding::read("lights"),
-            Binding::read("skin_shadow"),
-            Binding::read("scene.depth"),
-            Binding::write("output"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        dispatch()
-    }
-    fn shader(&self) -> Shader {
-        Shader {
-            file: "scene/opaque.wgsl",
-            entry: "vs_main",
-            fragment: Some("fs_main"),
-        }
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(OpaqueKernel {
-            params: OpaqueParams::from_ron(params)?,
-        }))
-    }
-    /// `OpaqueParams`: albedo rgb, ambient ([`OpaqueParams::uniform`]).
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(OpaqueParams::from_ron(params)?
-            .uniform()
-            .map(f32::to_bits)
-            .to_vec())
-    }
-    /// Shades where the prepass's depth is equal (the kernel's `==` test),
-    /// over the background the prologue clears to.
-    fn raster(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Option<RasterState>, ParamError> {
-        let [r, g, b] = OpaqueParams::from_ron(params)?.background;
-        Ok(Some(RasterState {
-            vertices: q.triangles * 3,
-            cull_back_faces: true,
-            color_load: ColorLoad::Clear([r, g, b, 1.0]),
-            depth_load: DepthLoad::Load,
-            draws: vec![Draw {
-                fragment: "fs_main",
-                blend: Blend::Replace,
-                color_writes: true,
-                depth_compare: Compare::Equal,
-                depth_write: false,
-            }],
-        }))
+/// Shades where the prepass's depth is equal (the kernel's `==` test),
+/// over the background the prologue clears to.
+fn draw(p: &OpaqueParams, q: &Quantities) -> RasterState {
+    let [r, g, b] = p.background;
+    RasterState {
+        vertices: q.triangles * 3,
+        cull_back_faces: true,
+        color_load: ColorLoad::Clear([r, g, b, 1.0]),
+        depth_load: DepthLoad::Load,
+        draws: vec![Draw {
+            fragment: "fs_main",
+            blend: Blend::Replace,
+            color_writes: true,
+            depth_compare: Compare::Equal,
+            depth_write: false,
+        }],
     }
 }
 
 /// The pass's parameters, with their defaults.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct OpaqueParams {
     /// Linear RGB where no mesh is drawn (the colour attachment's clear value).
     pub background: [f32; 3],
@@ -128,69 +103,38 @@ impl Default for OpaqueParams {
     }
 }
 
+impl PassParams for OpaqueParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        non_negative("ambient", self.ambient)?;
+        for (key, rgb) in [("background", self.background), ("albedo", self.albedo)] {
+            if !rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
+                return Err(Invalid::new(
+                    key,
+                    format!("expected three numbers >= 0, got {rgb:?}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+crate::gpu_block! {
+    /// `OpaqueParams` in shaders/scene/opaque.wgsl.
+    pub struct OpaqueGpu {
+        /// rgb: albedo; a: ambient.
+        albedo_ambient: [f32; 4],
+    }
+}
+
 impl OpaqueParams {
-    pub fn from_ron(value: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new(KIND, value)?;
-        let d = Self::default();
-        let ambient = p.f32("ambient", d.ambient)?;
-        if !(ambient.is_finite() && ambient >= 0.0) {
-            return Err(error(
-                "ambient",
-                format!("expected a number >= 0, got {ambient}"),
-            ));
-        }
-        Ok(Self {
-            background: rgb(value, "background", d.background)?,
-            albedo: rgb(value, "albedo", d.albedo)?,
-            ambient,
-        })
-    }
-
-    /// Values for the WGSL pipeline-overridable constants of
-    /// `shaders/scene/opaque.wgsl` (wgpu `PipelineCompilationOptions::constants`,
-    /// Vulkan specialization constants). `background` is the clear colour.
     /// The WGSL `OpaqueParams` block at binding 0: albedo rgb, ambient.
-    pub fn uniform(&self) -> [f32; 4] {
-        [self.albedo[0], self.albedo[1], self.albedo[2], self.ambient]
-    }
-}
-
-fn error(param: &str, message: String) -> ParamError {
-    ParamError {
-        kind: KIND,
-        param: param.to_string(),
-        message,
-    }
-}
-
-/// Reads a colour given as three non-negative numbers, e.g. `[0.75, 0.55, 0.45]`
-/// (a RON tuple reads the same). [`Params`] has no list reader, so this looks
-/// the key up itself; `Params::new` has already checked the block is a map.
-fn rgb(value: &ron::Value, name: &str, default: [f32; 3]) -> Result<[f32; 3], ParamError> {
-    let ron::Value::Map(map) = value else {
-        return Ok(default);
-    };
-    let Some(v) = map.get(&ron::Value::String(name.to_string())) else {
-        return Ok(default);
-    };
-    let bad = || error(name, format!("expected three numbers >= 0, got {v:?}"));
-    let ron::Value::Seq(items) = v else {
-        return Err(bad());
-    };
-    let mut out = [0.0f32; 3];
-    if items.len() != 3 {
-        return Err(bad());
-    }
-    for (o, item) in out.iter_mut().zip(items) {
-        match item {
-            ron::Value::Number(n) => *o = n.into_f64() as f32,
-            _ => return Err(bad()),
-        }
-        if !(o.is_finite() && *o >= 0.0) {
-            return Err(bad());
+    /// (`background` is the colour attachment's clear value.)
+    pub fn uniform(&self) -> OpaqueGpu {
+        let [r, g, b] = self.albedo;
+        OpaqueGpu {
+            albedo_ambient: [r, g, b, self.ambient],
         }
     }
-    Ok(out)
 }
 
 /// Linear RGB reflected towards the camera from a point `p` with unit
@@ -303,7 +247,7 @@ impl CpuKernel for OpaqueKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::depth_prepass::DepthPrepass;
+    use super::super::depth_prepass::DEPTH_PREPASS;
     use super::super::testing::{frame, harness, head, run, sun, triangle};
     use super::*;
 
@@ -320,23 +264,22 @@ mod tests {
     #[test]
     fn params_default_parse_and_reject() {
         assert_eq!(
-            OpaqueParams::from_ron(&ron::Value::Unit).unwrap(),
+            OPAQUE.params(&ron::Value::Unit).unwrap(),
             OpaqueParams::default()
         );
-        let v: ron::Value = ron::from_str(
-            r#"{"background": [0.1, 0.2, 0.3], "albedo": (1, 1, 1), "hair_ao_steps": 2}"#,
-        )
-        .unwrap();
-        let p = OpaqueParams::from_ron(&v).unwrap();
+        let v: ron::Value =
+            ron::from_str(r#"{"background": [0.1, 0.2, 0.3], "albedo": (1, 1, 1)}"#).unwrap();
+        let p = OPAQUE.params(&v).unwrap();
         assert_eq!(p.background, [0.1, 0.2, 0.3]);
         assert_eq!(p.albedo, [1.0; 3]);
         for bad in [
             r#"{"albedo": [1, 2]}"#,
             r#"{"background": 0.5}"#,
             r#"{"albedo": [1, -1, 0]}"#,
+            r#"{"hair_ao_steps": 2}"#,
         ] {
             let v: ron::Value = ron::from_str(bad).unwrap();
-            let e = OpaqueParams::from_ron(&v).unwrap_err();
+            let e = OPAQUE.params(&v).unwrap_err();
             assert!(e.to_string().contains("scene.opaque"), "{e}");
         }
     }
@@ -345,7 +288,7 @@ mod tests {
     fn uniform_block_carries_albedo_and_ambient() {
         let p = OpaqueParams::default();
         assert_eq!(
-            p.uniform(),
+            p.uniform().albedo_ambient,
             [p.albedo[0], p.albedo[1], p.albedo[2], p.ambient]
         );
         let wgsl = include_str!("../../../shaders/scene/opaque.wgsl");
@@ -373,8 +316,8 @@ mod tests {
             Vec3::X,
         );
         let hs = harness(f, &[far, near], &[light]);
-        run(&hs, &DepthPrepass);
-        run(&hs, &Opaque);
+        run(&hs, &DEPTH_PREPASS);
+        run(&hs, &OPAQUE);
         assert_eq!(hs.out_of_bounds(), 0);
         let out = hs.read("output");
         let p = OpaqueParams::default();
@@ -402,8 +345,8 @@ mod tests {
         }];
         let hs = harness(f, tris, &lights);
         let start = std::time::Instant::now();
-        run(&hs, &DepthPrepass);
-        run(&hs, &Opaque);
+        run(&hs, &DEPTH_PREPASS);
+        run(&hs, &OPAQUE);
         let ms = start.elapsed().as_secs_f64() * 1e3;
         (
             hs.read("scene.depth"),

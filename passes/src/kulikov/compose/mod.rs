@@ -42,16 +42,15 @@ use super::raster::geometry::Trapezoid;
 use super::raster::{LAYERS, segment_trapezoid};
 use super::tiles::ModelTiles;
 use super::{Scene, TILE};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
+use crate::describe::PassKind;
 use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use crate::layout::MODEL_FACIAL_HAIR;
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{CounterValues, Ctx, Words};
 use reconstruct::{Layer, reconstruct};
+use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
-
-pub struct Compose;
-
-const KIND: &str = "kulikov.compose";
 pub const GROUP: u32 = 256;
 
 /// A fixed Poisson-disk pattern in the unit disk (minimum distance 0.5),
@@ -67,158 +66,160 @@ pub const POISSON: [[f32; 2]; 8] = [
     [-0.1, 0.95],
 ];
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+crate::string_enum! {
+    /// Kulikov's coverage reconstruction from the summed coverage.
+    pub enum CoverageFit {
+        Quadratic,
+        /// 1 − exp(−x).
+        Exponential,
+    }
+}
+
+crate::string_enum! {
+    /// What a layer's coverage is measured by.
+    pub enum LayerCoverage {
+        /// The exact trapezoid area.
+        Exact,
+        /// The projected width.
+        Width,
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ComposeParams {
+    /// Poisson-disk atlas samples per pixel (0..=8).
     pub poisson_samples: u32,
-    /// false: quadratic; true: 1 - exp(-x).
-    pub exponential_fit: bool,
-    /// false: exact trapezoid area; true: projected width.
-    pub width_coverage: bool,
+    pub coverage_fit: CoverageFit,
+    pub layer_coverage: LayerCoverage,
     pub reconstruct_missing: bool,
     pub depth_threshold: f32,
     pub facial_hair_bias: f32,
 }
 
-impl ComposeParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new(KIND, v)?;
-        let err = |param: &str, message: String| ParamError {
-            kind: KIND,
-            param: param.into(),
-            message,
-        };
-        let exponential_fit = match p.string("coverage_fit", "Quadratic")?.as_str() {
-            "Quadratic" => false,
-            "Exponential" => true,
-            o => {
-                return Err(err(
-                    "coverage_fit",
-                    format!("expected \"Quadratic\" or \"Exponential\", got {o:?}"),
-                ));
-            }
-        };
-        let width_coverage = match p.string("layer_coverage", "Exact")?.as_str() {
-            "Exact" => false,
-            "Width" => true,
-            o => {
-                return Err(err(
-                    "layer_coverage",
-                    format!("expected \"Exact\" or \"Width\", got {o:?}"),
-                ));
-            }
-        };
-        let poisson_samples = p.u32("poisson_samples", 8)?;
-        if poisson_samples as usize > POISSON.len() {
-            return Err(err(
-                "poisson_samples",
-                format!("expected 0..={}, got {poisson_samples}", POISSON.len()),
-            ));
+impl Default for ComposeParams {
+    fn default() -> Self {
+        Self {
+            poisson_samples: 8,
+            coverage_fit: CoverageFit::Quadratic,
+            layer_coverage: LayerCoverage::Exact,
+            reconstruct_missing: true,
+            depth_threshold: 0.75,
+            facial_hair_bias: 0.5,
         }
-        Ok(Self {
-            poisson_samples,
-            exponential_fit,
-            width_coverage,
-            reconstruct_missing: p.bool("reconstruct_missing", true)?,
-            depth_threshold: p.f32("depth_threshold", 0.75)?,
-            facial_hair_bias: p.f32("facial_hair_bias", 0.5)?,
-        })
-    }
-
-    /// The WGSL `ComposeParams` block (binding 0, 32 bytes).
-    pub fn uniform(&self, q: &strandgraph_graph::Quantities) -> Vec<u32> {
-        vec![
-            self.poisson_samples,
-            u32::from(self.exponential_fit),
-            u32::from(self.width_coverage),
-            u32::from(self.reconstruct_missing),
-            self.depth_threshold.to_bits(),
-            self.facial_hair_bias.to_bits(),
-            q.width,
-            q.height,
-        ]
     }
 }
 
-const BINDINGS: &[Binding] = &[
-    Binding::read("frame"),
-    Binding::read("models"),
-    Binding::read("lod_models"),
-    Binding::read("atlas_tiles"),
-    Binding::read("vis_atlas"),
-    Binding::read("coverage_atlas"),
-    Binding::read("vertex_lighting"),
-    Binding::read("clip_positions"),
-    Binding::read("groom.vertices"),
-    // Attachments (GPU): blended colour, hair depth.
-    Binding::write("output"),
-    Binding::write("scene.depth"),
-];
+impl PassParams for ComposeParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range(
+            "poisson_samples",
+            self.poisson_samples,
+            0..=POISSON.len() as u32,
+        )
+    }
+}
 
-impl PassDef for Compose {
-    fn kind(&self) -> &'static str {
-        KIND
+impl ComposeParams {
+    /// Coverage fit 1 − exp(−x) rather than quadratic.
+    pub fn exponential_fit(&self) -> bool {
+        self.coverage_fit == CoverageFit::Exponential
     }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        Some(BINDINGS)
+    /// Layer coverage by projected width rather than exact area.
+    pub fn width_coverage(&self) -> bool {
+        self.layer_coverage == LayerCoverage::Width
     }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::PerElement {
-            quantity: Quantity::Pixels,
-            per_group: GROUP,
+
+    /// The WGSL `ComposeParams` block (binding 0, 32 bytes).
+    pub fn uniform(&self, q: &Quantities) -> ComposeGpu {
+        ComposeGpu {
+            poisson_samples: self.poisson_samples,
+            exponential_fit: flag(self.exponential_fit()),
+            width_coverage: flag(self.width_coverage()),
+            reconstruct_missing: flag(self.reconstruct_missing),
+            depth_threshold: self.depth_threshold,
+            facial_hair_bias: self.facial_hair_bias,
+            width: q.width,
+            height: q.height,
         }
     }
-    fn shader(&self) -> Shader {
-        Shader {
-            file: "kulikov/compose.wgsl",
-            entry: "vs_main",
-            fragment: Some("fs_main"),
-        }
+}
+
+crate::gpu_block! {
+    /// `ComposeParams` in shaders/kulikov/compose.wgsl.
+    pub struct ComposeGpu {
+        poisson_samples: u32,
+        /// 0 Quadratic, 1 Exponential.
+        exponential_fit: u32,
+        /// 0 Exact, 1 Width.
+        width_coverage: u32,
+        reconstruct_missing: u32,
+        depth_threshold: f32,
+        facial_hair_bias: f32,
+        width: u32,
+        height: u32,
     }
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(ComposeParams::from_ron(params)?.uniform(q))
-    }
-    /// shaders/kulikov/compose.wgsl (header): six vertices per model, drawn
-    /// back to front with premultiplied blending over the loaded colour;
-    /// then `fs_depth` with the same quads writes hair depth into the
-    /// loaded `scene.depth` where nearer (the CPU kernel's `z < depth`).
-    fn raster(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Option<RasterState>, ParamError> {
-        ComposeParams::from_ron(params)?;
-        Ok(Some(RasterState {
-            vertices: q.models * 6,
-            cull_back_faces: false,
-            color_load: ColorLoad::Load,
-            depth_load: DepthLoad::Load,
-            draws: vec![
-                Draw {
-                    fragment: "fs_main",
-                    blend: Blend::PremultipliedOverKeepAlpha,
-                    color_writes: true,
-                    depth_compare: Compare::Always,
-                    depth_write: false,
-                },
-                Draw {
-                    fragment: "fs_depth",
-                    blend: Blend::Replace,
-                    color_writes: false,
-                    depth_compare: Compare::Less,
-                    depth_write: true,
-                },
-            ],
-        }))
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(ComposeKernel(ComposeParams::from_ron(params)?)))
+}
+
+pub static COMPOSE: PassKind<ComposeParams, ComposeGpu> = PassKind {
+    kind: "kulikov.compose",
+    summary: "per-model quad, back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion: kulikov.pixel_motion)",
+    source: "Kulikov 2025, 'Composition', 'Motion vectors'",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("atlas_tiles"),
+        Binding::read("vis_atlas"),
+        Binding::read("coverage_atlas"),
+        Binding::read("vertex_lighting"),
+        Binding::read("clip_positions"),
+        Binding::read("groom.vertices"),
+        // Attachments (GPU): blended colour, hair depth.
+        Binding::write("output"),
+        Binding::write("scene.depth"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: GROUP,
+    },
+    shader: Shader {
+        file: "kulikov/compose.wgsl",
+        entry: "vs_main",
+        fragment: Some("fs_main"),
+    },
+    kernel: |p| Box::new(ComposeKernel(*p)),
+    gpu: |p, q| p.uniform(q),
+    raster: Some(draw),
+};
+
+/// shaders/kulikov/compose.wgsl (header): six vertices per model, drawn
+/// back to front with premultiplied blending over the loaded colour;
+/// then `fs_depth` with the same quads writes hair depth into the
+/// loaded `scene.depth` where nearer (the CPU kernel's `z < depth`).
+fn draw(_: &ComposeParams, q: &Quantities) -> RasterState {
+    RasterState {
+        vertices: q.models * 6,
+        cull_back_faces: false,
+        color_load: ColorLoad::Load,
+        depth_load: DepthLoad::Load,
+        draws: vec![
+            Draw {
+                fragment: "fs_main",
+                blend: Blend::PremultipliedOverKeepAlpha,
+                color_writes: true,
+                depth_compare: Compare::Always,
+                depth_write: false,
+            },
+            Draw {
+                fragment: "fs_depth",
+                blend: Blend::Replace,
+                color_writes: false,
+                depth_compare: Compare::Less,
+                depth_write: true,
+            },
+        ],
     }
 }
 
@@ -307,7 +308,7 @@ impl ComposeKernel {
                 continue;
             };
             let t = axis_t(&trap, u, v);
-            let coverage = if self.0.width_coverage {
+            let coverage = if self.0.width_coverage() {
                 let pts = trap.quad.points();
                 let w0 = ((pts[0][0] - pts[3][0]).powi(2) + (pts[0][1] - pts[3][1]).powi(2)).sqrt();
                 let w1 = ((pts[1][0] - pts[2][0]).powi(2) + (pts[1][1] - pts[2][1]).powi(2)).sqrt();
@@ -371,7 +372,7 @@ impl CpuKernel for ComposeKernel {
                 if additive == 0 {
                     continue;
                 }
-                let c_total = if self.0.exponential_fit {
+                let c_total = if self.0.exponential_fit() {
                     1.0 - (-(additive as f32) / COVERAGE_SCALE).exp()
                 } else {
                     total_coverage(additive)

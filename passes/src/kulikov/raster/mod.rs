@@ -23,110 +23,114 @@ use super::cull::{DrawnSegment, drawn_segment};
 use super::payload::{COVERAGE_SCALE, EMPTY, linear_depth, pack, quantize_depth};
 use super::tiles::ModelTiles;
 use super::{ModelLod, Scene, TILE, TILE_TEXELS};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
+use crate::describe::PassKind;
+use crate::params::{Invalid, PassParams};
 use crate::sim::{CounterValues, Ctx, Words};
 use geometry::Trapezoid;
-
-pub struct Raster;
 
 /// Segments per workgroup (Kulikov: "Need large groups (256/512/1024 lanes)").
 pub const GROUP: u32 = 256;
 /// Ordered visibility layers.
 pub const LAYERS: usize = 3;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct RasterParams {
     pub loop_flattening: bool,
     pub pixel_request_stack: bool,
     pub depth_test_stack: bool,
     pub last_layer_cull: bool,
     pub morton_sort: bool,
+    /// Accepted only at its one value: the sort pass's dispatch uses it.
+    pub workgroup_size: u32,
+    /// Accepted only at its one value: composition decodes with it.
+    pub coverage_scale: f32,
 }
 
-impl RasterParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new("kulikov.raster", v)?;
-        let size = p.u32("workgroup_size", GROUP)?;
-        if size != GROUP {
-            return Err(ParamError {
-                kind: "kulikov.raster",
-                param: "workgroup_size".into(),
-                message: format!(
-                    "the CPU kernel and the sort pass's dispatch use {GROUP}; got {size}"
+impl Default for RasterParams {
+    fn default() -> Self {
+        Self {
+            loop_flattening: true,
+            pixel_request_stack: true,
+            depth_test_stack: true,
+            last_layer_cull: true,
+            morton_sort: true,
+            workgroup_size: GROUP,
+            coverage_scale: COVERAGE_SCALE,
+        }
+    }
+}
+
+impl PassParams for RasterParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        if self.workgroup_size != GROUP {
+            return Err(Invalid::new(
+                "workgroup_size",
+                format!(
+                    "the CPU kernel and the sort pass's dispatch use {GROUP}; got {}",
+                    self.workgroup_size
                 ),
-            });
+            ));
         }
-        if p.f32("coverage_scale", COVERAGE_SCALE)? != COVERAGE_SCALE {
-            return Err(ParamError {
-                kind: "kulikov.raster",
-                param: "coverage_scale".into(),
-                message: "composition decodes coverage with the talk's scale of 1024".into(),
-            });
+        if self.coverage_scale != COVERAGE_SCALE {
+            return Err(Invalid::new(
+                "coverage_scale",
+                "composition decodes coverage with the talk's scale of 1024",
+            ));
         }
-        Ok(Self {
-            loop_flattening: p.bool("loop_flattening", true)?,
-            pixel_request_stack: p.bool("pixel_request_stack", true)?,
-            depth_test_stack: p.bool("depth_test_stack", true)?,
-            last_layer_cull: p.bool("last_layer_cull", true)?,
-            morton_sort: p.bool("morton_sort", true)?,
-        })
+        Ok(())
     }
 }
 
-impl PassDef for Raster {
-    fn kind(&self) -> &'static str {
-        "kulikov.raster"
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("raster_args"),
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("sorted_segments"),
-            Binding::read("clip_positions"),
-            Binding::read("groom.vertices"),
-            Binding::read("atlas_tiles"),
-            Binding::read("scene.depth"),
-            Binding::atomic("vis_atlas"),
-            Binding::atomic("coverage_atlas"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Indirect {
-            binding: "raster_args",
-            word: 0,
-        }
-    }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/raster.wgsl", "raster")
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(RasterKernel(RasterParams::from_ron(params)?)))
-    }
+crate::gpu_block! {
     /// `RasterParams`: the five switches, then the screen size.
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        q: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        let p = RasterParams::from_ron(params)?;
-        let flag = crate::contract::flag;
-        Ok(vec![
-            flag(p.loop_flattening),
-            flag(p.pixel_request_stack),
-            flag(p.depth_test_stack),
-            flag(p.last_layer_cull),
-            flag(p.morton_sort),
-            q.width,
-            q.height,
-        ])
+    pub struct RasterGpu {
+        loop_flattening: u32,
+        pixel_request_stack: u32,
+        depth_test_stack: u32,
+        last_layer_cull: u32,
+        morton_sort: u32,
+        width: u32,
+        height: u32,
     }
 }
+
+pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
+    kind: "kulikov.raster",
+    summary: "conservative software rasterizer into a 3-layer 32-bit visibility atlas plus additive coverage",
+    source: "Kulikov 2025, 'Rasterization', 'Divergence', 'Pixel request stack'",
+    bindings: Some(&[
+        Binding::read("raster_args"),
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("sorted_segments"),
+        Binding::read("clip_positions"),
+        Binding::read("groom.vertices"),
+        Binding::read("atlas_tiles"),
+        Binding::read("scene.depth"),
+        Binding::atomic("vis_atlas"),
+        Binding::atomic("coverage_atlas"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::Indirect {
+        binding: "raster_args",
+        word: 0,
+    },
+    shader: Shader::compute("kulikov/raster.wgsl", "raster"),
+    kernel: |p| Box::new(RasterKernel(*p)),
+    gpu: |p, q| RasterGpu {
+        loop_flattening: flag(p.loop_flattening),
+        pixel_request_stack: flag(p.pixel_request_stack),
+        depth_test_stack: flag(p.depth_test_stack),
+        last_layer_cull: flag(p.last_layer_cull),
+        morton_sort: flag(p.morton_sort),
+        width: q.width,
+        height: q.height,
+    },
+    raster: None,
+};
 
 struct RasterKernel(RasterParams);
 

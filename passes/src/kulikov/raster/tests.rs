@@ -100,7 +100,7 @@ fn run(segs: &[Seg], order: &[u32], params: RasterParams) -> (Vec<u32>, Vec<u32>
 }
 
 fn defaults() -> RasterParams {
-    RasterParams::from_ron(&ron::Value::Unit).unwrap()
+    RasterParams::default()
 }
 
 /// Supersampled coverage of pixel (x, y) by the segment's trapezoid, computed

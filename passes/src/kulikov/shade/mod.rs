@@ -31,26 +31,25 @@ pub mod karis;
 
 use super::cull::drawn_segment;
 use super::debug_resolve::store_rgba16f;
-use super::density::{GRID_WORDS, Grid, resolution};
+use super::density::{GRID_WORDS, Grid, MAX_RESOLUTION, check_resolution};
 use super::shade_sort::SHADE_GROUP;
 use super::{Scene, world_of_clip};
-use crate::contract::{Binding, CpuKernel, Dispatch, ParamError, Params, PassDef, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
 use crate::layout::{LightData, read};
+use crate::params::{Invalid, PassParams, in_range};
 use crate::sim::{Ctx, Words};
 use glam::Vec3;
 use karis::{Lobes, hair_shading};
 use strandgraph_bake::{BakeSettings, HAIR_MAX_SCATTER_EVENTS};
 
-pub struct Shade;
-
-const KIND: &str = "kulikov.shade";
-
-/// How lights are shadowed by the hair itself.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SelfShadow {
-    None,
-    VoxelMarch,
-    Baked,
+crate::string_enum! {
+    /// How lights are shadowed by the hair itself.
+    pub enum SelfShadow {
+        None,
+        VoxelMarch,
+        Baked,
+    }
 }
 
 impl SelfShadow {
@@ -60,17 +59,34 @@ impl SelfShadow {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The pass's parameters as the graph names them.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct ShadeParams {
-    pub lobes: Lobes,
     pub self_shadow: SelfShadow,
+    /// Extinction per strand crossed.
     pub absorption: f32,
+    /// Grid edge of `density_grid` (as written by `kulikov.density`).
     pub resolution: u32,
+    /// `VoxelMarch` samples per light (1..=256).
     pub march_steps: u32,
     /// Fraction of the base colour added as ambient light.
     pub ambient: f32,
-    /// The offline bake `"Baked"` reads (ignored by the other modes).
-    pub bake: BakeSettings,
+    /// Kulikov: "Non-PBR scalars for each path".
+    pub r_scale: f32,
+    pub tt_scale: f32,
+    pub trt_scale: f32,
+    /// Karis's multiple-scattering weight; off with `multiple_scattering: false`.
+    pub scatter: f32,
+    pub multiple_scattering: bool,
+    /// Cuticle tilt in radians (Karis: 0.035).
+    pub shift: f32,
+    // The offline bake `"Baked"` reads (ignored by the other modes).
+    pub bake_rays: u32,
+    pub max_scatter_events: f32,
+    pub bake_max_distance: f32,
+    pub bake_vertex_stride: u32,
+    pub bake_occluder_stride: u32,
 }
 
 /// Rays per probe vertex of the self-shadowing bake when the graph names none.
@@ -86,132 +102,148 @@ pub const DEFAULT_BAKE_OCCLUDER_STRIDE: u32 = 8;
 /// neighborhood of each segment".
 pub const DEFAULT_BAKE_MAX_DISTANCE: f32 = 0.1;
 
-impl ShadeParams {
-    pub fn from_ron(v: &ron::Value) -> Result<Self, ParamError> {
-        let p = Params::new(KIND, v)?;
-        let err = |param: &str, message: String| ParamError {
-            kind: KIND,
-            param: param.into(),
-            message,
-        };
-        let self_shadow = match p.string("self_shadow", "VoxelMarch")?.as_str() {
-            "None" => SelfShadow::None,
-            "VoxelMarch" => SelfShadow::VoxelMarch,
-            "Baked" => SelfShadow::Baked,
-            other => {
-                return Err(err(
-                    "self_shadow",
-                    format!("expected \"None\", \"VoxelMarch\" or \"Baked\", got {other:?}"),
-                ));
-            }
-        };
-        let march_steps = p.u32("march_steps", 12)?;
-        if march_steps == 0 || march_steps > 256 {
-            return Err(err(
-                "march_steps",
-                format!("expected 1..=256, got {march_steps}"),
-            ));
+impl Default for ShadeParams {
+    fn default() -> Self {
+        Self {
+            self_shadow: SelfShadow::VoxelMarch,
+            absorption: 1.0,
+            resolution: MAX_RESOLUTION,
+            march_steps: 12,
+            ambient: 0.05,
+            r_scale: 1.0,
+            tt_scale: 1.0,
+            trt_scale: 1.0,
+            scatter: 1.0,
+            multiple_scattering: true,
+            shift: 0.035,
+            bake_rays: DEFAULT_BAKE_RAYS,
+            max_scatter_events: HAIR_MAX_SCATTER_EVENTS,
+            bake_max_distance: DEFAULT_BAKE_MAX_DISTANCE,
+            bake_vertex_stride: DEFAULT_BAKE_VERTEX_STRIDE,
+            bake_occluder_stride: DEFAULT_BAKE_OCCLUDER_STRIDE,
         }
-        let multiple = p.bool("multiple_scattering", true)?;
-        let bake = BakeSettings {
-            rays: p.u32("bake_rays", DEFAULT_BAKE_RAYS)?,
-            max_scatter_events: p.f32("max_scatter_events", HAIR_MAX_SCATTER_EVENTS)?,
-            max_distance: p.f32("bake_max_distance", DEFAULT_BAKE_MAX_DISTANCE)?,
-            vertex_stride: p.u32("bake_vertex_stride", DEFAULT_BAKE_VERTEX_STRIDE)?,
-            occluder_stride: p.u32("bake_occluder_stride", DEFAULT_BAKE_OCCLUDER_STRIDE)?,
-            ..BakeSettings::default()
-        };
-        if let Err(e) = bake.check() {
-            return Err(err("bake", e.to_string()));
-        }
-        Ok(Self {
-            lobes: Lobes {
-                r: p.f32("r_scale", 1.0)?,
-                tt: p.f32("tt_scale", 1.0)?,
-                trt: p.f32("trt_scale", 1.0)?,
-                scatter: if multiple {
-                    p.f32("scatter", 1.0)?
-                } else {
-                    0.0
-                },
-                shift: p.f32("shift", 0.035)?,
-            },
-            self_shadow,
-            absorption: p.f32("absorption", 1.0)?,
-            resolution: resolution(KIND, v)?,
-            march_steps,
-            ambient: p.f32("ambient", 0.05)?,
-            bake,
+    }
+}
+
+impl PassParams for ShadeParams {
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("march_steps", self.march_steps, 1..=256)?;
+        check_resolution(self.resolution)?;
+        self.bake().check().map_err(|e| {
+            // BakeSettings names its own field first ("rays: ..."); the
+            // graph's keys carry a `bake_` prefix.
+            let detail = match &e {
+                strandgraph_bake::BakeError::Settings(m) => m.clone(),
+                other => other.to_string(),
+            };
+            let key = match detail.split(':').next().unwrap_or("") {
+                "max_scatter_events" => "max_scatter_events".to_string(),
+                field => format!("bake_{field}"),
+            };
+            Invalid::new(key, e.to_string())
         })
     }
 }
 
 impl ShadeParams {
-    /// The WGSL `ShadeParams` block (binding 0, 48 bytes).
-    pub fn uniform(&self) -> Vec<u32> {
-        let l = &self.lobes;
-        vec![
-            l.r.to_bits(),
-            l.tt.to_bits(),
-            l.trt.to_bits(),
-            l.scatter.to_bits(),
-            l.shift.to_bits(),
-            self.self_shadow.code(),
-            self.absorption.to_bits(),
-            self.resolution,
-            self.march_steps,
-            self.ambient.to_bits(),
-            0,
-            0,
-        ]
-    }
-}
-
-impl PassDef for Shade {
-    fn kind(&self) -> &'static str {
-        KIND
-    }
-    fn bindings(&self) -> Option<&'static [Binding]> {
-        const BINDINGS: &[Binding] = &[
-            Binding::read("shade_args"),
-            Binding::read("frame"),
-            Binding::read("models"),
-            Binding::read("lod_models"),
-            Binding::read("lights"),
-            Binding::read("shading_segments"),
-            Binding::read("segment_visibility"),
-            Binding::read("clip_positions"),
-            Binding::read("density_grid"),
-            Binding::read("groom.shadow_sh"),
-            Binding::write("vertex_lighting"),
-        ];
-        Some(BINDINGS)
-    }
-    fn workgroup_size(&self) -> u32 {
-        SHADE_GROUP
-    }
-    fn dispatch(&self) -> Dispatch {
-        Dispatch::Indirect {
-            binding: "shade_args",
-            word: 0,
+    /// The per-lobe scalars the shading reads.
+    pub fn lobes(&self) -> Lobes {
+        Lobes {
+            r: self.r_scale,
+            tt: self.tt_scale,
+            trt: self.trt_scale,
+            scatter: if self.multiple_scattering {
+                self.scatter
+            } else {
+                0.0
+            },
+            shift: self.shift,
         }
     }
-    fn shader(&self) -> Shader {
-        Shader::compute("kulikov/shade.wgsl", "shade")
+
+    /// The offline bake `"Baked"` reads.
+    pub fn bake(&self) -> BakeSettings {
+        BakeSettings {
+            rays: self.bake_rays,
+            max_scatter_events: self.max_scatter_events,
+            max_distance: self.bake_max_distance,
+            vertex_stride: self.bake_vertex_stride,
+            occluder_stride: self.bake_occluder_stride,
+            ..BakeSettings::default()
+        }
     }
-    fn gpu_params(
-        &self,
-        params: &ron::Value,
-        _: &strandgraph_graph::Quantities,
-    ) -> Result<Vec<u32>, ParamError> {
-        Ok(ShadeParams::from_ron(params)?.uniform())
-    }
-    fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
-        Ok(Box::new(ShadeKernel(ShadeParams::from_ron(params)?)))
+
+    /// The WGSL `ShadeParams` block (binding 0, 48 bytes).
+    pub fn uniform(&self) -> ShadeGpu {
+        let l = self.lobes();
+        ShadeGpu {
+            lobes: [l.r, l.tt, l.trt, l.scatter],
+            shift: l.shift,
+            self_shadow: self.self_shadow.code(),
+            absorption: self.absorption,
+            resolution: self.resolution,
+            march_steps: self.march_steps,
+            ambient: self.ambient,
+            ..ShadeGpu::default()
+        }
     }
 }
 
-struct ShadeKernel(ShadeParams);
+crate::gpu_block! {
+    /// `ShadeParams` in shaders/kulikov/shade.wgsl.
+    pub struct ShadeGpu {
+        /// r, tt, trt scales; scatter (0 = no multiple scattering).
+        lobes: [f32; 4],
+        shift: f32,
+        /// 0 None, 1 VoxelMarch, 2 Baked.
+        self_shadow: u32,
+        absorption: f32,
+        resolution: u32,
+        march_steps: u32,
+        ambient: f32,
+        // WGSL rounds the struct to its vec4 alignment.
+        _pad0: u32,
+        _pad1: u32,
+    }
+}
+
+pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
+    kind: "kulikov.shade",
+    summary: "per-vertex Marschner (Karis 2016 R, TT, TRT, multiple scattering), self-shadowing: none, voxel march, baked SH",
+    source: "Kulikov 2025, 'Shading', 'Self-shadowing'",
+    bindings: Some(&[
+        Binding::read("shade_args"),
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("lights"),
+        Binding::read("shading_segments"),
+        Binding::read("segment_visibility"),
+        Binding::read("clip_positions"),
+        Binding::read("density_grid"),
+        Binding::read("groom.shadow_sh"),
+        Binding::write("vertex_lighting"),
+    ]),
+    workgroup_size: SHADE_GROUP,
+    dispatch: Dispatch::Indirect {
+        binding: "shade_args",
+        word: 0,
+    },
+    shader: Shader::compute("kulikov/shade.wgsl", "shade"),
+    kernel: |p| {
+        Box::new(ShadeKernel {
+            params: *p,
+            lobes: p.lobes(),
+        })
+    },
+    gpu: |p, _| p.uniform(),
+    raster: None,
+};
+
+struct ShadeKernel {
+    params: ShadeParams,
+    lobes: Lobes,
+}
 
 /// Distance along `dir` from `p` to where it leaves the box (0 if outside).
 fn exit_distance(g: &Grid, p: Vec3, dir: Vec3) -> f32 {
@@ -268,7 +300,7 @@ impl ShadeKernel {
         p: Vec3,
         t: Vec3,
     ) -> Vec3 {
-        let k = &self.0;
+        let k = &self.params;
         let md = &scene.models[model];
         let cam = Vec3::from_slice(&scene.frame.camera_pos[..3]);
         let v = (cam - p).normalize_or(Vec3::Z);
@@ -298,8 +330,8 @@ impl ShadeKernel {
                 SelfShadow::None => 1.0,
             };
             let radiance = Vec3::from_slice(&l.radiance[..3]) * falloff;
-            out +=
-                radiance * hair_shading(t, v, to_light, color, md.color[3], visibility, &k.lobes);
+            out += radiance
+                * hair_shading(t, v, to_light, color, md.color[3], visibility, &self.lobes);
         }
         out
     }
@@ -318,7 +350,7 @@ impl CpuKernel for ShadeKernel {
             ctx.words("vertex_lighting"),
         );
         // The vertex's baked SH (4 words); only loaded when it is read.
-        let baked = self.0.self_shadow == SelfShadow::Baked;
+        let baked = self.params.self_shadow == SelfShadow::Baked;
         let sh = |v: u32| -> [f32; 4] {
             if baked {
                 std::array::from_fn(|i| f32::from_bits(sh_words.load(4 * v as usize + i)))

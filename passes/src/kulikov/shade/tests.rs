@@ -91,7 +91,7 @@ fn harness(strands: u32, hidden: &[u32]) -> (Harness, Vec<u32>) {
 }
 
 fn shade(hs: &Harness, params: &str) -> Vec<[f32; 4]> {
-    let k = Shade.cpu_kernel(&ron::from_str(params).unwrap()).unwrap();
+    let k = crate::PassDef::cpu_kernel(&SHADE, &ron::from_str(params).unwrap()).unwrap();
     let groups = hs.read("shade_args")[0];
     hs.run(k.as_ref(), groups, SHADE_GROUP);
     assert_eq!(hs.out_of_bounds(), 0);
@@ -195,10 +195,10 @@ fn baked_sh_shadows_towards_the_light_only() {
 
 #[test]
 fn bake_settings_are_checked() {
-    let p = |s: &str| ShadeParams::from_ron(&ron::from_str(s).unwrap());
+    let p = |s: &str| SHADE.params(&ron::from_str(s).unwrap());
     let ok = p(r#"{"self_shadow": "Baked", "bake_rays": 8}"#).unwrap();
     assert_eq!(ok.self_shadow, SelfShadow::Baked);
-    assert_eq!(ok.bake.rays, 8);
+    assert_eq!(ok.bake().rays, 8);
     for bad in [
         r#"{"bake_rays": 0}"#,
         r#"{"bake_vertex_stride": 0}"#,

@@ -1,0 +1,296 @@
+//! Typed pass parameters: each pass kind declares a `serde` struct of its
+//! parameters, and the graph's RON map is deserialised into it.
+//!
+//! `#[serde(deny_unknown_fields, default)]` makes a misspelt key an error
+//! (naming the closest valid key) instead of a silently ignored switch, and
+//! [`PassParams::validate`] checks ranges. Every error names the offending
+//! key, so the graph compiler can point at it (`PassRegistry::check_params`).
+
+use serde::de::DeserializeOwned;
+use strandgraph_graph::unroll::MODEL_INDEX;
+
+/// A parameter value that is unknown, mistyped or out of range.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Invalid {
+    /// The key, or empty when the whole parameter block is wrong.
+    pub key: String,
+    pub message: String,
+}
+
+impl Invalid {
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// A pass kind's parameters.
+pub trait PassParams: DeserializeOwned + Default + Send + Sync + 'static {
+    /// Whether the kind reads `model_index`, which graph/src/unroll.rs adds
+    /// to every pass of a per-model block (declare it as
+    /// `#[serde(deserialize_with = "crate::params::some")] model_index: Option<u32>`).
+    /// Kinds that do not read it may still sit in the block; they never see it.
+    const READS_MODEL_INDEX: bool = false;
+
+    /// Range checks the types cannot express.
+    fn validate(&self) -> Result<(), Invalid> {
+        Ok(())
+    }
+}
+
+/// No parameters: only an empty map (or none) is accepted.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NoParams {}
+
+impl PassParams for NoParams {}
+
+/// Parses the parameters a graph file (or `--param`) wrote: every key must
+/// be one the kind declares, `model_index` included.
+pub fn check<P: PassParams>(value: &ron::Value) -> Result<P, Invalid> {
+    parse_map(value, false)
+}
+
+/// Parses the parameters of a compiled pass: as [`check`], but a
+/// `model_index` the unrolling added is dropped for kinds that do not read it.
+pub fn parse<P: PassParams>(value: &ron::Value) -> Result<P, Invalid> {
+    parse_map(value, !P::READS_MODEL_INDEX)
+}
+
+fn parse_map<P: PassParams>(value: &ron::Value, drop_model_index: bool) -> Result<P, Invalid> {
+    let map = match value {
+        ron::Value::Unit => ron::Map::new(),
+        ron::Value::Map(m) => m.clone(),
+        other => {
+            return Err(Invalid::new(
+                "",
+                format!("expected a map of parameters, found {}", describe(other)),
+            ));
+        }
+    };
+    let mut kept = ron::Map::new();
+    for (k, v) in map.iter() {
+        let ron::Value::String(key) = k else {
+            return Err(Invalid::new(
+                "",
+                format!("parameter names are strings, found {}", describe(k)),
+            ));
+        };
+        if !(drop_model_index && key == MODEL_INDEX) {
+            kept.insert(k.clone(), v.clone());
+        }
+    }
+    let parsed = match ron::Value::Map(kept.clone()).into_rust::<P>() {
+        Ok(p) => p,
+        Err(whole) => return Err(locate::<P>(&kept, &whole)),
+    };
+    parsed.validate()?;
+    Ok(parsed)
+}
+
+/// Finds the key a failed deserialisation is about: serde's errors carry no
+/// path, so each key is tried alone (the struct is `#[serde(default)]`, so
+/// one valid key on its own always parses).
+fn locate<P: PassParams>(map: &ron::Map, whole: &ron::Error) -> Invalid {
+    for (k, v) in map.iter() {
+        let ron::Value::String(key) = k else { continue };
+        let mut one = ron::Map::new();
+        one.insert(k.clone(), v.clone());
+        if let Err(e) = ron::Value::Map(one).into_rust::<P>() {
+            return Invalid::new(key.clone(), message(key, &e));
+        }
+    }
+    Invalid::new("", lower_first(&whole.to_string()))
+}
+
+fn message(key: &str, e: &ron::Error) -> String {
+    match e {
+        ron::Error::NoSuchStructField { expected, .. } => {
+            let mut m = String::from("unknown");
+            match closest(key, expected) {
+                Some(s) => m.push_str(&format!(", did you mean `{s}`?")),
+                None if expected.is_empty() => m.push_str(" (the pass takes no parameters)"),
+                None => m.push_str(&format!(" (parameters: {})", expected.join(", "))),
+            }
+            m
+        }
+        ron::Error::InvalidValueForType { expected, found } => {
+            format!("expected {expected}, found {found}")
+        }
+        other => lower_first(&other.to_string()),
+    }
+}
+
+/// The valid key most like `wanted`, when it is close enough to be a typo.
+pub fn closest<'a>(wanted: &str, valid: &[&'a str]) -> Option<&'a str> {
+    valid
+        .iter()
+        .map(|k| (strsim::jaro_winkler(k, wanted), *k))
+        .filter(|(score, _)| *score > 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, k)| k)
+}
+
+fn describe(v: &ron::Value) -> &'static str {
+    match v {
+        ron::Value::Bool(_) => "a boolean",
+        ron::Value::Char(_) => "a char",
+        ron::Value::Map(_) => "a map",
+        ron::Value::Number(_) => "a number",
+        ron::Value::Option(_) => "an option",
+        ron::Value::String(_) => "a string",
+        ron::Value::Bytes(_) => "bytes",
+        ron::Value::Seq(_) => "a list",
+        ron::Value::Unit => "()",
+    }
+}
+
+fn lower_first(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_lowercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+/// `model_index` as `Option<u32>`: ron's `Value` has no options of its own,
+/// so a present number means `Some`.
+pub fn some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    <u32 as serde::Deserialize>::deserialize(d).map(Some)
+}
+
+/// `value` within `range`, or an error naming `key`.
+pub fn in_range<T>(key: &str, value: T, range: std::ops::RangeInclusive<T>) -> Result<(), Invalid>
+where
+    T: PartialOrd + std::fmt::Display,
+{
+    if range.contains(&value) {
+        Ok(())
+    } else {
+        Err(Invalid::new(
+            key,
+            format!("{value} is outside {}..={}", range.start(), range.end()),
+        ))
+    }
+}
+
+/// A finite number `>= 0`, or an error naming `key`.
+pub fn non_negative(key: &str, value: f32) -> Result<(), Invalid> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(Invalid::new(
+            key,
+            format!("expected a finite number >= 0, got {value}"),
+        ))
+    }
+}
+
+/// A string-valued switch (`"self_shadow": "Baked"`): ron's `Value` keeps no
+/// enum variants, so the variants are matched by name, and a wrong one lists
+/// the valid names.
+#[macro_export]
+macro_rules! string_enum {
+    ($(#[$m:meta])* $vis:vis enum $name:ident { $($(#[$vm:meta])* $variant:ident),+ $(,)? }) => {
+        $(#[$m])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        $vis enum $name { $($(#[$vm])* $variant),+ }
+
+        impl $name {
+            pub const NAMES: &'static [&'static str] = &[$(stringify!($variant)),+];
+        }
+
+        impl<'de> serde::Deserialize<'de> for $name {
+            fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let s = <String as serde::Deserialize>::deserialize(d)?;
+                match s.as_str() {
+                    $(stringify!($variant) => Ok(Self::$variant),)+
+                    _ => Err(serde::de::Error::custom(format!(
+                        "expected one of \"{}\", found \"{s}\"",
+                        Self::NAMES.join("\", \"")
+                    ))),
+                }
+            }
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    string_enum! {
+        enum Mode { Fast, Exact }
+    }
+
+    #[derive(Debug, PartialEq, serde::Deserialize)]
+    #[serde(deny_unknown_fields, default)]
+    struct Example {
+        flag: bool,
+        count: u32,
+        scale: f32,
+        mode: Mode,
+    }
+
+    impl Default for Example {
+        fn default() -> Self {
+            Self {
+                flag: true,
+                count: 4,
+                scale: 1.0,
+                mode: Mode::Fast,
+            }
+        }
+    }
+
+    impl PassParams for Example {
+        fn validate(&self) -> Result<(), Invalid> {
+            in_range("count", self.count, 1..=8)
+        }
+    }
+
+    fn v(s: &str) -> ron::Value {
+        ron::from_str(s).unwrap()
+    }
+
+    #[test]
+    fn defaults_and_values() {
+        assert_eq!(check::<Example>(&ron::Value::Unit), Ok(Example::default()));
+        let p: Example = check(&v(r#"{"flag": false, "scale": 2, "mode": "Exact"}"#)).unwrap();
+        assert_eq!(
+            (p.flag, p.count, p.scale, p.mode),
+            (false, 4, 2.0, Mode::Exact)
+        );
+    }
+
+    #[test]
+    fn errors_name_the_key() {
+        let e = check::<Example>(&v(r#"{"count": 2, "flga": true}"#)).unwrap_err();
+        assert_eq!(e.key, "flga");
+        assert!(e.message.contains("did you mean `flag`"), "{}", e.message);
+        let e = check::<Example>(&v(r#"{"scael": 2}"#)).unwrap_err();
+        assert_eq!(e.key, "scael");
+        assert!(e.message.contains("did you mean `scale`"), "{}", e.message);
+        let e = check::<Example>(&v(r#"{"flag": 1}"#)).unwrap_err();
+        assert_eq!(e.key, "flag");
+        assert!(e.message.contains("boolean"), "{}", e.message);
+        let e = check::<Example>(&v(r#"{"count": 9}"#)).unwrap_err();
+        assert_eq!(
+            (e.key.as_str(), e.message.as_str()),
+            ("count", "9 is outside 1..=8")
+        );
+        let e = check::<Example>(&v(r#"{"mode": "Slow"}"#)).unwrap_err();
+        assert!(e.message.contains("\"Fast\", \"Exact\""), "{}", e.message);
+        let e = check::<Example>(&v("[1, 2]")).unwrap_err();
+        assert_eq!(e.key, "");
+    }
+
+    #[test]
+    fn model_index_is_dropped_only_for_kinds_that_ignore_it() {
+        let m = v(r#"{"model_index": 1}"#);
+        assert!(parse::<Example>(&m).is_ok());
+        assert_eq!(check::<Example>(&m).unwrap_err().key, "model_index");
+    }
+}
