@@ -81,7 +81,9 @@ pub fn bake_shadows(plan: &Plan, up: &mut Upload) -> Result<Option<BakeOutcome>>
         if !plan.live[p] || !reads || pass.kind != "kulikov.shade" {
             continue;
         }
-        let params = SHADE.params(&pass.params).map_err(|e| miette::miette!("{e}"))?;
+        let params = SHADE
+            .params(&pass.params)
+            .map_err(|e| miette::miette!("{e}"))?;
         if params.self_shadow != SelfShadow::Baked {
             continue;
         }
@@ -167,7 +169,11 @@ fn check_override(
     Registry
         .check_params(kind, &ron::Value::Map(written))
         .map_err(|p| {
-            let key = if p.key.is_empty() { "params".into() } else { format!("parameter `{}`", p.key) };
+            let key = if p.key.is_empty() {
+                "params".into()
+            } else {
+                format!("parameter `{}`", p.key)
+            };
             format!("pass `{pass}` ({kind}): {key}: {}", p.message)
         })
 }

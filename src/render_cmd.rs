@@ -7,6 +7,7 @@ use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{depth_to_view, motion_image, to_linear, to_picture};
 use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
+use strandgraph_passes::backend::Clock;
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Backend {
@@ -239,7 +240,12 @@ fn write_outputs(
 fn print_side_by_side(plan: &Plan, all: &[(runner::Backend, Vec<PassTime>)]) {
     print!("\n  {:<16} {:<24}", "pass", "kind");
     for (b, _) in all {
-        print!(" {:>14}", format!("{} ms", b.name()));
+        // The clock says what the column measures: "cpu wall ms", "ash GPU ms".
+        let clock = match b.clock() {
+            Clock::CpuWall => "wall",
+            Clock::GpuTimestamps => "GPU",
+        };
+        print!(" {:>14}", format!("{} {clock} ms", b.name()));
     }
     println!();
     let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.3}"));
@@ -298,7 +304,7 @@ fn print_timings(plan: &Plan, times: &[PassTime], instrument: bool) {
             .filter(|t| t.queue == lane.queue)
             .filter_map(|t| t.millis)
             .sum();
-        println!("  {:<14} sum {sum:.3} ms", lane.queue.to_string());
+        println!("  {:<14} total {sum:.3} ms", lane.queue.to_string());
     }
     println!("  frame {:.3} ms", frame_millis(times));
 }
