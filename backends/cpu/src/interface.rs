@@ -58,7 +58,7 @@ impl api::Session for Session<'_> {
                 millis: Some(t.millis),
                 span: None,
                 family: None,
-                counters: instrument.then(|| t.counters),
+                counters: instrument.then_some(t.counters),
             })
             .collect())
     }
