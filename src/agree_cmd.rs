@@ -4,7 +4,7 @@
 use miette::{IntoDiagnostic, Result};
 use std::path::PathBuf;
 use strandgraph::agree;
-use strandgraph::frame::{override_param, parse_size, prepare};
+use strandgraph::frame::{parse_size, prepare_with};
 use strandgraph::runner::Backend;
 
 #[derive(clap::Args)]
@@ -36,10 +36,7 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     let size = args.size.as_deref().map(parse_size).transpose()?;
-    let mut p = prepare(&args.scene, args.graph.as_deref(), size)?;
-    for spec in &args.params {
-        override_param(&mut p.plan, spec)?;
-    }
+    let p = prepare_with(&args.scene, args.graph.as_deref(), size, &args.params)?;
     let gpus: Vec<Backend> = args
         .backends
         .iter()

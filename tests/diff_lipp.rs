@@ -40,7 +40,7 @@ const BEARD: &str = r#", (
         source: HairMesh(style: Beard, strands: 3000, points: 8, seed: 13),
         parent: "head",
         hair_mesh: (bundles: 64, layers: 4, style: (curl_radius: 0.001, curl_turns: 3.0, twist: 0.5, noise: 0.002)),
-        material: (color: (0.30, 0.09, 0.03), roughness: 0.35, highlight_shift_deg: -2.0),
+        material: (color: (0.30, 0.09, 0.03), roughness: 0.35),
         facial_hair: true,
     )"#;
 
@@ -75,7 +75,7 @@ fn small_scene(tag: &str, beard: bool) -> PathBuf {
         source: HairMesh(style: Long, strands: 8000, points: 16, seed: 7),
         parent: "head",
         hair_mesh: (bundles: 128, layers: 8, style: (curl_radius: 0.002, curl_turns: 5.0, twist: 0.25, noise: 0.003)),
-        material: (melanin: 0.4, redness: 0.3, roughness: 0.3, highlight_shift_deg: -3.0),
+        material: (melanin: 0.4, roughness: 0.3),
     ){beard}],
     graph: {graph:?},
 )

@@ -664,3 +664,45 @@ fn layout_mismatches_are_reported() {
     assert!(layout_mismatch(&renamed, &wgsl, 8).is_some());
     assert!(layout_mismatch(&ok, &wgsl, 32).is_some());
 }
+
+/// The f32 bits of constant `name` in `module`, following aliases.
+fn constant_bits(module: &Module, name: &str) -> Option<u32> {
+    let c = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))?;
+    let mut init = c.1.init;
+    loop {
+        match module.global_expressions[init] {
+            naga::Expression::Literal(naga::Literal::F32(v)) => return Some(v.to_bits()),
+            naga::Expression::Constant(h) => init = module.constants[h].init,
+            _ => return None,
+        }
+    }
+}
+
+/// Constants whose exact bits both sides must share: a kernel multiplies by
+/// them where a division would round differently on a GPU (payload.rs).
+#[test]
+fn wgsl_constants_have_the_rust_bits() {
+    let source = "
+#import strandgraph::lipp::{DEPTH_MAX, INV_DEPTH_MAX}
+const PROBE_DEPTH_MAX: f32 = DEPTH_MAX;
+const PROBE_INV_DEPTH_MAX: f32 = INV_DEPTH_MAX;
+@compute @workgroup_size(1)
+fn probe() {
+    _ = PROBE_DEPTH_MAX * PROBE_INV_DEPTH_MAX;
+}
+";
+    let mut composer = composer();
+    let module = compose(&mut composer, "constants_probe.wgsl", source, BASE)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0;
+    use strandgraph_passes::lipp::payload::{DEPTH_MAX, INV_DEPTH_MAX};
+    for (name, rust) in [
+        ("PROBE_DEPTH_MAX", DEPTH_MAX),
+        ("PROBE_INV_DEPTH_MAX", INV_DEPTH_MAX),
+    ] {
+        assert_eq!(constant_bits(&module, name), Some(rust.to_bits()), "{name}");
+    }
+}

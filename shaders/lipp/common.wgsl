@@ -15,6 +15,8 @@ const LOD_CULLED: u32 = 1u;
 const LOD_OTHER_GROOM: u32 = 2u;
 // payload::DEPTH_MAX, the sub-pixel snap grid.
 const DEPTH_MAX: f32 = 16777215.0;
+// payload::INV_DEPTH_MAX: 1 / DEPTH_MAX rounded once to f32 (0x33800001).
+const INV_DEPTH_MAX: f32 = 0x1.000002p-24f;
 const SNAP: f32 = 256.0;
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
@@ -125,7 +127,7 @@ fn unpack_payload(p: vec2<u32>) -> Sample {
     let hi = p.y;
     let e = vec2<f32>(f32(hi & 0xFFu) / 255.0 * 2.0 - 1.0, f32(lo >> 24u) / 255.0 * 2.0 - 1.0);
     return Sample(
-        f32(hi >> 8u) / DEPTH_MAX,
+        f32(hi >> 8u) * INV_DEPTH_MAX,
         oct_decode(e),
         vec3<f32>(f32((lo >> 18u) & 63u) / 63.0, f32((lo >> 12u) & 63u) / 63.0, f32((lo >> 6u) & 63u) / 63.0),
         f32(lo & 63u) / 63.0,

@@ -9,6 +9,7 @@ use strandgraph_graph::resolve::{Access, Graph, PassId};
 use strandgraph_graph::schema::{
     AccessMode, GraphDesc, LifetimeClass, PassDecl, Repeat, ResourceDecl,
 };
+use strandgraph_graph::unroll::MODEL_INDEX;
 use strandgraph_graph::{Plan, compile_str};
 use strandgraph_passes::{Definitions, Registry, bind};
 
@@ -73,7 +74,7 @@ pub fn isolate(plan: &Plan, p: PassId) -> Result<Isolated> {
             name: pass.name.replace(['[', ']'], "_"),
             kind: pass.kind.clone(),
             queue: pass.queue,
-            params: pass.params.clone(),
+            params: without_model_index(&pass.params),
             reads,
             writes,
             atomics,
@@ -87,8 +88,24 @@ pub fn isolate(plan: &Plan, p: PassId) -> Result<Isolated> {
     };
     let text = ron::ser::to_string_pretty(&desc, ron::ser::PrettyConfig::default())
         .map_err(|e| miette!("pass `{}`: isolating: {e}", pass.name))?;
-    let plan = compile_str(&desc.name, &text, &Registry, 1)?;
+    let mut plan = compile_str(&desc.name, &text, &Registry, 1)?;
+    // The copy of a per-model pass keeps the model it ran for: a graph may
+    // not set `model_index` (the per-model block does), so it is put back
+    // on the compiled pass, as unrolling puts it.
+    plan.graph.passes[0].params = pass.params.clone();
     Ok(Isolated { plan, ports, text })
+}
+
+/// `params` less the `model_index` that unrolling added.
+fn without_model_index(params: &ron::Value) -> ron::Value {
+    match params {
+        ron::Value::Map(m) => {
+            let mut m = m.clone();
+            m.remove(&ron::Value::String(MODEL_INDEX.into()));
+            ron::Value::Map(m)
+        }
+        other => other.clone(),
+    }
 }
 
 /// The declared resource whose memory `r` is (through versions and per-model copies).

@@ -138,7 +138,7 @@ pub fn check_pass(
         })?;
         let mut checks_here = Vec::new();
         for (port, (c, g)) in outputs.iter().zip(cpu.iter().zip(&gpu)) {
-            let judgement = rules::rule(&pass.kind, &port.name, &port.decl);
+            let judgement = rules::rule(&pass.kind, &port.name, &port.decl, backend);
             let mut outcome = compare(c, g, judgement.rule);
             outcome.allowed = (judgement.outliers * outcome.words as f64) as usize;
             if let (Some(dir), false) = (dump, outcome.passed()) {

@@ -365,7 +365,7 @@ mod tests {
     ],
     grooms: [
         (name: "hair", source: Procedural(style: Wavy, strands: 500, points: 8), parent: "head",
-         material: (melanin: 1.0, roughness: 0.25, highlight_shift_deg: -4.0)),
+         material: (melanin: 1.0, roughness: 0.25)),
         (name: "beard", source: Procedural(style: Beard, strands: 200, points: 4), parent: "head",
          facial_hair: true, hair_mesh: (bundles: 20, layers: 4)),
     ],

@@ -184,30 +184,27 @@ pub enum GroomSource {
     },
 }
 
-/// Hair appearance: melanin concentration or a colour, roughness and highlight shift.
+/// Hair appearance: melanin concentration or a colour, and roughness. The
+/// cuticle tilt is the shading pass's parameter (`kulikov.shade`'s `shift`;
+/// Chiang's fixed α in `lipp.shade`), not the material's: a key nothing read
+/// would be accepted and do nothing.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Material {
     /// Eumelanin concentration (0 = white, about 1.3 = black). Ignored when `color` is set.
     pub melanin: Option<f32>,
-    /// Pheomelanin ratio (red) in [0, 1].
-    pub redness: f32,
     /// A direct linear RGB colour instead of melanin.
     pub color: Option<[f32; 3]>,
     /// Longitudinal roughness in [0, 1].
     pub roughness: f32,
-    /// Cuticle tilt in degrees (negative shifts the highlight towards the root).
-    pub highlight_shift_deg: f32,
 }
 
 impl Default for Material {
     fn default() -> Self {
         Material {
             melanin: Some(0.6),
-            redness: 0.1,
             color: None,
             roughness: 0.3,
-            highlight_shift_deg: -3.0,
         }
     }
 }

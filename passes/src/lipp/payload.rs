@@ -26,6 +26,11 @@ use super::{oct_decode, oct_encode};
 pub const EMPTY: u64 = u64::MAX;
 /// 2^24 − 1.
 pub const DEPTH_MAX: f32 = 16_777_215.0;
+/// `1 / DEPTH_MAX`, rounded once: depth unpacks as a multiplication on the
+/// CPU and in WGSL (`INV_DEPTH_MAX`, the same bits), because a GPU compiler
+/// may turn `x / DEPTH_MAX` into `x · rcp(DEPTH_MAX)` (the H100's does),
+/// one rounding more than the CPU's division.
+pub const INV_DEPTH_MAX: f32 = 1.0 / DEPTH_MAX;
 
 /// What a strand writes into a pixel, before quantisation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,7 +73,7 @@ pub fn unpack(p: u64) -> Sample {
     ];
     let six = |shift: u32| ((lo >> shift) & 63) as f32 / 63.0;
     Sample {
-        depth: (hi >> 8) as f32 / DEPTH_MAX,
+        depth: (hi >> 8) as f32 * INV_DEPTH_MAX,
         tangent: oct_decode(e),
         uvw: [six(18), six(12), six(6)],
         ao: six(0),

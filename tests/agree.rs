@@ -1,0 +1,179 @@
+//! Per-pass agreement (src/agree): every pass of every shipped graph runs
+//! alone on the CPU simulator, wgpu and ash with the words the CPU saw just
+//! before it, and every output must agree under its rule (src/agree/rules.rs
+//! lists where and why a GPU may differ). On lavapipe in CI; the H100
+//! figures are in README ("Per-pass agreement").
+//!
+//! The inputs exercise what each kind must handle: several models (the
+//! showcase's hair, eyebrows and beard; two grooms for Lipp's per-model
+//! block), sizes that are not a multiple of any tile (boundary tiles), and a
+//! camera that sees no hair at all (empty input).
+//! `every_pass_kind_is_checked` proves that together they cover every kind.
+
+mod common;
+
+use common::root;
+use std::collections::BTreeSet;
+use std::path::Path;
+use strandgraph::agree::{self, PassCheck};
+use strandgraph::frame::{Prepared, prepare};
+use strandgraph::runner::Backend;
+use strandgraph_passes::PASSES;
+
+/// A scene, the graph to run on it and the size.
+struct Case {
+    scene: &'static str,
+    graph: &'static str,
+    size: (u32, u32),
+}
+
+const SHOWCASE: Case = Case {
+    scene: "scenes/showcase.ron",
+    graph: "scenes/graphs/kulikov.ron",
+    size: (250, 140),
+};
+const VISIBILITY: Case = Case {
+    scene: "scenes/showcase.ron",
+    graph: "scenes/graphs/kulikov_visibility.ron",
+    size: (250, 140),
+};
+const LIPP: Case = Case {
+    scene: "scenes/grooms.ron",
+    graph: "scenes/graphs/lipp.ron",
+    size: (240, 135),
+};
+const LIPP_MSAA: Case = Case {
+    scene: "scenes/grooms.ron",
+    graph: "scenes/graphs/lipp_msaa.ron",
+    size: (160, 90),
+};
+const ROOFLINE: Case = Case {
+    scene: "scenes/showcase.ron",
+    graph: "scenes/graphs/roofline.ron",
+    size: (64, 64),
+};
+const ALL: [&Case; 5] = [&SHOWCASE, &VISIBILITY, &LIPP, &LIPP_MSAA, &ROOFLINE];
+
+fn prepared(scene: &Path, graph: &str, size: (u32, u32)) -> Prepared {
+    prepare(scene, Some(&root().join(graph)), Some(size)).unwrap_or_else(|e| panic!("{e:?}"))
+}
+
+/// Every pass of `p` on wgpu and ash against the CPU; panics with the
+/// table when any output disagrees beyond its rule.
+fn agree(p: &Prepared) -> Vec<PassCheck> {
+    let captured = agree::capture(p).unwrap_or_else(|e| panic!("{e:?}"));
+    assert!(!captured.is_empty(), "the CPU captured no pass");
+    let checks = agree::check_all(
+        &p.plan,
+        &p.upload,
+        &captured,
+        &[Backend::Wgpu, Backend::Ash],
+        None,
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e:?}\n(no Vulkan device? run scripts/test.sh)"));
+    let table = agree::table(&checks);
+    eprintln!("{table}");
+    let failed: Vec<String> = checks
+        .iter()
+        .filter(|c| !c.passed())
+        .map(|c| format!("{} on {}", c.pass, c.backend))
+        .collect();
+    assert!(failed.is_empty(), "disagree: {failed:?}\n{table}");
+    checks
+}
+
+fn run(case: &Case) -> Vec<PassCheck> {
+    agree(&prepared(&root().join(case.scene), case.graph, case.size))
+}
+
+#[test]
+fn kulikov_passes_agree() {
+    run(&SHOWCASE);
+}
+
+#[test]
+fn kulikov_visibility_passes_agree() {
+    run(&VISIBILITY);
+}
+
+#[test]
+fn lipp_passes_agree_on_two_grooms() {
+    run(&LIPP);
+}
+
+#[test]
+fn lipp_msaa_passes_agree() {
+    run(&LIPP_MSAA);
+}
+
+#[test]
+fn roofline_passes_agree() {
+    run(&ROOFLINE);
+}
+
+/// A scene whose camera looks away from every strand: each pass gets empty
+/// work (no visible segment, no covered pixel) and must still agree.
+#[test]
+fn passes_agree_when_no_hair_is_visible() {
+    let dir = common::out_dir("agree");
+    let scene = dir.join("looking_away.ron");
+    std::fs::write(&scene, LOOKING_AWAY).unwrap();
+    for graph in [SHOWCASE.graph, LIPP.graph] {
+        let p = prepared(&scene, graph, (96, 64));
+        let checks = agree(&p);
+        let cull = checks.iter().find(|c| c.kind == "kulikov.cull");
+        let lod = checks.iter().find(|c| c.kind == "lipp.lod");
+        assert!(
+            cull.is_some() || lod.is_some(),
+            "{graph}: no culling pass ran"
+        );
+    }
+}
+
+const LOOKING_AWAY: &str = r#"Scene(
+    resolution: (96, 64),
+    camera: LookAt(position: (0.0, 1.6, 1.5), target: (0.0, 1.6, 5.0), fov_deg: 35.0),
+    lights: [Directional(direction: (0.4, -0.6, -0.6), color: (1.0, 1.0, 1.0), intensity: 3.0)],
+    meshes: [(name: "head", source: Head(resolution: 32), transform: (translation: (0.0, 1.6, 0.0)))],
+    grooms: [
+        (
+            name: "hair",
+            source: HairMesh(style: Long, strands: 2000, points: 16, seed: 1),
+            parent: "head",
+            hair_mesh: (bundles: 64, layers: 4),
+        ),
+        (
+            name: "beard",
+            source: HairMesh(style: Beard, strands: 1000, points: 8, seed: 2),
+            parent: "head",
+            hair_mesh: (bundles: 32, layers: 4),
+            facial_hair: true,
+        ),
+    ],
+    graph: "unused.ron",
+)"#;
+
+/// The cases above run every pass kind the registry declares: a kind no
+/// shipped graph runs would otherwise go unchecked.
+#[test]
+fn every_pass_kind_is_checked() {
+    let mut run: BTreeSet<String> = BTreeSet::new();
+    for case in ALL {
+        let p = prepared(&root().join(case.scene), case.graph, case.size);
+        for &pass in &p.plan.order {
+            if p.plan.live[pass] {
+                run.insert(p.plan.graph.passes[pass].kind.clone());
+            }
+        }
+    }
+    let missing: Vec<&str> = PASSES
+        .iter()
+        .map(|d| d.kind())
+        .filter(|k| !run.contains(*k))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "pass kinds no agreement case runs: {missing:?}"
+    );
+}
