@@ -1,7 +1,7 @@
 //! `strandgraph agree`: every pass of a scene's graph alone on the CPU
 //! simulator and the GPU backends, outputs compared (see `strandgraph::agree`).
 
-use miette::{IntoDiagnostic, Result};
+use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::PathBuf;
 use strandgraph::agree;
 use strandgraph::frame::{parse_size, prepare_with};
@@ -10,7 +10,8 @@ use strandgraph::runner::Backend;
 #[derive(clap::Args)]
 pub struct Args {
     /// The scene (RON), e.g. scenes/showcase.ron.
-    pub scene: PathBuf,
+    #[arg(required_unless_present = "summarize")]
+    pub scene: Option<PathBuf>,
     /// Run this graph instead of the scene's.
     #[arg(long)]
     pub graph: Option<PathBuf>,
@@ -32,11 +33,36 @@ pub struct Args {
     /// Also write every check as JSON here.
     #[arg(long, value_name = "FILE.json")]
     pub json: Option<PathBuf>,
+    /// Run nothing: print Markdown tables of earlier `--json` files (what
+    /// README's per-pass agreement tables are generated from).
+    #[arg(long, num_args = 1.., value_name = "FILE.json", conflicts_with = "scene")]
+    pub summarize: Vec<PathBuf>,
+}
+
+fn summarize(files: &[PathBuf]) -> Result<()> {
+    for file in files {
+        let text = std::fs::read_to_string(file)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("reading {}", file.display()))?;
+        let json: serde_json::Value = serde_json::from_str(&text)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("parsing {}", file.display()))?;
+        let title = file
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        let md = agree::summary::markdown(&title, &json)
+            .map_err(|e| miette::miette!("{}: {e}", file.display()))?;
+        println!("{md}");
+    }
+    Ok(())
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let Some(scene) = &args.scene else {
+        return summarize(&args.summarize);
+    };
     let size = args.size.as_deref().map(parse_size).transpose()?;
-    let p = prepare_with(&args.scene, args.graph.as_deref(), size, &args.params)?;
+    let p = prepare_with(scene, args.graph.as_deref(), size, &args.params)?;
     let gpus: Vec<Backend> = args
         .backends
         .iter()

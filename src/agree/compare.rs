@@ -16,6 +16,8 @@ pub enum Rule {
     F16 { ulps: u32 },
     /// Bytes of 8-bit UNORM texels, within `steps` of each other.
     Unorm8 { steps: u32 },
+    /// Pairs of 16-bit UNORM codes, within `steps` of each other.
+    Unorm16 { steps: u32 },
     /// The same words in any order: the order is set by which GPU thread
     /// wins an atomic slot, and every consumer is order-independent.
     Multiset,
@@ -143,6 +145,14 @@ fn word_error(c: u32, g: u32, rule: Rule) -> (f64, bool) {
             let d = c.abs_diff(g);
             (f64::from(d), d <= max)
         }
+        Rule::Unorm16 { steps } => {
+            let d = [0, 16]
+                .map(|k| ((c >> k) & 0xffff).abs_diff((g >> k) & 0xffff))
+                .into_iter()
+                .max()
+                .unwrap_or(0);
+            (f64::from(d), d <= steps)
+        }
         Rule::Unorm8 { steps } => {
             let d = (0..4)
                 .map(|k| ((c >> (8 * k)) & 0xff).abs_diff((g >> (8 * k)) & 0xff))
@@ -215,6 +225,9 @@ mod tests {
         let u = Rule::Unorm8 { steps: 1 };
         assert!(compare(&[0x0101_0101], &[0x0201_0100], u).passed());
         assert!(!compare(&[0x0101_0101], &[0x0301_0101], u).passed());
+        let w = Rule::Unorm16 { steps: 1 };
+        assert!(compare(&[0x0005_fffe], &[0x0004_ffff], w).passed());
+        assert!(!compare(&[0x0005_0000], &[0x0007_0000], w).passed());
         let h = Rule::F16 { ulps: 1 };
         assert!(compare(&[0x3c00_3c00], &[0x3c01_3c00], h).passed());
         assert!(!compare(&[0x3c00_3c00], &[0x3c00_3c02], h).passed());

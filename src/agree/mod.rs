@@ -12,6 +12,7 @@
 pub mod compare;
 pub mod isolate;
 pub mod rules;
+pub mod summary;
 
 use crate::frame::Prepared;
 use crate::runner::{self, Backend, CpuOptions};

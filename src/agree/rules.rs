@@ -132,6 +132,14 @@ static EXCEPTIONS: &[Exception] = &[
         why: "f32 lighting packed to halves: exp and pow differ in their last f32 bits on a GPU, which moves a value on a half's rounding boundary by one half-ULP",
     },
     Exception {
+        kind: "kulikov.store_history",
+        binding: "prev_clip_positions",
+        on: On::Every,
+        rule: Rule::Unorm16 { steps: 1 },
+        outliers: 0.0,
+        why: "NDC positions packed as 16-bit UNORM come from x / w: a GPU may divide as x · rcp(w) (Vulkan allows OpFDiv 2.5 ULP), which moves a position on a code's rounding boundary by one code (H100: 0.016% of words)",
+    },
+    Exception {
         kind: "kulikov.sort",
         binding: "sorted_segments",
         on: On::Every,
