@@ -220,3 +220,127 @@ fn nested_loops(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::stacks::Region;
+    use super::super::{ModelLod, ModelTiles};
+    use super::*;
+
+    /// Requests carry (x, y) and the lane's segment; every depth test passes.
+    #[derive(Default)]
+    struct Log {
+        written: Vec<(u32, u32, u32)>,
+    }
+
+    impl Sink for Log {
+        fn depth_passes(&mut self, _: u32, _: f32) -> bool {
+            true
+        }
+        fn write(&mut self, texel: u32, payload: u32, _: u32) {
+            self.written.push((payload, texel & 0xFF, texel >> 8));
+        }
+    }
+
+    impl Pixels for Log {
+        fn request(&self, lane: &Lane, x: u32, y: u32, _: f32) -> Request {
+            Request {
+                texel: x | (y << 8),
+                payload: lane.local,
+                cov: 1,
+                ..Request::default()
+            }
+        }
+    }
+
+    fn lane(local: u32, a: [f32; 2], b: [f32; 2], half: f32) -> Lane {
+        Lane {
+            trap: Trapezoid::new(a, b, half, half, 1.0, 1.0).unwrap(),
+            local,
+            lod: ModelLod {
+                strands: 1,
+                vertex_step: 1,
+                thickness_scale: 1.0,
+                segments_per_strand: 1,
+                strand_prefix: 0,
+                depth_near: 0.5,
+                depth_far: 10.0,
+            },
+            tiles: ModelTiles {
+                first_tile: 0,
+                grid_w: 1,
+                grid_h: 1,
+                origin_x: 0,
+                origin_y: 0,
+                downscale: 1,
+                valid: 1,
+            },
+            morton: 0,
+        }
+    }
+
+    fn run(flattened: bool, stacks: bool) -> (Vec<(u32, u32, u32)>, LaneTally) {
+        // Lane 0: 9 columns of one pixel (shallow); lane 1: one column of 5 (steep).
+        let shallow = lane(0, [0.5, 10.5], [8.5, 10.5], 0.25);
+        let steep = lane(1, [20.5, 0.5], [20.5, 4.5], 0.25);
+        let mut st = Stacks::new(2, stacks, stacks);
+        let mut log = Log::default();
+        raster(
+            &[Some(&shallow), Some(&steep)],
+            flattened,
+            &mut st,
+            &mut log,
+        );
+        log.written.sort_unstable();
+        (log.written, st.tally)
+    }
+
+    #[test]
+    fn nested_loops_wait_for_the_tallest_column_and_flattening_does_not() {
+        let (flat_px, flat) = run(true, false);
+        let (nested_px, nested) = run(false, false);
+        let want: Vec<_> = (0..9)
+            .map(|x| (0, x, 10))
+            .chain((0..5).map(|y| (1, 20, y)))
+            .collect();
+        assert_eq!(flat_px, want);
+        assert_eq!(nested_px, want);
+        let region = |active, steps| Region {
+            active,
+            total: 2 * steps,
+            steps,
+        };
+        // Flattened: 9 pixel steps (the shallow lane's 9 pixels), the steep
+        // lane idle after 5; both lanes open a column, then the shallow one alone 8 times.
+        assert_eq!(flat.pixels, region(14, 9));
+        assert_eq!(flat.columns, region(2 + 8, 9));
+        // Nested: the first column costs the steep lane's 5 rows, the other 8 one each.
+        assert_eq!(nested.pixels, region(14, 5 + 8));
+        assert_eq!(nested.columns, region(2 + 8, 9));
+        // Without stacks, the depth test and write run in the pixel steps that have pixels.
+        assert_eq!(flat.depth_tests, flat.pixels);
+        assert_eq!(nested.writes, nested.pixels);
+        assert!(flat.sum().utilisation() > nested.sum().utilisation());
+    }
+
+    #[test]
+    fn stacks_batch_the_same_writes_into_full_steps() {
+        for flattened in [true, false] {
+            let (px, without) = run(flattened, false);
+            let (px_stacks, with) = run(flattened, true);
+            assert_eq!(px, px_stacks);
+            assert_eq!(with.pixels, without.pixels);
+            // 14 requests in steps of 2 lanes: every flush is full.
+            assert_eq!(
+                with.depth_tests,
+                Region {
+                    active: 14,
+                    total: 14,
+                    steps: 7
+                }
+            );
+            assert_eq!(with.writes, with.depth_tests);
+            assert!(with.sum().utilisation() > without.sum().utilisation());
+        }
+    }
+}

@@ -289,7 +289,7 @@ mod tests {
     impl Sink for Log {
         fn depth_passes(&mut self, pos: u32, _: f32) -> bool {
             self.tests.push(pos);
-            pos % 2 == 0
+            pos.is_multiple_of(2)
         }
         fn write(&mut self, texel: u32, payload: u32, cov: u32) {
             self.writes.push((texel, payload, cov));
