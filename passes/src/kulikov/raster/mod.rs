@@ -12,12 +12,18 @@
 //! - `last_layer_cull`: skip the layer atomics when the (non-atomic) last layer
 //!   already holds something nearer ("up to 50%");
 //! - `morton_sort`: order the workgroup's segments along a Morton curve;
-//! - `pixel_request_stack`, `depth_test_stack`: the LDS request stacks. They
-//!   change how a GPU schedules the same writes, not which writes happen, so
-//!   the CPU kernel accepts and reports them; the WGSL implements them.
+//! - `pixel_request_stack`, `depth_test_stack`: the LDS request stacks.
+//!
+//! None of them changes which writes happen. The CPU kernel executes the
+//! WGSL's control structure for every setting (which lane takes which
+//! segment, the per-lane loops in lock step, the stacks and their drain:
+//! [`order`], [`lanes`], [`stacks`]), so the instrumented lane utilisation
+//! measures what each switch buys on a GPU of the emulated subgroup width.
 
 pub mod geometry;
 pub mod lanes;
+pub mod order;
+pub mod stacks;
 
 use super::cull::{DrawnSegment, drawn_segment};
 use super::payload::{COVERAGE_SCALE, EMPTY, linear_depth, pack, quantize_depth};
@@ -28,6 +34,7 @@ use crate::describe::PassKind;
 use crate::params::{Invalid, PassParams};
 use crate::sim::{CounterValues, Ctx, Words};
 use geometry::Trapezoid;
+use stacks::{Request, Sink, Stacks};
 
 /// Segments per workgroup (Kulikov: "Need large groups (256/512/1024 lanes)").
 pub const GROUP: u32 = 256;
@@ -143,17 +150,6 @@ struct Lane {
     morton: u32,
 }
 
-fn morton(x: u32, y: u32) -> u32 {
-    let spread = |mut v: u32| {
-        v &= 0xFFFF;
-        v = (v | (v << 8)) & 0x00FF_00FF;
-        v = (v | (v << 4)) & 0x0F0F_0F0F;
-        v = (v | (v << 2)) & 0x3333_3333;
-        (v | (v << 1)) & 0x5555_5555
-    };
-    spread(x) | (spread(y) << 1)
-}
-
 /// Everything a pixel write needs, shared by the workgroup.
 struct Targets<'a> {
     scene: &'a Scene,
@@ -222,7 +218,7 @@ impl RasterKernel {
         }
         let trap = segment_trapezoid(scene, ctx, &tiles, &lod, seg.v0, seg.v1)?;
         let mid = [0.5 * (trap.a[0] + trap.b[0]), 0.5 * (trap.a[1] + trap.b[1])];
-        let morton = morton(mid[0].max(0.0) as u32, mid[1].max(0.0) as u32);
+        let morton = order::morton(mid[0].max(0.0) as u32, mid[1].max(0.0) as u32);
         Some(Lane {
             trap,
             local: seg.local,
@@ -231,82 +227,79 @@ impl RasterKernel {
             morton,
         })
     }
+}
 
-    /// Rasterizes one lane; returns its pixel count per column (for lane statistics).
-    fn rasterize(&self, lane: &Lane, t: &Targets<'_>, tally: &mut CounterValues) -> Vec<u32> {
-        let grid_w = (lane.tiles.grid_w * TILE) as i32;
-        let grid_h = (lane.tiles.grid_h * TILE) as i32;
-        let (x0, x1) = lane.trap.columns();
-        let mut heights = Vec::new();
-        for x in x0.max(0)..=x1.min(grid_w - 1) {
-            let col = lane.trap.column(x);
-            if col.is_empty() {
-                heights.push(0);
-                continue;
-            }
-            let (lo, hi) = col.range(1);
-            let (y0, y1) = (
-                (lo.floor() as i32).max(0),
-                (hi.floor() as i32).min(grid_h - 1),
-            );
-            heights.push((y1 - y0 + 1).max(0) as u32);
-            for y in y0..=y1 {
-                let coverage = Trapezoid::coverage(&col, y);
-                // Only coverage that quantises to at least 1/1024 counts: thinner
-                // slivers are float noise the GPU backends need not agree on.
-                if (coverage * COVERAGE_SCALE).round() >= 1.0 {
-                    self.write_pixel(lane, x as u32, y as u32, coverage, t, tally);
-                }
-            }
-        }
-        heights
-    }
-
-    fn write_pixel(
-        &self,
-        lane: &Lane,
-        x: u32,
-        y: u32,
-        coverage: f32,
-        t: &Targets<'_>,
-        tally: &mut CounterValues,
-    ) {
+impl Targets<'_> {
+    /// Everything a pixel write decides before the depth test (the WGSL's
+    /// `pixel_request`).
+    fn pixel_request(&self, lane: &Lane, x: u32, y: u32, coverage: f32) -> Request {
         let tiles = &lane.tiles;
         let view_depth = lane.trap.depth_at(x as i32, y as i32);
         // Depth test at the screen pixel under this atlas texel's centre.
         let d = tiles.downscale;
-        let sx = ((tiles.origin_x * TILE + x) * d + d / 2).min(t.width - 1);
-        let sy = ((tiles.origin_y * TILE + y) * d + d / 2).min(t.height - 1);
-        let z = t.depth.load_f32((sy * t.width + sx) as usize);
-        if view_depth >= linear_depth(z, t.scene.frame.near, t.scene.frame.far) {
-            return;
-        }
+        let sx = ((tiles.origin_x * TILE + x) * d + d / 2).min(self.width - 1);
+        let sy = ((tiles.origin_y * TILE + y) * d + d / 2).min(self.height - 1);
         let (tx, ty) = (x / TILE, y / TILE);
-        let texel = ((tiles.first_tile + ty * tiles.grid_w + tx) * TILE_TEXELS
+        let texel = (tiles.first_tile + ty * tiles.grid_w + tx) * TILE_TEXELS
             + (y % TILE) * TILE
-            + x % TILE) as usize;
-        let mut payload = pack(
+            + x % TILE;
+        let payload = pack(
             quantize_depth(view_depth, lane.lod.depth_near, lane.lod.depth_far),
             lane.local,
         );
-        tally.pixels_written += 1;
+        Request {
+            pos: sx | (sy << 16),
+            view_depth,
+            texel,
+            payload,
+            cov: (coverage * COVERAGE_SCALE).round() as u32,
+        }
+    }
+}
+
+/// The atlas end of the request path: depth test and write, tallied.
+struct Atlas<'a> {
+    t: &'a Targets<'a>,
+    last_layer_cull: bool,
+    tally: CounterValues,
+}
+
+impl Sink for Atlas<'_> {
+    fn depth_passes(&mut self, pos: u32, view_depth: f32) -> bool {
+        let (sx, sy) = (pos & 0xFFFF, pos >> 16);
+        let z = self.t.depth.load_f32((sy * self.t.width + sx) as usize);
+        let f = &self.t.scene.frame;
+        // Written so that a NaN depth passes, as the WGSL's `!(a >= b)`.
+        !(view_depth >= linear_depth(z, f.near, f.far))
+    }
+
+    /// Kulikov's WritePixelToVisBuffer: last-layer cull, then chained
+    /// `atomicMin` with the evicted value moving down; additive coverage in
+    /// any case.
+    fn write(&mut self, texel: u32, mut payload: u32, cov: u32) {
+        let (t, texel) = (self.t, texel as usize);
+        self.tally.pixels_written += 1;
         // Kulikov, "Last layer culling": a plain load of the last layer.
         let culled =
-            self.0.last_layer_cull && t.vis.load(texel + (LAYERS - 1) * t.layer_stride) < payload;
+            self.last_layer_cull && t.vis.load(texel + (LAYERS - 1) * t.layer_stride) < payload;
         if !culled {
-            // Kulikov's WritePixelToVisBuffer: the evicted value moves down a layer.
             for layer in 0..LAYERS {
                 let prev = t.vis.fetch_min(texel + layer * t.layer_stride, payload);
-                tally.atomics += 1;
+                self.tally.atomics += 1;
                 if prev == EMPTY {
                     break;
                 }
                 payload = payload.max(prev);
             }
         }
-        t.coverage
-            .fetch_add(texel, (coverage * COVERAGE_SCALE).round() as u32);
-        tally.atomics += 1;
+        t.coverage.fetch_add(texel, cov);
+        self.tally.atomics += 1;
+    }
+}
+
+impl lanes::Pixels for Atlas<'_> {
+    fn request(&self, lane: &Lane, x: u32, y: u32, coverage: f32) -> Request {
+        self.t.pixel_request(lane, x, y, coverage)
     }
 }
 
@@ -317,15 +310,15 @@ impl CpuKernel for RasterKernel {
         let sorted = ctx.words("sorted_segments");
         let lods = scene.lods(ctx);
         let tiles = scene.tiles(ctx);
-        let mut lanes: Vec<Lane> = (group * GROUP..((group + 1) * GROUP).min(count))
-            .filter_map(|i| {
+        // Invocation `i` of the group projects sorted segment `first + i`.
+        let mut lanes: Vec<Option<Lane>> = (group * GROUP..((group + 1) * GROUP).min(count))
+            .map(|i| {
                 let seg = drawn_segment(&scene, &lods, sorted.load(i as usize))?;
                 self.project(&scene, ctx, &seg, lods[seg.model], tiles[seg.model])
             })
             .collect();
         if self.0.morton_sort {
-            // Kulikov: "sort according to Morton curve within each group".
-            lanes.sort_by_key(|l| l.morton);
+            lanes = order::morton_sort(lanes, |l| l.morton);
         }
         let vis = ctx.words("vis_atlas");
         let targets = Targets {
@@ -337,21 +330,30 @@ impl CpuKernel for RasterKernel {
             width: ctx.quantities.width,
             height: ctx.quantities.height,
         };
-        let mut tally = CounterValues::default();
+        let mut atlas = Atlas {
+            t: &targets,
+            last_layer_cull: self.0.last_layer_cull,
+            tally: CounterValues::default(),
+        };
         let width = ctx.subgroup_width.max(1) as usize;
-        for sub in lanes.chunks(width) {
-            let heights: Vec<Vec<u32>> = sub
-                .iter()
-                .map(|l| self.rasterize(l, &targets, &mut tally))
-                .collect();
-            if ctx.instrument {
-                let (active, total) = lanes::utilisation(&heights, width, self.0.loop_flattening);
-                tally.active_lanes += active;
-                tally.total_lanes += total;
-            }
+        let mut tally = stacks::LaneTally::default();
+        // Subgroup `k` is invocations k·width.. (the WGSL's `subgroup_id`).
+        for (k, sub) in lanes.chunks(width).enumerate() {
+            let fit = stacks::stacks_fit(width, k, targets.layer_stride);
+            let mut st = Stacks::new(
+                width,
+                self.0.depth_test_stack && fit,
+                self.0.pixel_request_stack && fit,
+            );
+            let sub: Vec<Option<&Lane>> = sub.iter().map(Option::as_ref).collect();
+            lanes::raster(&sub, self.0.loop_flattening, &mut st, &mut atlas);
+            tally.add(&st.tally);
         }
         if ctx.instrument {
-            ctx.counters.add(&tally);
+            let lanes = tally.sum();
+            atlas.tally.active_lanes = lanes.active;
+            atlas.tally.total_lanes = lanes.total;
+            ctx.counters.add(&atlas.tally);
         }
     }
 }
