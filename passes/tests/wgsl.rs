@@ -187,7 +187,7 @@ fn access_matches(mode: AccessMode, kind: &Kind) -> bool {
 
 /// The shared records and their sizes on the Rust side.
 fn record_sizes() -> [(&'static str, usize); 6] {
-    use strandgraph_passes::kulikov::{ModelLod, tiles::ModelTiles};
+    use strandgraph_passes::kulikov::{ModelLod, tile_alloc::ModelTiles};
     [
         ("FrameData", std::mem::size_of::<FrameData>()),
         ("ModelData", std::mem::size_of::<ModelData>()),

@@ -2,7 +2,7 @@
 // Each invocation (one per screen pixel) does `ops` 64-bit atomicMin with
 // the result unused (naga SHADER_INT64_ATOMIC_MIN_MAX allows no more), at
 // addresses and with values hashed from its global id, the sequence the CPU
-// kernel replays (passes/src/bench/roofline.rs, sim `fetch_min_u64`).
+// kernel replays (passes/src/bench/roofline.rs, kernel::wide `fetch_min_u64`).
 
 struct RooflineParams {
     ops: u32,

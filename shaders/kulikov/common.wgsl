@@ -27,7 +27,7 @@ const EMPTY: u32 = 0xFFFFFFFFu;
 const COVERAGE_SCALE: f32 = 1024.0;
 // Ordered visibility layers.
 const LAYERS: u32 = 3u;
-// Hi-Z block edge (kulikov::hiz::FACTOR).
+// Hi-Z block edge (kulikov::depth_downsample::FACTOR).
 const HIZ_FACTOR: u32 = 16u;
 // Sub-pixel snap grid (raster::geometry::SNAP).
 const SNAP: f32 = 256.0;

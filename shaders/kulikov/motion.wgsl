@@ -1,6 +1,6 @@
 // kulikov.store_history and kulikov.motion: motion vectors from the
 // post-transform cache (Kulikov, "Motion vectors"). CPU kernels:
-// passes/src/kulikov/history.rs, which documents the packing.
+// passes/src/kulikov/motion.rs, which documents the packing.
 //
 // Bindings (group 0): 0 = HistoryParams, then the pass's bindings() in
 // order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions,
@@ -17,7 +17,7 @@ struct HistoryParams {
 
 const UNORM_MAX: f32 = 65534.0;
 // Codes are stored plus one; 0 (a History buffer's first contents) is
-// "not transformed" (history::NOT_TRANSFORMED).
+// "not transformed" (motion::NOT_TRANSFORMED).
 const NOT_TRANSFORMED: u32 = 0u;
 
 @group(0) @binding(0) var<uniform> params: HistoryParams;
