@@ -29,6 +29,10 @@ const COVERAGE_SCALE: f32 = 1024.0;
 const LAYERS: u32 = 3u;
 // Hi-Z block edge (kulikov::depth_downsample::FACTOR).
 const HIZ_FACTOR: u32 = 16u;
+// Density grid words per model (48^3, one per voxel) and the fixed-point
+// unit of projected area (kulikov::density::{GRID_WORDS, AREA_UNIT}).
+const GRID_WORDS: u32 = 110592u;
+const AREA_UNIT: f32 = 1e-9;
 // Sub-pixel snap grid (raster::geometry::SNAP).
 const SNAP: f32 = 256.0;
 // f32::MAX and f32::MIN.

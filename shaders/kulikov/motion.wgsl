@@ -7,6 +7,7 @@
 // 4 = prev_frame.
 // motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions, 4 = vertex_motion.
 #import strandgraph::layout::FrameData
+#import strandgraph::kulikov::round_away
 
 struct HistoryParams {
     vertices: u32,
@@ -27,12 +28,6 @@ const NOT_TRANSFORMED: u32 = 0u;
 @group(0) @binding(3) var<storage, read> motion_prev_clip_positions: array<u32>;
 @group(0) @binding(4) var<storage, read_write> vertex_motion: array<vec2<f32>>;
 @group(0) @binding(4) var<storage, read_write> prev_frame: FrameData;
-
-// Rust's f32::round: halves away from zero.
-fn round_away(x: f32) -> f32 {
-    let t = trunc(x);
-    return select(t, t + sign(x), abs(x - t) >= 0.5);
-}
 
 fn compress(ndc: f32) -> u32 {
     return u32(round_away((clamp(ndc, -1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX));

@@ -3,6 +3,8 @@
 //   #import strandgraph::lipp::{...}
 #define_import_path strandgraph::lipp
 
+#import strandgraph::hash::pcg
+
 // Words per record (lipp::{BUNDLE_WORDS, LOD_WORDS}); vec4s per packed layer.
 const BUNDLE_WORDS: u32 = 16u;
 const LOD_WORDS: u32 = 4u;
@@ -22,13 +24,6 @@ const F32_MAX: f32 = 3.40282347e38;
 const F32_MIN: f32 = -3.40282347e38;
 // payload::EMPTY as the two words WGSL sees.
 const EMPTY_WORD: u32 = 0xFFFFFFFFu;
-
-// PCG hash (Jarzynski and Olano, JCGT 2020), as bench::pcg.
-fn pcg(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
 
 // lipp::unit: 24 bits of a hash in [0, 1).
 fn unit(h: u32) -> f32 {

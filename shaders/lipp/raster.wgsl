@@ -11,7 +11,8 @@
 // subgroup width. Needs SHADER_INT64 and SHADER_INT64_ATOMIC_MIN_MAX.
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::hash::pcg
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {

@@ -6,7 +6,8 @@
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
+#import strandgraph::hash::pcg
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
 #import strandgraph::chiang::{chiang}
 #import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
