@@ -13,6 +13,7 @@
 // (naga_oil: identifiers of a composable module must not end in a digit.)
 
 #import strandgraph::layout::{ModelData, ModelLod, ModelTiles}
+#import strandgraph::clip::clip_to_screen
 
 // Atlas tile edge in texels (kulikov::TILE) and texels per tile.
 const TILE: u32 = 64u;
@@ -61,17 +62,6 @@ fn load_tiles(t: ModelTiles) -> ModelTiles {
     var out = t;
     out.downscale = max(t.downscale, 1u);
     return out;
-}
-
-// kulikov::transform: column-major 4x4 times a point, summed in column order.
-fn transform(m: mat4x4<f32>, p: vec4<f32>) -> vec4<f32> {
-    return m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] * p.w;
-}
-
-// kulikov::clip_to_screen: pixels (y down) and NDC depth.
-fn clip_to_screen(c: vec4<f32>, width: f32, height: f32) -> vec3<f32> {
-    let iw = 1.0 / c.w;
-    return vec3<f32>((c.x * iw * 0.5 + 0.5) * width, (0.5 - c.y * iw * 0.5) * height, c.z * iw);
 }
 
 // Drawn segments per strand of `points` points at a vertex step.

@@ -12,7 +12,8 @@
 #define LOD_MODELS_BINDING 3
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::layout::ModelData
-#import strandgraph::kulikov::{transform, clip_to_screen, DrawnSegment, screen_bin, HIZ_FACTOR}
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
 #import strandgraph::subgroup::elected
 
 struct CullParams {

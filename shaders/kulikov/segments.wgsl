@@ -12,7 +12,8 @@
 #define_import_path strandgraph::kulikov_segments
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod}
-#import strandgraph::kulikov::{load_lod, segment_in_model, drawn_in_model, DrawnSegment, transform}
+#import strandgraph::clip::transform
+#import strandgraph::kulikov::{load_lod, segment_in_model, drawn_in_model, DrawnSegment}
 
 @group(0) @binding(#{FRAME_BINDING}) var<storage, read> frame: FrameData;
 @group(0) @binding(#{MODELS_BINDING}) var<storage, read> models: array<ModelData>;

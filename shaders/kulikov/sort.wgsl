@@ -7,7 +7,8 @@
 #define MODELS_BINDING 2
 #define LOD_MODELS_BINDING 3
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
-#import strandgraph::kulikov::{clip_to_screen, screen_bin}
+#import strandgraph::clip::clip_to_screen
+#import strandgraph::kulikov::screen_bin
 
 struct SortParams {
     // kulikov.sort `enabled` (scatter only).

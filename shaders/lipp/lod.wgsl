@@ -6,7 +6,8 @@
 
 #import strandgraph::layout::FrameData
 #import strandgraph::hash::pcg
-#import strandgraph::lipp::{unit, transform, clip_to_screen, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp::{unit, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
 struct LodParams {

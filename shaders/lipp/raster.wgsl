@@ -12,7 +12,8 @@
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
