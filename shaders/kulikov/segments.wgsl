@@ -9,6 +9,9 @@
 // bindings() (passes/tests/wgsl.rs checks it), so the importing shader
 // says where these three sit with the defines above; naga_oil substitutes
 // them into this module when it composes that shader.
+// naga_oil renames every token that spells an imported name, struct members
+// included: an importer must not use these names for anything else (or
+// must reach the item qualified, as lipp/shade.wgsl does with `lights`).
 #define_import_path strandgraph::kulikov_segments
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod}
