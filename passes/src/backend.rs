@@ -9,7 +9,7 @@
 //! The trait lives here, beside the pass definitions, because every backend
 //! already depends on this crate and none depends on another.
 
-use crate::sim::CounterValues;
+use crate::kernel::CounterValues;
 use crate::upload::Upload;
 use strandgraph_graph::Queue;
 use strandgraph_graph::resolve::PassId;

@@ -5,8 +5,8 @@
 //! rule, a WGSL entry point for the GPU backends and a CPU kernel written per
 //! workgroup for the CPU simulator.
 
-use crate::draw::RasterState;
-use crate::sim::Ctx;
+use crate::kernel::Ctx;
+use crate::raster_state::RasterState;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::{AccessMode, Quantity};
 

@@ -7,8 +7,8 @@
 //! registry (`crate::PASSES`) lists the statics.
 
 use crate::contract::{Binding, CpuKernel, Dispatch, GpuLayout, ParamError, PassDef, Shader};
-use crate::draw::RasterState;
 use crate::params::{self, Invalid, PassParams};
+use crate::raster_state::RasterState;
 use strandgraph_graph::Quantities;
 
 /// A pass's GPU parameter block (binding 0): a `#[repr(C)]` `Pod` struct

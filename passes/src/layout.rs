@@ -93,7 +93,7 @@ pub fn words_of<T: Pod>(v: &[T]) -> Vec<u32> {
 }
 
 /// Decodes a `Pod` record at record index `i` from a binding's words.
-pub fn read<T: Pod>(words: &crate::sim::Words<'_>, i: usize) -> T {
+pub fn read<T: Pod>(words: &crate::kernel::Words<'_>, i: usize) -> T {
     let n = std::mem::size_of::<T>() / 4;
     let raw: Vec<u32> = (0..n).map(|k| words.load(i * n + k)).collect();
     bytemuck::pod_read_unaligned(bytemuck::cast_slice(&raw))

@@ -18,21 +18,21 @@ pub mod bind;
 pub mod common;
 pub mod contract;
 pub mod describe;
-pub mod draw;
+pub mod kernel;
 pub mod kulikov;
 pub mod layout;
 pub mod lipp;
+pub mod opaque_mesh;
 pub mod params;
-pub mod scene;
-pub mod sim;
+pub mod raster_state;
 pub mod spirv;
 pub mod upload;
 pub mod wgsl;
 
 pub use contract::{Binding, CpuKernel, Dispatch, GpuLayout, ParamError, Params, PassDef, Shader};
 pub use describe::{GpuBlock, PassKind};
-pub use draw::RasterState;
 pub use params::{Invalid, NoParams, PassParams};
+pub use raster_state::RasterState;
 use strandgraph_graph::PassRegistry;
 use strandgraph_graph::registry::ParamProblem;
 
@@ -41,15 +41,15 @@ use strandgraph_graph::registry::ParamProblem;
 pub static PASSES: &[&dyn PassDef] = &[
     // Shared by every pipeline.
     &common::clear::CLEAR,
-    &scene::depth_prepass::DEPTH_PREPASS,
-    &scene::opaque::OPAQUE,
+    &opaque_mesh::depth_prepass::DEPTH_PREPASS,
+    &opaque_mesh::opaque::OPAQUE,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
     &kulikov::lod::LOD,
     &kulikov::skin::SKIN,
     &kulikov::density::DENSITY,
-    &kulikov::hiz::DEPTH_DOWNSAMPLE,
+    &kulikov::depth_downsample::DEPTH_DOWNSAMPLE,
     &kulikov::cull::CULL,
-    &kulikov::tiles::TILE_ALLOC,
+    &kulikov::tile_alloc::TILE_ALLOC,
     &kulikov::sort::SORT_SCAN,
     &kulikov::sort::SORT,
     &kulikov::raster::RASTER,
@@ -59,8 +59,8 @@ pub static PASSES: &[&dyn PassDef] = &[
     &kulikov::compose::COMPOSE,
     &kulikov::pixel_motion::PIXEL_MOTION,
     &kulikov::skin_shadow::SKIN_SHADOW,
-    &kulikov::history::STORE_HISTORY,
-    &kulikov::history::MOTION,
+    &kulikov::motion::STORE_HISTORY,
+    &kulikov::motion::MOTION,
     // Lipp et al., deferred software rasterization of hair meshes.
     &lipp::lod::LOD,
     &lipp::raster::RASTER,

@@ -116,6 +116,15 @@ fn contains_atomic(module: &Module, ty: naga::Handle<naga::Type>) -> bool {
     }
 }
 
+/// `name` without naga_oil's module decoration: a binding declared in an
+/// imported module (`shaders/kulikov/segments.wgsl`) keeps its WGSL name
+/// before the suffix naga_oil appends (`Composer::decorated_name`: the
+/// marker below, then the module path in base32).
+fn undecorated(name: &str) -> &str {
+    name.split_once("X_naga_oil_mod_X")
+        .map_or(name, |(plain, _)| plain)
+}
+
 /// The group-0 resources the named entry points use, by binding number.
 fn reflect(
     module: &Module,
@@ -133,7 +142,7 @@ fn reflect(
                 continue;
             }
             let Some(rb) = &var.binding else { continue };
-            let name = var.name.clone().unwrap_or_default();
+            let name = undecorated(var.name.as_deref().unwrap_or_default()).to_string();
             if rb.group != 0 {
                 return Err(format!("`{name}` is in group {}, expected 0", rb.group));
             }
@@ -187,7 +196,7 @@ fn access_matches(mode: AccessMode, kind: &Kind) -> bool {
 
 /// The shared records and their sizes on the Rust side.
 fn record_sizes() -> [(&'static str, usize); 6] {
-    use strandgraph_passes::kulikov::{ModelLod, tiles::ModelTiles};
+    use strandgraph_passes::kulikov::{ModelLod, tile_alloc::ModelTiles};
     [
         ("FrameData", std::mem::size_of::<FrameData>()),
         ("ModelData", std::mem::size_of::<ModelData>()),

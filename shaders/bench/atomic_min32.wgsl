@@ -3,6 +3,8 @@
 // addresses and with values hashed from its global id, the sequence the CPU
 // kernel replays (passes/src/bench/roofline.rs).
 
+#import strandgraph::hash::pcg
+
 struct RooflineParams {
     ops: u32,
     invocations: u32,
@@ -12,13 +14,6 @@ struct RooflineParams {
 @group(0) @binding(1) var<storage, read_write> atomics_u32: array<atomic<u32>>;
 
 const VALUE_SALT: u32 = 0x9e3779b9u;
-
-// PCG hash (Jarzynski and Olano, JCGT 2020), as roofline.rs `pcg`.
-fn pcg(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
 
 @compute @workgroup_size(256)
 fn atomic_min32(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -2,7 +2,9 @@
 // Each invocation (one per screen pixel) does `ops` 64-bit atomicMin with
 // the result unused (naga SHADER_INT64_ATOMIC_MIN_MAX allows no more), at
 // addresses and with values hashed from its global id, the sequence the CPU
-// kernel replays (passes/src/bench/roofline.rs, sim `fetch_min_u64`).
+// kernel replays (passes/src/bench/roofline.rs, kernel::wide `fetch_min_u64`).
+
+#import strandgraph::hash::pcg
 
 struct RooflineParams {
     ops: u32,
@@ -14,13 +16,6 @@ struct RooflineParams {
 
 const VALUE_SALT: u32 = 0x9e3779b9u;
 const HIGH_SALT: u32 = 0x85ebca6bu;
-
-// PCG hash (Jarzynski and Olano, JCGT 2020), as roofline.rs `pcg`.
-fn pcg(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
 
 @compute @workgroup_size(256)
 fn atomic_min64(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -80,7 +80,7 @@ struct ModelLod {
     _pad: u32,
 }
 
-// `atlas_tiles`: one model's part of the atlas (kulikov::tiles::ModelTiles, 8 words).
+// `atlas_tiles`: one model's part of the atlas (kulikov::tile_alloc::ModelTiles, 8 words).
 // Readers treat a downscale of 0 as 1, as ModelTiles::load does.
 struct ModelTiles {
     first_tile: u32,

@@ -13,6 +13,7 @@
 // (naga_oil: identifiers of a composable module must not end in a digit.)
 
 #import strandgraph::layout::{ModelData, ModelLod, ModelTiles}
+#import strandgraph::clip::clip_to_screen
 
 // Atlas tile edge in texels (kulikov::TILE) and texels per tile.
 const TILE: u32 = 64u;
@@ -27,8 +28,12 @@ const EMPTY: u32 = 0xFFFFFFFFu;
 const COVERAGE_SCALE: f32 = 1024.0;
 // Ordered visibility layers.
 const LAYERS: u32 = 3u;
-// Hi-Z block edge (kulikov::hiz::FACTOR).
+// Hi-Z block edge (kulikov::depth_downsample::FACTOR).
 const HIZ_FACTOR: u32 = 16u;
+// Density grid words per model (48^3, one per voxel) and the fixed-point
+// unit of projected area (kulikov::density::{GRID_WORDS, AREA_UNIT}).
+const GRID_WORDS: u32 = 110592u;
+const AREA_UNIT: f32 = 1e-9;
 // Sub-pixel snap grid (raster::geometry::SNAP).
 const SNAP: f32 = 256.0;
 // f32::MAX and f32::MIN.
@@ -57,17 +62,6 @@ fn load_tiles(t: ModelTiles) -> ModelTiles {
     var out = t;
     out.downscale = max(t.downscale, 1u);
     return out;
-}
-
-// kulikov::transform: column-major 4x4 times a point, summed in column order.
-fn transform(m: mat4x4<f32>, p: vec4<f32>) -> vec4<f32> {
-    return m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] * p.w;
-}
-
-// kulikov::clip_to_screen: pixels (y down) and NDC depth.
-fn clip_to_screen(c: vec4<f32>, width: f32, height: f32) -> vec3<f32> {
-    let iw = 1.0 / c.w;
-    return vec3<f32>((c.x * iw * 0.5 + 0.5) * width, (0.5 - c.y * iw * 0.5) * height, c.z * iw);
 }
 
 // Drawn segments per strand of `points` points at a vertex step.

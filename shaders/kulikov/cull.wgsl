@@ -6,8 +6,15 @@
 // elected lane), as Kulikov: "utilize wave intrinsics and only do actual
 // atomic write once per wave". The memory left behind is the same either way.
 
-#import strandgraph::layout::{FrameData, ModelData, ModelLod}
-#import strandgraph::kulikov::{transform, clip_to_screen, load_lod, segment_in_model, drawn_in_model, DrawnSegment, screen_bin, HIZ_FACTOR}
+// Bindings 1..=3 (frame, models, lod_models) are declared in segments.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 2
+#define LOD_MODELS_BINDING 3
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::layout::ModelData
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
+#import strandgraph::subgroup::elected
 
 struct CullParams {
     frustum: u32,
@@ -19,9 +26,6 @@ struct CullParams {
 }
 
 @group(0) @binding(0) var<uniform> params: CullParams;
-@group(0) @binding(1) var<storage, read> frame: FrameData;
-@group(0) @binding(2) var<storage, read> models: array<ModelData>;
-@group(0) @binding(3) var<storage, read> lod_models: array<ModelLod>;
 @group(0) @binding(4) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(5) var hiz: texture_2d<f32>;
 // One bit per segment.
@@ -32,17 +36,6 @@ struct CullParams {
 
 const GROUP: u32 = 256u;
 const NONE: u32 = 0xFFFFFFFFu;
-
-// cull::drawn_segment: the first model holding `id`, then its LOD.
-fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
-        let md = models[m];
-        if segment_in_model(md, id) {
-            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
-        }
-    }
-    return DrawnSegment(false, 0u, 0u, 0u, 0u);
-}
 
 // cull::fedora_culls: inside the exclusion box and outside the inclusion sphere.
 fn fedora_culls(m: ModelData, p: vec3<f32>) -> bool {
@@ -119,19 +112,6 @@ fn test(seg: DrawnSegment, c0: vec4<f32>, c1: vec4<f32>) -> Verdict {
     out.bounds = bounds;
     out.bin = screen_bin(w, h, s0, s1);
     return out;
-}
-
-// subgroupElect: the lowest active lane of the ballot.
-fn elected(lane: u32) -> bool {
-    let ballot = subgroupBallot(true);
-    var first = 0u;
-    for (var k = 0u; k < 4u; k++) {
-        if ballot[k] != 0u {
-            first = 32u * k + firstTrailingBit(ballot[k]);
-            break;
-        }
-    }
-    return lane == first;
 }
 
 @compute @workgroup_size(256)

@@ -3,8 +3,13 @@
 // model's grid over the model's world bounds, with atomicAdd.
 // Port of passes/src/kulikov/density.rs.
 
-#import strandgraph::layout::{FrameData, ModelData, ModelLod}
-#import strandgraph::kulikov::{transform, load_lod, segment_in_model, drawn_in_model, DrawnSegment, round_away}
+// Bindings 1..=3 (frame, models, lod_models) are declared in segments.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 2
+#define LOD_MODELS_BINDING 3
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment, world_of_clip}
+#import strandgraph::layout::ModelData
+#import strandgraph::kulikov::{load_lod, round_away, GRID_WORDS, AREA_UNIT}
 
 struct DensityParams {
     // Grid edge (1..=48); density_grid holds 48^3 words per model.
@@ -14,33 +19,11 @@ struct DensityParams {
 }
 
 @group(0) @binding(0) var<uniform> params: DensityParams;
-@group(0) @binding(1) var<storage, read> frame: FrameData;
-@group(0) @binding(2) var<storage, read> models: array<ModelData>;
-@group(0) @binding(3) var<storage, read> lod_models: array<ModelLod>;
 @group(0) @binding(4) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> groom_vertices: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read_write> density_grid: array<atomic<u32>>;
 
 const GROUP: u32 = 256u;
-const GRID_WORDS: u32 = 110592u;
-const AREA_UNIT: f32 = 1e-9;
-
-fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
-        let md = models[m];
-        if segment_in_model(md, id) {
-            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
-        }
-    }
-    return DrawnSegment(false, 0u, 0u, 0u, 0u);
-}
-
-// kulikov::world_of_clip.
-fn world_of_clip(c: vec4<f32>) -> vec3<f32> {
-    let p = transform(frame.inv_view_proj, c);
-    let iw = 1.0 / p.w;
-    return vec3<f32>(p.x * iw, p.y * iw, p.z * iw);
-}
 
 // density::Grid::voxel: the voxel of p within the model's block, or 0xFFFFFFFF.
 fn grid_voxel(md: ModelData, res: u32, p: vec3<f32>) -> u32 {

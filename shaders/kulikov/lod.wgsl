@@ -4,7 +4,8 @@
 // f64 exactly as the CPU kernel does (`budget as f64 / total as f64`).
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, MODEL_LOD_ENABLED}
-#import strandgraph::kulikov::{transform, clip_to_screen, drawn_segments, MAX_SEGMENTS_PER_MODEL, F32_MAX, F32_MIN}
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::kulikov::{drawn_segments, MAX_SEGMENTS_PER_MODEL, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
 struct LodParams {

@@ -28,8 +28,13 @@
 //   key range; the scan reuses the stack memory).
 // None of them changes which writes happen: results are the CPU kernel's.
 
-#import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles}
-#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, segment_in_model, drawn_in_model, DrawnSegment, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, trapezoid_depth_at, morton_code}
+// Bindings 2..=4 (frame, models, lod_models) are declared in segments.wgsl.
+#define FRAME_BINDING 2
+#define MODELS_BINDING 3
+#define LOD_MODELS_BINDING 4
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::layout::{ModelLod, ModelTiles}
+#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, trapezoid_depth_at, morton_code}
 
 struct RasterParams {
     loop_flattening: u32,
@@ -45,9 +50,6 @@ struct RasterParams {
 @group(0) @binding(0) var<uniform> params: RasterParams;
 // Indirect arguments; word 3 is the number of sorted segments.
 @group(0) @binding(1) var<storage, read> raster_args: array<u32>;
-@group(0) @binding(2) var<storage, read> frame: FrameData;
-@group(0) @binding(3) var<storage, read> models: array<ModelData>;
-@group(0) @binding(4) var<storage, read> lod_models: array<ModelLod>;
 @group(0) @binding(5) var<storage, read> sorted_segments: array<u32>;
 @group(0) @binding(6) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> groom_vertices: array<vec4<f32>>;
@@ -106,16 +108,6 @@ struct Request {
     texel: u32,
     payload: u32,
     cov: u32,
-}
-
-fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
-        let md = models[m];
-        if segment_in_model(md, id) {
-            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
-        }
-    }
-    return DrawnSegment(false, 0u, 0u, 0u, 0u);
 }
 
 // RasterKernel::project for sorted segment number `index`.

@@ -8,8 +8,13 @@
 // (groom_shadow_sh, baked offline by strandgraph-bake).
 // Port of passes/src/kulikov/shade/{mod,karis}.rs.
 
-#import strandgraph::layout::{FrameData, ModelData, ModelLod, LightData}
-#import strandgraph::kulikov::{transform, load_lod, segment_in_model, drawn_in_model, DrawnSegment}
+// Bindings 2..=4 (frame, models, lod_models) are declared in segments.wgsl.
+#define FRAME_BINDING 2
+#define MODELS_BINDING 3
+#define LOD_MODELS_BINDING 4
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment, world_of_clip}
+#import strandgraph::layout::{ModelData, LightData}
+#import strandgraph::kulikov::{load_lod, GRID_WORDS, AREA_UNIT, F32_MAX}
 
 struct ShadeParams {
     // r, tt, trt scales; scatter (0 = no multiple scattering).
@@ -25,9 +30,6 @@ struct ShadeParams {
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(1) var<storage, read> shade_args: array<u32>;
-@group(0) @binding(2) var<storage, read> frame: FrameData;
-@group(0) @binding(3) var<storage, read> models: array<ModelData>;
-@group(0) @binding(4) var<storage, read> lod_models: array<ModelLod>;
 @group(0) @binding(5) var<storage, read> lights: array<LightData>;
 @group(0) @binding(6) var<storage, read> shading_segments: array<u32>;
 @group(0) @binding(7) var<storage, read> segment_visibility: array<u32>;
@@ -40,26 +42,7 @@ struct ShadeParams {
 @group(0) @binding(11) var<storage, read_write> vertex_lighting: array<vec2<u32>>;
 
 const GROUP: u32 = 64u;
-const GRID_WORDS: u32 = 110592u;
-const AREA_UNIT: f32 = 1e-9;
 const PI: f32 = 3.14159265;
-const F32_MAX: f32 = 3.40282347e38;
-
-fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
-        let md = models[m];
-        if segment_in_model(md, id) {
-            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
-        }
-    }
-    return DrawnSegment(false, 0u, 0u, 0u, 0u);
-}
-
-fn world_of_clip(c: vec4<f32>) -> vec3<f32> {
-    let p = transform(frame.inv_view_proj, c);
-    let iw = 1.0 / p.w;
-    return vec3<f32>(p.x * iw, p.y * iw, p.z * iw);
-}
 
 // Karis 2016: longitudinal Gaussian and Schlick Fresnel (n = 1.55).
 fn hair_g(b: f32, theta: f32) -> f32 {

@@ -3,6 +3,8 @@
 // segment order"). shade_args (cleared to 0) ends as [groups, 1, 1, count].
 // Port of passes/src/kulikov/shade_sort.rs.
 
+#import strandgraph::subgroup::elected
+
 struct ShadeSortParams {
     wave_aggregated_atomics: u32,
     // Scene quantity: segments in the full numbering.
@@ -17,19 +19,6 @@ struct ShadeSortParams {
 const GROUP: u32 = 256u;
 // kulikov.shade's workgroup size (shade_sort::SHADE_GROUP).
 const SHADE_GROUP: u32 = 64u;
-
-// subgroupElect: the lowest active lane of the ballot.
-fn elected(sg_lane: u32) -> bool {
-    let ballot = subgroupBallot(true);
-    var first = 0u;
-    for (var k = 0u; k < 4u; k++) {
-        if ballot[k] != 0u {
-            first = 32u * k + firstTrailingBit(ballot[k]);
-            break;
-        }
-    }
-    return sg_lane == first;
-}
 
 @compute @workgroup_size(256)
 fn shade_sort(

@@ -4,7 +4,8 @@
 // p = root_now + sum_i now[i] * dot(p - root_bind, bind[i]).
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, TriangleData}
-#import strandgraph::kulikov::{transform, load_lod}
+#import strandgraph::clip::transform
+#import strandgraph::kulikov::load_lod
 
 // The pass has no parameters; the block keeps binding 0 the same for every pass.
 struct SkinParams {

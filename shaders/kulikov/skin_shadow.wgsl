@@ -5,6 +5,7 @@
 // Mask word: bytes 0-2 the visibility of lights 0-2, byte 3 the AO.
 
 #import strandgraph::layout::{FrameData, ModelData, LightData}
+#import strandgraph::kulikov::{GRID_WORDS, AREA_UNIT, F32_MAX}
 
 // SkinShadowParams::uniform.
 struct SkinShadowParams {
@@ -27,10 +28,6 @@ struct SkinShadowParams {
 @group(0) @binding(6) var<storage, read_write> skin_shadow: array<u32>;
 
 const GROUP: u32 = 64u;
-// kulikov::density::{GRID_WORDS, AREA_UNIT}.
-const GRID_WORDS: u32 = 110592u;
-const AREA_UNIT: f32 = 1e-9;
-const F32_MAX: f32 = 3.40282347e38;
 const MASK_LIGHTS: u32 = 3u;
 const LIT: u32 = 0xFFFFFFFFu;
 

@@ -2,8 +2,13 @@
 // sort of visible segments into 64x64 screen buckets.
 // Port of passes/src/kulikov/sort.rs.
 
-#import strandgraph::layout::{FrameData, ModelData, ModelLod}
-#import strandgraph::kulikov::{clip_to_screen, load_lod, segment_in_model, drawn_in_model, DrawnSegment, screen_bin, TILE}
+// Bindings 1..=3 (frame, models, lod_models) are declared in segments.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 2
+#define LOD_MODELS_BINDING 3
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::clip::clip_to_screen
+#import strandgraph::kulikov::screen_bin
 
 struct SortParams {
     // kulikov.sort `enabled` (scatter only).
@@ -46,25 +51,12 @@ fn scan() {
 
 // --- scatter: frame, models, lod_models, clip_positions, segment_visibility,
 // sort_offsets, sorted_segments ---
-@group(0) @binding(1) var<storage, read> frame: FrameData;
-@group(0) @binding(2) var<storage, read> models: array<ModelData>;
-@group(0) @binding(3) var<storage, read> lod_models: array<ModelLod>;
 @group(0) @binding(4) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> segment_visibility: array<u32>;
 @group(0) @binding(6) var<storage, read_write> sort_offsets: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> sorted_segments: array<u32>;
 
 const GROUP: u32 = 256u;
-
-fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
-        let md = models[m];
-        if segment_in_model(md, id) {
-            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
-        }
-    }
-    return DrawnSegment(false, 0u, 0u, 0u, 0u);
-}
 
 @compute @workgroup_size(256)
 fn scatter(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {

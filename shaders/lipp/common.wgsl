@@ -3,6 +3,9 @@
 //   #import strandgraph::lipp::{...}
 #define_import_path strandgraph::lipp
 
+#import strandgraph::hash::pcg
+#import strandgraph::clip::transform
+
 // Words per record (lipp::{BUNDLE_WORDS, LOD_WORDS}); vec4s per packed layer.
 const BUNDLE_WORDS: u32 = 16u;
 const LOD_WORDS: u32 = 4u;
@@ -25,27 +28,9 @@ const F32_MIN: f32 = -3.40282347e38;
 // payload::EMPTY as the two words WGSL sees.
 const EMPTY_WORD: u32 = 0xFFFFFFFFu;
 
-// PCG hash (Jarzynski and Olano, JCGT 2020), as bench::pcg.
-fn pcg(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
 // lipp::unit: 24 bits of a hash in [0, 1).
 fn unit(h: u32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0);
-}
-
-// kulikov::transform (column-major matrix times a point).
-fn transform(m: mat4x4<f32>, p: vec4<f32>) -> vec4<f32> {
-    return m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3] * p.w;
-}
-
-// kulikov::clip_to_screen: pixels (y down) and NDC depth.
-fn clip_to_screen(c: vec4<f32>, width: f32, height: f32) -> vec3<f32> {
-    let iw = 1.0 / c.w;
-    return vec3<f32>((c.x * iw * 0.5 + 0.5) * width, (0.5 - c.y * iw * 0.5) * height, c.z * iw);
 }
 
 // lipp::normalize: zero for a zero vector.

@@ -4,7 +4,8 @@
 // `output` is Rgba16Float, read and written: a read_write storage texture.
 
 #import strandgraph::layout::FrameData
-#import strandgraph::lipp::{safe_normalize, transform, is_empty, unpack_payload, world_position, linear_depth, Sample}
+#import strandgraph::clip::transform
+#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {

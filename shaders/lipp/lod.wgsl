@@ -5,7 +5,9 @@
 // paper's one-thread-per-bundle pass that lod.rs explains).
 
 #import strandgraph::layout::FrameData
-#import strandgraph::lipp::{pcg, unit, transform, clip_to_screen, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
+#import strandgraph::hash::pcg
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp::{unit, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
 struct LodParams {

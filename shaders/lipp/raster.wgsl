@@ -10,8 +10,15 @@
 // of shuffled; the bits are the same, so the result does not depend on the
 // subgroup width. Needs SHADER_INT64 and SHADER_INT64_ATOMIC_MIN_MAX.
 
+// Bindings 1 (frame), 6 (models) and 7 (lights) are declared in dom.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 6
+#define LIGHTS_BINDING 7
+#import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, transform, clip_to_screen, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::hash::pcg
+#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -34,7 +41,6 @@ struct RasterParams {
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
-@group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> raster_args: array<u32>;
 @group(0) @binding(3) var<storage, read> bundle_lod: array<u32>;
 @group(0) @binding(4) var<storage, read> hairmesh_bundles: array<u32>;
@@ -554,32 +560,12 @@ struct DomParams {
 }
 
 @group(0) @binding(0) var<uniform> dom_params: DomParams;
-@group(0) @binding(6) var<storage, read> models: array<ModelData>;
-@group(0) @binding(7) var<storage, read> lights: array<LightData>;
 @group(0) @binding(8) var<storage, read_write> dom_depth: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read> dom_opacity_pass_dom_depth: array<u32>;
 @group(0) @binding(9) var<storage, read_write> dom_layers: array<atomic<u32>>;
 
-const NO_HIT: u32 = 0xFFFFFFFFu;
-const OPACITY_SCALE: f32 = 1024.0;
 // dom::MAX_DOM_LIGHTS.
 const MAX_DOM_LIGHTS: u32 = 4u;
-
-// dom::LightFrame::new over every model's bounds.
-fn light_frame(l: u32) -> LightFrame {
-    var lo = vec3<f32>(3.40282347e38);
-    var hi = vec3<f32>(-3.40282347e38);
-    let count = min(frame.model_count, arrayLength(&models));
-    for (var m = 0u; m < count; m++) {
-        lo = min(lo, models[m].bounds_min.xyz);
-        hi = max(hi, models[m].bounds_max.xyz);
-    }
-    if count == 0u {
-        lo = vec3<f32>(-1.0);
-        hi = vec3<f32>(1.0);
-    }
-    return light_frame_of(lo, hi, lights[l].position_or_direction);
-}
 
 // Number of lights the maps have room for (dom::light_frames).
 fn dom_light_count(res: u32, map_words: u32) -> u32 {

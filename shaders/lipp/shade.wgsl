@@ -5,8 +5,18 @@
 // irradiance and a prefiltered GGX lookup for R + TRT, shaders/lipp/probe.wgsl). Writes rgba32f into `shaded`
 // (pixel i: vec4 2i centre layer, 2i+1 conservative layer).
 
+// Bindings 1 (frame), 2 (models) and 3 (lights) are declared in dom.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 2
+#define LIGHTS_BINDING 3
+// `lights` is also a ShadeParams member, which a plain import would rename
+// too (naga_oil decorates every token of an imported name): the binding is
+// reached as lipp_dom::lights instead.
+#import strandgraph::lipp_dom
+#import strandgraph::lipp_dom::{frame, models, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, pcg, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
+#import strandgraph::hash::pcg
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, is_empty, unpack_payload, world_position, Sample, PI}
 #import strandgraph::chiang::{chiang}
 #import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
@@ -31,9 +41,6 @@ struct ShadeParams {
 }
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
-@group(0) @binding(1) var<storage, read> frame: FrameData;
-@group(0) @binding(2) var<storage, read> models: array<ModelData>;
-@group(0) @binding(3) var<storage, read> lights: array<LightData>;
 @group(0) @binding(4) var<storage, read> env_sh: array<vec4<f32>, 9>;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
 @group(0) @binding(6) var<storage, read> raster_args: array<u32>;
@@ -43,24 +50,6 @@ struct ShadeParams {
 // probe.rs's layout: 6 lat-long levels of rgba32f, back to back.
 @group(0) @binding(10) var<storage, read> env_prefiltered: array<vec4<f32>>;
 
-const NO_HIT: u32 = 0xFFFFFFFFu;
-const OPACITY_SCALE: f32 = 1024.0;
-
-// dom::LightFrame::new over every model's bounds.
-fn light_frame(l: u32) -> LightFrame {
-    var lo = vec3<f32>(3.40282347e38);
-    var hi = vec3<f32>(-3.40282347e38);
-    let count = min(frame.model_count, arrayLength(&models));
-    for (var m = 0u; m < count; m++) {
-        lo = min(lo, models[m].bounds_min.xyz);
-        hi = max(hi, models[m].bounds_max.xyz);
-    }
-    if count == 0u {
-        lo = vec3<f32>(-1.0);
-        hi = vec3<f32>(1.0);
-    }
-    return light_frame_of(lo, hi, lights[l].position_or_direction);
-}
 
 // shade::depth_correction (Lipp Eq. 8): Δ = −log β.
 fn depth_correction(drawn: u32, all: u32) -> f32 {
@@ -153,9 +142,9 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
     let color = clamp(c.xyz * vary, vec3<f32>(0.0), vec3<f32>(1.0));
     let roughness = c.w;
     var out = vec3<f32>(0.0);
-    let count = min(frame.light_count, arrayLength(&lights));
+    let count = min(frame.light_count, arrayLength(&lipp_dom::lights));
     for (var i = 0u; i < count; i++) {
-        let pd = lights[i].position_or_direction;
+        let pd = lipp_dom::lights[i].position_or_direction;
         var l = safe_normalize(-pd.xyz);
         var atten = 1.0;
         if pd.w != 0.0 {
@@ -171,7 +160,7 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
             }
             shadow = dom_transmittance(i, pos, delta);
         }
-        let rad = lights[i].radiance.xyz * atten * shadow;
+        let rad = lipp_dom::lights[i].radiance.xyz * atten * shadow;
         var f = chiang(t, l, v, color, roughness) * params.specular;
         if params.multiple_scattering != 0u {
             let sin_tl = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));

@@ -17,7 +17,7 @@ use ash::vk;
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::Dispatch;
-use strandgraph_passes::draw::RasterState;
+use strandgraph_passes::raster_state::RasterState;
 
 /// How a compute dispatch gets its workgroup count.
 #[derive(Debug, Clone, Copy)]

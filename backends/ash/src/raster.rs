@@ -9,7 +9,7 @@ use crate::pipelines::{Context, Work, entry_name};
 use crate::prepare::Prepared;
 use ash::vk;
 use strandgraph_graph::schema::Usage;
-use strandgraph_passes::draw::{Blend, Compare, Draw, RasterState};
+use strandgraph_passes::raster_state::{Blend, Compare, Draw, RasterState};
 
 fn compare(c: Compare) -> vk::CompareOp {
     match c {

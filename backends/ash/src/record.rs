@@ -22,7 +22,7 @@ use ash::vk;
 use std::sync::Arc;
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::{Plan, Queue};
-use strandgraph_passes::draw::{ColorLoad, DepthLoad};
+use strandgraph_passes::raster_state::{ColorLoad, DepthLoad};
 
 /// Which backend queue a plan queue runs on.
 pub(crate) fn backend_queue(q: Queue, has_compute: bool) -> usize {

@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::{Instance, Plan, Queue};
-use strandgraph_passes::sim::{CounterValues, Counters, Ctx, Words};
+use strandgraph_passes::kernel::{CounterValues, Counters, Ctx, Words};
 use strandgraph_passes::{CpuKernel, Definitions, Dispatch, PassDef, Registry};
 
 #[derive(Debug, thiserror::Error)]

@@ -4,7 +4,7 @@
 use std::time::Duration;
 use strandgraph_cpu::{CpuBackend, CpuError, Inputs};
 use strandgraph_graph::{KindList, Plan, Quantities, compile_str};
-use strandgraph_passes::sim::Ctx;
+use strandgraph_passes::kernel::Ctx;
 use strandgraph_passes::{
     Binding, CpuKernel, Definitions, Dispatch, ParamError, Params, PassDef, Shader,
 };

@@ -2,7 +2,7 @@
 //! a frame only records them ([`crate::record`]).
 
 use super::*;
-use strandgraph_passes::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use strandgraph_passes::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use wgpu::util::DeviceExt;
 
 /// One pass, ready to record every frame.

@@ -3,8 +3,8 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
+use crate::kernel::{CounterValues, Ctx};
 use crate::params::{Invalid, NoParams, PassParams, in_range};
-use crate::sim::{CounterValues, Ctx};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
@@ -211,7 +211,7 @@ impl CpuKernel for CopyKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::harness::Harness;
+    use crate::kernel::harness::Harness;
 
     fn quantities(width: u32, height: u32) -> Quantities {
         let mut q = Quantities::example();

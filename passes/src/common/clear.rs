@@ -6,8 +6,8 @@
 
 use crate::contract::{CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::params::PassParams;
-use crate::sim::Ctx;
 
 const GROUP: u32 = 256;
 /// Words each lane clears, `GROUP` apart (coalesced). A 1080p 8-sample

@@ -10,9 +10,9 @@
 use super::{ModelLod, Scene, TILE, clip_to_screen, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{CounterValues, Ctx, Words};
 use crate::layout::ModelData;
 use crate::params::PassParams;
-use crate::sim::{CounterValues, Ctx, Words};
 use std::collections::BTreeMap;
 use strandgraph_graph::schema::Quantity;
 
@@ -188,7 +188,7 @@ impl CullKernel {
             clampy(s0[1].max(s1[1])),
         ];
         if self.0.occlusion {
-            let f16 = super::hiz::FACTOR;
+            let f16 = super::depth_downsample::FACTOR;
             let hw = (w as u32).div_ceil(f16);
             let (tx0, ty0, tx1, ty1) = (
                 bounds[0] / f16,

@@ -11,8 +11,8 @@ use super::raster::LAYERS;
 use super::{Scene, TILE_TEXELS};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::params::NoParams;
-use crate::sim::{Ctx, Words};
 use half::f16;
 use strandgraph_graph::schema::Quantity;
 

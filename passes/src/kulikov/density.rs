@@ -15,9 +15,9 @@ use super::cull::{GROUP, drawn_segment};
 use super::{Scene, world_of_clip};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::layout::ModelData;
 use crate::params::{Invalid, PassParams};
-use crate::sim::Ctx;
 use strandgraph_graph::schema::Quantity;
 
 /// Largest grid edge; `density_grid` holds `MAX_RESOLUTION³` words per model.
@@ -188,9 +188,9 @@ impl CpuKernel for DensityKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::harness::Harness;
     use crate::kulikov::ModelLod;
     use crate::layout::{FrameData, words_of};
-    use crate::sim::harness::Harness;
     use bytemuck::Zeroable;
     use strandgraph_graph::Quantities;
 
@@ -219,7 +219,7 @@ mod tests {
                 .map(|&w| std::sync::atomic::AtomicU32::new(w))
                 .collect();
             let oob = std::sync::atomic::AtomicU64::new(0);
-            lod.store(&crate::sim::Words::new(&atoms, &oob), 0);
+            lod.store(&crate::kernel::Words::new(&atoms, &oob), 0);
             lod_words = atoms
                 .iter()
                 .map(|a| a.load(std::sync::atomic::Ordering::Relaxed))

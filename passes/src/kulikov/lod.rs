@@ -15,9 +15,9 @@ use super::payload::MAX_SEGMENTS_PER_MODEL;
 use super::{ModelLod, Scene, drawn_segments, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::layout::{MODEL_LOD_ENABLED, ModelData};
 use crate::params::{Invalid, PassParams, in_range, non_negative};
-use crate::sim::Ctx;
 
 /// Skinning workgroup size; the LOD pass writes the skinning dispatch.
 pub const SKIN_GROUP: u32 = 64;

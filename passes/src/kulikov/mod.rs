@@ -6,9 +6,9 @@ pub mod compose;
 pub mod cull;
 pub mod debug_resolve;
 pub mod density;
-pub mod history;
-pub mod hiz;
+pub mod depth_downsample;
 pub mod lod;
+pub mod motion;
 pub mod payload;
 pub mod pixel_motion;
 pub mod raster;
@@ -17,10 +17,10 @@ pub mod shade_sort;
 pub mod skin;
 pub mod skin_shadow;
 pub mod sort;
-pub mod tiles;
+pub mod tile_alloc;
 
+use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, ModelData, read};
-use crate::sim::{Ctx, Words};
 
 /// Atlas tile edge in texels (Kulikov: "64x64 pixel tiles").
 pub const TILE: u32 = 64;
@@ -117,10 +117,10 @@ impl Scene {
     }
 
     /// The tile allocation (`atlas_tiles`), one per model.
-    pub fn tiles(&self, ctx: &Ctx<'_>) -> Vec<tiles::ModelTiles> {
+    pub fn tiles(&self, ctx: &Ctx<'_>) -> Vec<tile_alloc::ModelTiles> {
         let w = ctx.words("atlas_tiles");
         (0..self.models.len())
-            .map(|m| tiles::ModelTiles::load(&w, m))
+            .map(|m| tile_alloc::ModelTiles::load(&w, m))
             .collect()
     }
 

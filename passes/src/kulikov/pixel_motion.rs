@@ -30,9 +30,9 @@ use super::raster::{LAYERS, segment_trapezoid};
 use super::{Scene, TILE};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::layout::{FrameData, read};
 use crate::params::NoParams;
-use crate::sim::Ctx;
 use glam::{Mat4, Vec4};
 use strandgraph_graph::schema::Quantity;
 
@@ -169,7 +169,7 @@ impl CpuKernel for PixelMotionKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::testing::frame;
+    use crate::opaque_mesh::testing::frame;
     use glam::Vec3;
 
     #[test]

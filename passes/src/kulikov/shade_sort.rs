@@ -15,8 +15,8 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{CounterValues, Ctx, subgroup};
 use crate::params::PassParams;
-use crate::sim::{CounterValues, Ctx, subgroup};
 use strandgraph_graph::schema::Quantity;
 
 pub const GROUP: u32 = 256;
@@ -144,7 +144,7 @@ impl CpuKernel for ShadeSortKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::harness::Harness;
+    use crate::kernel::harness::Harness;
     use strandgraph_graph::Quantities;
 
     fn run(aggregated: bool, width: u32) -> (Vec<u32>, Vec<u32>, u64) {

@@ -11,9 +11,9 @@ use super::lod::SKIN_GROUP;
 use super::{Scene, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::layout::{ModelData, TriangleData, read};
 use crate::params::NoParams;
-use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3};
 use strandgraph_assets::octahedral::{unpack_barycentrics, unpack_unit_vector};
 

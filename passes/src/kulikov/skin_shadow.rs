@@ -24,9 +24,9 @@ use super::Scene;
 use super::density::{AREA_UNIT, GRID_WORDS, Grid, MAX_RESOLUTION, check_resolution};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::layout::{LightData, read};
 use crate::params::{Invalid, PassParams, in_range, non_negative};
-use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3, Vec4};
 use strandgraph_graph::schema::Quantity;
 
@@ -340,9 +340,9 @@ impl CpuKernel for SkinShadowParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::harness::Harness;
     use crate::layout::{ModelData, words_of};
-    use crate::scene::testing::frame;
-    use crate::sim::harness::Harness;
+    use crate::opaque_mesh::testing::frame;
     use strandgraph_graph::Quantities;
 
     /// A 1 m box of hair above the origin: uniform density `units` per voxel.

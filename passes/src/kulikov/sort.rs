@@ -11,8 +11,8 @@ use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
 use super::{Scene, clip_to_screen};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::params::{NoParams, PassParams};
-use crate::sim::Ctx;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 

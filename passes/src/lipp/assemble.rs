@@ -12,7 +12,7 @@ use super::strand::{
     strand_id, strand_uv,
 };
 use super::{BundleLod, BundleRecord, MAX_CONTROL_POINTS, RASTER_GROUP};
-use crate::sim::Words;
+use crate::kernel::Words;
 
 /// What receives each segment: both ends and their tangents.
 pub type DrawSegment<'a> = dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]) + 'a;

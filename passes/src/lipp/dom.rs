@@ -30,9 +30,9 @@ use super::{
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::layout::{LightData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::sim::{Ctx, Words};
 use strandgraph_graph::Quantities;
 
 /// Fixed-point scale of the opacity layers.

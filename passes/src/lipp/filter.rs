@@ -36,10 +36,10 @@ use super::shade::world_position;
 use super::{add, frame, normalize, scale, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::layout::FrameData;
 use crate::params::{Invalid, PassParams, in_range};
-use crate::sim::{Ctx, Words};
 use strandgraph_graph::schema::Quantity;
 
 pub const FILTER_GROUP: u32 = 64;

@@ -31,9 +31,9 @@ use super::{
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::layout::FrameData;
 use crate::params::{Invalid, PassParams};
-use crate::sim::{Ctx, Words};
 
 /// Threads of the single LOD workgroup (WGSL).
 pub const LOD_GROUP: u32 = 256;

@@ -20,8 +20,8 @@ pub mod shade;
 pub mod strand;
 pub mod upload;
 
+use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, read};
-use crate::sim::{Ctx, Words};
 
 /// Layers a bundle may have on the GPU (the `hairmesh.layers` size is
 /// 16 layers per bundle; upload resamples taller bundles to this many).

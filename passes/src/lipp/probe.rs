@@ -33,7 +33,7 @@
 
 use super::chiang::{Material, reflected_albedo};
 use super::{dot, normalize, scale, sub};
-use crate::sim::Words;
+use crate::kernel::Words;
 use glam::Vec3;
 use rayon::prelude::*;
 use strandgraph_assets::Scene;

@@ -47,9 +47,9 @@ use super::{
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{CounterValues, Ctx, Words};
 use crate::layout::FrameData;
 use crate::params::{Invalid, PassParams};
-use crate::sim::{CounterValues, Ctx, Words};
 
 /// Sub-pixel snap grid (as the Kulikov raster's `SNAP`).
 pub const SNAP: f32 = 256.0;

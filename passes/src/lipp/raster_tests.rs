@@ -3,10 +3,10 @@
 
 use super::*;
 use crate::contract::PassDef;
+use crate::kernel::harness::Harness;
 use crate::layout::words_of;
 use crate::lipp::lod::LOD;
 use crate::lipp::payload::{EMPTY, unpack};
-use crate::sim::harness::Harness;
 use bytemuck::Zeroable;
 use strandgraph_graph::Quantities;
 

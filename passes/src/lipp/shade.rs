@@ -35,9 +35,9 @@ use super::probe;
 use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, LightData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::sim::{Ctx, Words};
 use strandgraph_graph::schema::Quantity;
 
 pub const SHADE_GROUP: u32 = 64;

@@ -25,7 +25,7 @@
 //!   arbitrary orthonormal basis, does not flip along the strand.
 
 use super::{BundleRecord, Corner, add, cross, dot, mix, normalize, pcg, scale, sub, unit};
-use crate::sim::Words;
+use crate::kernel::Words;
 
 const TAU: f32 = std::f32::consts::TAU;
 const PI: f32 = std::f32::consts::PI;

@@ -27,12 +27,12 @@ pub mod stacks;
 
 use super::cull::{DrawnSegment, drawn_segment};
 use super::payload::{COVERAGE_SCALE, EMPTY, linear_depth, pack, quantize_depth};
-use super::tiles::ModelTiles;
+use super::tile_alloc::ModelTiles;
 use super::{ModelLod, Scene, TILE, TILE_TEXELS};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
+use crate::kernel::{CounterValues, Ctx, Words};
 use crate::params::{Invalid, PassParams};
-use crate::sim::{CounterValues, Ctx, Words};
 use geometry::Trapezoid;
 use stacks::{Request, Sink, Stacks};
 

@@ -1,8 +1,8 @@
 //! The rasterizer against a brute-force reference, and order independence.
 
 use super::*;
+use crate::kernel::harness::Harness;
 use crate::layout::{FrameData, ModelData, words_of};
-use crate::sim::harness::Harness;
 use bytemuck::Zeroable;
 use strandgraph_graph::Quantities;
 

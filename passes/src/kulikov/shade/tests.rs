@@ -3,11 +3,11 @@
 //! towards the directions it counts scattering events in.
 
 use super::*;
+use crate::kernel::harness::Harness;
 use crate::kulikov::ModelLod;
 use crate::kulikov::density::AREA_UNIT;
 use crate::layout::{ModelData, words_of};
-use crate::scene::testing::{frame, sun};
-use crate::sim::harness::Harness;
+use crate::opaque_mesh::testing::{frame, sun};
 use bytemuck::Zeroable;
 use strandgraph_graph::Quantities;
 

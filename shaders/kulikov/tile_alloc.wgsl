@@ -1,6 +1,6 @@
 // kulikov.tile_alloc: 64x64 atlas tiles for each model's visible screen
 // bounds, at the smallest power-of-two downscale that fits.
-// Port of passes/src/kulikov/tiles.rs (`allocate`), one invocation.
+// Port of passes/src/kulikov/tile_alloc.rs (`allocate`), one invocation.
 
 #import strandgraph::layout::{FrameData, ModelTiles}
 #import strandgraph::kulikov::TILE
@@ -17,7 +17,7 @@ struct TileParams {
 @group(0) @binding(2) var<storage, read> screen_bounds: array<u32>;
 @group(0) @binding(3) var<storage, read_write> atlas_tiles: array<ModelTiles>;
 
-// tiles::visible_bounds: (x0, y0, x1, y1), or x0 > x1 when nothing is visible.
+// tile_alloc::visible_bounds: (x0, y0, x1, y1), or x0 > x1 when nothing is visible.
 fn visible_bounds(m: u32) -> vec4<u32> {
     return vec4<u32>(screen_bounds[4u * m], screen_bounds[4u * m + 1u], ~screen_bounds[4u * m + 2u], ~screen_bounds[4u * m + 3u]);
 }

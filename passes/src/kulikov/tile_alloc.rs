@@ -8,8 +8,8 @@
 use super::TILE;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
+use crate::kernel::{Ctx, Words};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::sim::{Ctx, Words};
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -65,7 +65,7 @@ pub static TILE_ALLOC: PassKind<TileParams, TileGpu> = PassKind {
     ]),
     workgroup_size: 1,
     dispatch: Dispatch::Fixed(1),
-    shader: Shader::compute("kulikov/tiles.wgsl", "allocate"),
+    shader: Shader::compute("kulikov/tile_alloc.wgsl", "allocate"),
     kernel: |p| {
         Box::new(AllocKernel {
             atlas_tiles: p.atlas_tiles,

@@ -1,5 +1,6 @@
 //! What CPU kernels see: memory as atomic 32-bit words, emulated subgroups
-//! and instrumentation counters. The CPU backend builds a [`Ctx`] per pass.
+//! and instrumentation counters. The CPU backend builds a [`Ctx`] per pass;
+//! unit tests beside each pass build one with [`harness::Harness`].
 
 pub mod harness;
 pub mod subgroup;

@@ -9,15 +9,15 @@
 //! The result is therefore independent of triangle and workgroup order.
 //!
 //! On the GPU backends this is a depth-only raster pipeline
-//! (`shaders/scene/depth_prepass.wgsl`): depth attachment cleared to 1.0,
+//! (`shaders/opaque_mesh/depth_prepass.wgsl`): depth attachment cleared to 1.0,
 //! compare `Less`, writes on, `FrontFace::Ccw`, `CullMode::Back`.
 
 use super::{GROUP, View, clear, dispatch};
 use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
-use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use crate::kernel::{CounterValues, Ctx};
 use crate::params::NoParams;
-use crate::sim::{CounterValues, Ctx};
+use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use strandgraph_graph::Quantities;
 
 crate::gpu_block! {
@@ -39,7 +39,7 @@ pub static DEPTH_PREPASS: PassKind<NoParams, DepthPrepassGpu> = PassKind {
     workgroup_size: GROUP,
     dispatch: dispatch(),
     shader: Shader {
-        file: "scene/depth_prepass.wgsl",
+        file: "opaque_mesh/depth_prepass.wgsl",
         entry: "vs_main",
         fragment: Some("fs_main"),
     },

@@ -21,7 +21,7 @@
 //! `output` is `Rgba16Float`: 2 words per texel, row-major,
 //! word 0 = r | g << 16, word 1 = b | a << 16 (IEEE half floats).
 //!
-//! On the GPU backends this is a raster pipeline (`shaders/scene/opaque.wgsl`):
+//! On the GPU backends this is a raster pipeline (`shaders/opaque_mesh/opaque.wgsl`):
 //! colour attachment cleared to `background`, depth attachment `scene.depth`
 //! loaded with compare `Equal` and writes off, `FrontFace::Ccw`,
 //! `CullMode::Back`; [`OpaqueParams::uniform`] fills its parameter block.
@@ -29,11 +29,11 @@
 use super::{GROUP, View, corner_normals, corners, dispatch};
 use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
-use crate::draw::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use crate::kernel::{CounterValues, Ctx, Words};
 use crate::kulikov::skin_shadow::{ambient_visibility, light_visibility};
 use crate::layout::{LightData, read};
 use crate::params::{Invalid, PassParams, non_negative};
-use crate::sim::{CounterValues, Ctx, Words};
+use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use glam::Vec3;
 use half::f16;
 use strandgraph_graph::Quantities;
@@ -53,7 +53,7 @@ pub static OPAQUE: PassKind<OpaqueParams, OpaqueGpu> = PassKind {
     workgroup_size: GROUP,
     dispatch: dispatch(),
     shader: Shader {
-        file: "scene/opaque.wgsl",
+        file: "opaque_mesh/opaque.wgsl",
         entry: "vs_main",
         fragment: Some("fs_main"),
     },
@@ -119,7 +119,7 @@ impl PassParams for OpaqueParams {
 }
 
 crate::gpu_block! {
-    /// `OpaqueParams` in shaders/scene/opaque.wgsl.
+    /// `OpaqueParams` in shaders/opaque_mesh/opaque.wgsl.
     pub struct OpaqueGpu {
         /// rgb: albedo; a: ambient.
         albedo_ambient: [f32; 4],
@@ -291,7 +291,7 @@ mod tests {
             p.uniform().albedo_ambient,
             [p.albedo[0], p.albedo[1], p.albedo[2], p.ambient]
         );
-        let wgsl = include_str!("../../../shaders/scene/opaque.wgsl");
+        let wgsl = include_str!("../../../shaders/opaque_mesh/opaque.wgsl");
         assert!(
             wgsl.contains("albedo_ambient: vec4<f32>"),
             "WGSL block changed without the Rust side"

@@ -1,15 +1,15 @@
 // kulikov.depth_downsample: the farthest scene depth of each 16x16 block.
-// Port of passes/src/kulikov/hiz.rs.
+// Port of passes/src/kulikov/depth_downsample.rs.
 
 #import strandgraph::kulikov::HIZ_FACTOR
 
 // The screen size the CPU kernel reads from the scene quantities.
-struct HizParams {
+struct DepthDownsampleParams {
     width: u32,
     height: u32,
 }
 
-@group(0) @binding(0) var<uniform> params: HizParams;
+@group(0) @binding(0) var<uniform> params: DepthDownsampleParams;
 @group(0) @binding(1) var scene_depth: texture_depth_2d;
 @group(0) @binding(2) var hiz: texture_storage_2d<r32float, write>;
 

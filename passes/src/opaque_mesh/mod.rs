@@ -1,19 +1,20 @@
 //! Opaque scene geometry (heads, bodies): a depth prepass and a forward
-//! shading pass. The Kulikov pipeline composes its hair coverage over this
+//! shading pass, the kinds `scene.depth_prepass` and `scene.opaque` (named
+//! for what graphs see: the scene's opaque meshes, as opposed to hair). The Kulikov pipeline composes its hair coverage over this
 //! opaque head, and culls and depth-tests hair against `scene.depth`.
 //!
 //! Both passes run one lane per triangle on the CPU simulator and share the
 //! fixed-point rasterizer in [`raster`], so the opaque pass's depth-equal test
 //! sees exactly the bits the prepass wrote. On the GPU backends they are real
-//! raster pipelines (`shaders/scene/*.wgsl`), which apply the same rules.
+//! raster pipelines (`shaders/opaque_mesh/*.wgsl`), which apply the same rules.
 
 pub mod depth_prepass;
 pub mod opaque;
 pub mod raster;
 
 use crate::contract::Dispatch;
+use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, TriangleData, read};
-use crate::sim::{Ctx, Words};
 use glam::{Mat4, Vec3, Vec4};
 use raster::Setup;
 use strandgraph_assets::octahedral::unpack_unit_vector;
@@ -105,8 +106,8 @@ pub(crate) mod testing {
 
     use super::GROUP;
     use crate::contract::PassDef;
+    use crate::kernel::harness::Harness;
     use crate::layout::{FrameData, LightData, TriangleData, words_of};
-    use crate::sim::harness::Harness;
     use crate::upload::{FAR, NEAR};
     use glam::{Mat4, Vec3};
     use strandgraph_assets::octahedral::pack_unit_vector;

@@ -1,12 +1,13 @@
 // kulikov.store_history and kulikov.motion: motion vectors from the
 // post-transform cache (Kulikov, "Motion vectors"). CPU kernels:
-// passes/src/kulikov/history.rs, which documents the packing.
+// passes/src/kulikov/motion.rs, which documents the packing.
 //
 // Bindings (group 0): 0 = HistoryParams, then the pass's bindings() in
 // order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions,
 // 4 = prev_frame.
 // motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions, 4 = vertex_motion.
 #import strandgraph::layout::FrameData
+#import strandgraph::kulikov::round_away
 
 struct HistoryParams {
     vertices: u32,
@@ -17,7 +18,7 @@ struct HistoryParams {
 
 const UNORM_MAX: f32 = 65534.0;
 // Codes are stored plus one; 0 (a History buffer's first contents) is
-// "not transformed" (history::NOT_TRANSFORMED).
+// "not transformed" (motion::NOT_TRANSFORMED).
 const NOT_TRANSFORMED: u32 = 0u;
 
 @group(0) @binding(0) var<uniform> params: HistoryParams;
@@ -27,12 +28,6 @@ const NOT_TRANSFORMED: u32 = 0u;
 @group(0) @binding(3) var<storage, read> motion_prev_clip_positions: array<u32>;
 @group(0) @binding(4) var<storage, read_write> vertex_motion: array<vec2<f32>>;
 @group(0) @binding(4) var<storage, read_write> prev_frame: FrameData;
-
-// Rust's f32::round: halves away from zero.
-fn round_away(x: f32) -> f32 {
-    let t = trunc(x);
-    return select(t, t + sign(x), abs(x - t) >= 0.5);
-}
 
 fn compress(ndc: f32) -> u32 {
     return u32(round_away((clamp(ndc, -1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX));

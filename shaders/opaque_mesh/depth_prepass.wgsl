@@ -1,6 +1,6 @@
 // scene.depth_prepass: opaque meshes (heads, bodies) into scene.depth.
 //
-// A depth-only raster pipeline; the CPU kernel is passes/src/scene/depth_prepass.rs.
+// A depth-only raster pipeline; the CPU kernel is passes/src/opaque_mesh/depth_prepass.rs.
 // Pipeline state the backend sets: topology TriangleList, FrontFace::Ccw,
 // CullMode::Back; depth attachment `scene.depth` (Depth32Float) cleared to 1.0,
 // compare Less, writes on; no colour attachments. Draw 3 × triangles vertices,

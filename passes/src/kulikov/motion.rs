@@ -1,4 +1,5 @@
-//! Motion vectors from the post-transform cache (Kulikov, "Motion vectors"):
+//! `kulikov.motion` and `kulikov.store_history`: motion vectors from the
+//! post-transform cache (Kulikov, "Motion vectors"):
 //! "Compress post-transform NDC from current frame; use as last frame
 //! positions in the next frame; assume no movement if vertex wasn't
 //! transformed last frame (LOD change); clamped UNORM16 for x and y."
@@ -11,15 +12,19 @@
 //!   `prev_clip_positions` for the next frame, and keeps this frame's camera
 //!   (`frame`) as `prev_frame` for `kulikov.pixel_motion`'s reprojection.
 //!
+//! The two kinds share one file because they share one packed format:
+//! `store_history` writes what `motion` reads next frame, and the encoder
+//! and decoder ([`pack`], [`motion`]) are tested against each other here.
+//!
 //! A vertex was transformed this frame when its clip w is in front of the
 //! near plane: the graph clears `clip_positions` before skinning, so a
 //! vertex the LOD skipped reads w = 0.
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::layout::{FrameData, read};
 use crate::params::NoParams;
-use crate::sim::Ctx;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
@@ -96,7 +101,7 @@ pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
     ]),
     workgroup_size: GROUP,
     dispatch: PER_VERTEX,
-    shader: Shader::compute("kulikov/history.wgsl", "store_history"),
+    shader: Shader::compute("kulikov/motion.wgsl", "store_history"),
     kernel: |_| Box::new(StoreKernel),
     gpu: history_gpu,
     raster: None,
@@ -114,7 +119,7 @@ pub static MOTION: PassKind<NoParams, HistoryGpu> = PassKind {
     ]),
     workgroup_size: GROUP,
     dispatch: PER_VERTEX,
-    shader: Shader::compute("kulikov/history.wgsl", "motion"),
+    shader: Shader::compute("kulikov/motion.wgsl", "motion"),
     kernel: |_| Box::new(MotionKernel),
     gpu: history_gpu,
     raster: None,

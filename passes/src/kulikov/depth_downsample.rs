@@ -6,8 +6,8 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::kernel::Ctx;
 use crate::params::NoParams;
-use crate::sim::Ctx;
 use strandgraph_graph::schema::Quantity;
 
 /// Block edge in pixels.
@@ -15,14 +15,14 @@ pub const FACTOR: u32 = 16;
 const GROUP: u32 = 64;
 
 crate::gpu_block! {
-    /// `HizParams`: the full-resolution screen size.
-    pub struct HizGpu {
+    /// `DepthDownsampleParams`: the full-resolution screen size.
+    pub struct DepthDownsampleGpu {
         width: u32,
         height: u32,
     }
 }
 
-pub static DEPTH_DOWNSAMPLE: PassKind<NoParams, HizGpu> = PassKind {
+pub static DEPTH_DOWNSAMPLE: PassKind<NoParams, DepthDownsampleGpu> = PassKind {
     kind: "kulikov.depth_downsample",
     summary: "1/16 downscaled max depth for segment occlusion culling",
     source: "Kulikov 2025, 'Culling'",
@@ -32,9 +32,9 @@ pub static DEPTH_DOWNSAMPLE: PassKind<NoParams, HizGpu> = PassKind {
         quantity: Quantity::Tiles(FACTOR),
         per_group: GROUP,
     },
-    shader: Shader::compute("kulikov/hiz.wgsl", "downsample"),
+    shader: Shader::compute("kulikov/depth_downsample.wgsl", "downsample"),
     kernel: |_| Box::new(DownsampleKernel),
-    gpu: |_, q| HizGpu {
+    gpu: |_, q| DepthDownsampleGpu {
         width: q.width,
         height: q.height,
     },

@@ -1,6 +1,6 @@
 // scene.opaque: shade opaque meshes where they won the depth prepass.
 //
-// A raster pipeline; the CPU kernel is passes/src/scene/opaque.rs.
+// A raster pipeline; the CPU kernel is passes/src/opaque_mesh/opaque.rs.
 // Pipeline state the backend sets: topology TriangleList, FrontFace::Ccw,
 // CullMode::Back; depth attachment `scene.depth` loaded (not cleared), compare
 // Equal, writes off; colour attachment 0 `output` (Rgba16Float) cleared to
@@ -13,7 +13,7 @@
 //
 #import strandgraph::layout::{FrameData, TriangleData, LightData}
 
-// passes/src/scene/opaque.rs: OpaqueParams. `background` is the colour
+// passes/src/opaque_mesh/opaque.rs: OpaqueParams. `background` is the colour
 // attachment's clear value, not a shader input.
 struct OpaqueParams {
     // rgb: albedo; a: ambient.
@@ -91,7 +91,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
 
 // Lambert (BRDF albedo/π) over every light plus ambient × albedo, scaled by
 // the pixel's shadow mask (bytes 0-2: lights 0-2, byte 3: ambient), as
-// `shade` in passes/src/scene/opaque.rs. Linear RGB.
+// `shade` in passes/src/opaque_mesh/opaque.rs. Linear RGB.
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     // Perspective-correct interpolation (the default) of the corner normals.

@@ -1,0 +1,41 @@
+// The scene bindings every per-segment Kulikov pass reads (frame, models,
+// lod_models), declared once with the helpers that read them. Composed
+// with naga_oil:
+//   #define FRAME_BINDING 1
+//   #define MODELS_BINDING 2
+//   #define LOD_MODELS_BINDING 3
+//   #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment, world_of_clip}
+// Each pass numbers its bindings in the order of its definition's
+// bindings() (passes/tests/wgsl.rs checks it), so the importing shader
+// says where these three sit with the defines above; naga_oil substitutes
+// them into this module when it composes that shader.
+// naga_oil renames every token that spells an imported name, struct members
+// included: an importer must not use these names for anything else (or
+// must reach the item qualified, as lipp/shade.wgsl does with `lights`).
+#define_import_path strandgraph::kulikov_segments
+
+#import strandgraph::layout::{FrameData, ModelData, ModelLod}
+#import strandgraph::clip::transform
+#import strandgraph::kulikov::{load_lod, segment_in_model, drawn_in_model, DrawnSegment}
+
+@group(0) @binding(#{FRAME_BINDING}) var<storage, read> frame: FrameData;
+@group(0) @binding(#{MODELS_BINDING}) var<storage, read> models: array<ModelData>;
+@group(0) @binding(#{LOD_MODELS_BINDING}) var<storage, read> lod_models: array<ModelLod>;
+
+// cull::drawn_segment: the first model holding `id`, then its LOD.
+fn drawn_segment(id: u32) -> DrawnSegment {
+    for (var m = 0u; m < frame.model_count; m++) {
+        let md = models[m];
+        if segment_in_model(md, id) {
+            return drawn_in_model(md, load_lod(lod_models[m]), m, id);
+        }
+    }
+    return DrawnSegment(false, 0u, 0u, 0u, 0u);
+}
+
+// kulikov::world_of_clip.
+fn world_of_clip(c: vec4<f32>) -> vec3<f32> {
+    let p = transform(frame.inv_view_proj, c);
+    let iw = 1.0 / p.w;
+    return vec3<f32>(p.x * iw, p.y * iw, p.z * iw);
+}
