@@ -13,7 +13,7 @@
 //! for entry (packed the same way), and counts the lanes of every depth-test
 //! and write step in a [`LaneTally`].
 
-use crate::sim::subgroup;
+use crate::kernel::subgroup;
 
 /// Bits of a stack entry's atlas texel; the coverage increment takes the
 /// other 11 (at most `COVERAGE_SCALE` = 1024).
