@@ -9,6 +9,7 @@
 //! `scenes/distances/{close,mid,far}.ron`), each prepared for the row's graph.
 
 mod report;
+mod variants;
 
 use miette::{Result, miette};
 use report::{Ceilings, Cell, Report, Stats};
@@ -20,187 +21,16 @@ use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, f
 use strandgraph_assets::Scene;
 use strandgraph_passes::upload::Upload;
 use strandgraph_passes::{Definitions, Registry};
-
-/// One row of the table: a pipeline configuration.
-#[derive(Debug, Clone, Copy)]
-pub struct Variant {
-    pub pipeline: &'static str,
-    pub name: &'static str,
-    /// The graph, relative to the repository root.
-    pub graph: &'static str,
-    /// `PASS.PARAM=VALUE` overrides, as `render --param`.
-    pub overrides: &'static [&'static str],
-    /// The raster passes: their time goes in parentheses, their atomics are
-    /// compared with the roofline.
-    pub raster: &'static [&'static str],
-    /// The roofline pass whose rate is the raster's ceiling.
-    pub ceiling: &'static str,
-}
-
-const KULIKOV: &str = "scenes/graphs/kulikov.ron";
-
-/// The rows. Kulikov's ablations switch one published optimisation off at
-/// a time (passes/src/kulikov/raster/mod.rs, sort.rs). Lipp's rows follow
-/// its Table 1 (passes/src/lipp/).
-pub const VARIANTS: &[Variant] = &[
-    Variant {
-        pipeline: "Kulikov",
-        name: "all optimisations",
-        graph: KULIKOV,
-        overrides: &[],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
-    Variant {
-        pipeline: "Kulikov",
-        name: "no loop flattening",
-        graph: KULIKOV,
-        overrides: &["raster.loop_flattening=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
-    Variant {
-        pipeline: "Kulikov",
-        name: "no pixel request stack",
-        graph: KULIKOV,
-        // The depth-test stack is the second half of the same LDS machinery.
-        overrides: &[
-            "raster.pixel_request_stack=false",
-            "raster.depth_test_stack=false",
-        ],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
-    Variant {
-        pipeline: "Kulikov",
-        name: "no sort",
-        graph: KULIKOV,
-        overrides: &["sort.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
-    Variant {
-        pipeline: "Kulikov",
-        name: "no last-layer cull",
-        graph: KULIKOV,
-        overrides: &["raster.last_layer_cull=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
-    // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
-    // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
-    // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`
-    // composites the centre layer as is; `lod.enabled=false` draws every
-    // strand at C_max control points.
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1",
-        graph: LIPP,
-        overrides: &[
-            "lod.enabled=false",
-            "shadow_lod.enabled=false",
-            "filter.enabled=false",
-        ],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F",
-        graph: LIPP,
-        overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+L",
-        graph: LIPP,
-        overrides: &["filter.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F+L (as published)",
-        graph: LIPP,
-        overrides: &[],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 2",
-        graph: LIPP_MSAA,
-        overrides: &[
-            "lod.enabled=false",
-            "shadow_lod.enabled=false",
-            "raster.msaa=2",
-            "filter.msaa=2",
-        ],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 4",
-        graph: LIPP_MSAA,
-        overrides: &[
-            "lod.enabled=false",
-            "shadow_lod.enabled=false",
-            "raster.msaa=4",
-            "filter.msaa=4",
-        ],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 8",
-        graph: LIPP_MSAA,
-        overrides: &[
-            "lod.enabled=false",
-            "shadow_lod.enabled=false",
-            "raster.msaa=8",
-            "filter.msaa=8",
-        ],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 2+L",
-        graph: LIPP_MSAA,
-        overrides: &["raster.msaa=2", "filter.msaa=2"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 4+L",
-        graph: LIPP_MSAA,
-        overrides: &["raster.msaa=4", "filter.msaa=4"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 8+L",
-        graph: LIPP_MSAA,
-        overrides: &["raster.msaa=8", "filter.msaa=8"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-];
-
-const LIPP: &str = "scenes/graphs/lipp.ron";
-const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";
+pub use variants::{VARIANTS, Variant};
 
 const VIEWS: [&str; 3] = [
     "scenes/distances/close.ron",
     "scenes/distances/mid.ron",
     "scenes/distances/far.ron",
 ];
+/// Whole scenes timed after the views (not by `--quick`): one head, and
+/// the crowd of twelve characters.
+const SCENES: [&str; 2] = ["scenes/showcase.ron", "scenes/crowd.ron"];
 const ROOFLINE: &str = "scenes/graphs/roofline.ron";
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -214,7 +44,8 @@ pub enum Choice {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Scenes, one column each (default: scenes/distances/{close,mid,far}.ron).
+    /// Scenes, one column each (default: scenes/distances/{close,mid,far}.ron,
+    /// then scenes/showcase.ron and scenes/crowd.ron unless --quick).
     pub scenes: Vec<PathBuf>,
     /// Backends to time (repeatable, or comma-separated).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "cpu")]
@@ -358,7 +189,8 @@ pub fn run(mut args: Args) -> Result<()> {
     }
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let scenes: Vec<PathBuf> = if args.scenes.is_empty() {
-        VIEWS.iter().map(|v| locate(v)).collect()
+        let whole = if args.quick { &[][..] } else { &SCENES[..] };
+        VIEWS.iter().chain(whole).map(|v| locate(v)).collect()
     } else {
         args.scenes.clone()
     };
@@ -399,7 +231,9 @@ pub fn run(mut args: Args) -> Result<()> {
         }
     }
     // Each (scene, graph) is loaded and compiled once; rows clone its plan.
-    let mut prepared: BTreeMap<(usize, &str), Prepared> = BTreeMap::new();
+    // A pipeline that cannot run a scene (Lipp needs hair meshes) gets its
+    // cells marked skipped with the reason, not a failed bench.
+    let mut prepared: BTreeMap<(usize, &str), Result<Prepared, String>> = BTreeMap::new();
     for (s, scene) in scenes.iter().enumerate() {
         for graph in rows.iter().map(|v| v.graph) {
             if skipped.contains_key(graph) {
@@ -407,14 +241,18 @@ pub fn run(mut args: Args) -> Result<()> {
             }
             if let std::collections::btree_map::Entry::Vacant(e) = prepared.entry((s, graph)) {
                 tracing::info!(scene = %scene.display(), graph, "preparing");
-                e.insert(prepare_graph(scene, &locate(graph), size, args.quick)?);
+                let p = prepare_graph(scene, &locate(graph), size, args.quick);
+                e.insert(p.map_err(|e| format!("{graph} on {}: {e}", scene.display())));
             }
         }
     }
     let first = prepared
         .values()
-        .next()
-        .ok_or_else(|| miette!("no runnable rows: {skipped:?}"))?;
+        .find_map(|p| p.as_ref().ok())
+        .ok_or_else(|| {
+            let why: Vec<&String> = prepared.values().filter_map(|p| p.as_ref().err()).collect();
+            miette!("no runnable rows: {skipped:?} {why:?}")
+        })?;
     // Raster atomics per (row, view), counted once for every backend.
     let mut counts: BTreeMap<(usize, usize), u64> = BTreeMap::new();
     'backends: for (backend, required) in backends(&args) {
@@ -433,7 +271,13 @@ pub fn run(mut args: Args) -> Result<()> {
                     report.cell(backend, v, s, Cell::Skipped(why.clone()));
                     continue;
                 }
-                let p = &prepared[&(s, v.graph)];
+                let p = match &prepared[&(s, v.graph)] {
+                    Ok(p) => p,
+                    Err(why) => {
+                        report.cell(backend, v, s, Cell::Skipped(why.clone()));
+                        continue;
+                    }
+                };
                 eprintln!(
                     "[{:>5.0} s] {} {}: {} / {}",
                     t0.elapsed().as_secs_f64(),

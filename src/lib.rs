@@ -7,3 +7,4 @@ pub mod compare;
 pub mod frame;
 pub mod images;
 pub mod runner;
+pub mod tables;

@@ -8,6 +8,7 @@ mod bench_cmd;
 mod graph_cmd;
 mod info;
 mod render_cmd;
+mod tables_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +32,8 @@ enum Command {
     Bench(bench_cmd::Args),
     /// Run every pass of a scene's graph alone on the CPU simulator and the GPU backends, and compare every output.
     Agree(agree_cmd::Args),
+    /// Regenerate (or --check) README's tables from the measurements under benches/results/.
+    Tables(tables_cmd::Args),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +51,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
         Command::Agree(args) => agree_cmd::run(args),
+        Command::Tables(args) => tables_cmd::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -66,7 +66,9 @@ pub fn markdown(title: &str, checks: &Value) -> Result<String, String> {
             match cells.get(b) {
                 Some(c) => {
                     let verdict = if c.passed { "ok" } else { "**outside**" };
-                    let _ = write!(md, " {:.3}% | {} {verdict} |", c.identical, c.rule);
+                    // Rounded down, so one differing word never reads 100.000%.
+                    let shown = (c.identical * 1000.0).floor() / 1000.0;
+                    let _ = write!(md, " {shown:.3}% | {} {verdict} |", c.rule);
                 }
                 None => md.push_str(" – | – |"),
             }

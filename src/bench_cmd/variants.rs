@@ -1,0 +1,177 @@
+//! The bench's rows: each pipeline's published configuration and its
+//! ablations, one published (or our own) optimisation switched off at a time.
+
+/// One row of the table: a pipeline configuration.
+#[derive(Debug, Clone, Copy)]
+pub struct Variant {
+    pub pipeline: &'static str,
+    pub name: &'static str,
+    /// The graph, relative to the repository root.
+    pub graph: &'static str,
+    /// `PASS.PARAM=VALUE` overrides, as `render --param`.
+    pub overrides: &'static [&'static str],
+    /// The raster passes: their time goes in parentheses, their atomics are
+    /// compared with the roofline.
+    pub raster: &'static [&'static str],
+    /// The roofline pass whose rate is the raster's ceiling.
+    pub ceiling: &'static str,
+}
+
+const KULIKOV: &str = "scenes/graphs/kulikov.ron";
+
+/// The rows. Kulikov's ablations switch one published optimisation off at
+/// a time (passes/src/kulikov/raster/mod.rs, sort.rs). Lipp's rows follow
+/// its Table 1 (passes/src/lipp/).
+pub const VARIANTS: &[Variant] = &[
+    Variant {
+        pipeline: "Kulikov",
+        name: "all optimisations",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no loop flattening",
+        graph: KULIKOV,
+        overrides: &["raster.loop_flattening=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no pixel request stack",
+        graph: KULIKOV,
+        // The depth-test stack is the second half of the same LDS machinery.
+        overrides: &[
+            "raster.pixel_request_stack=false",
+            "raster.depth_test_stack=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no sort",
+        graph: KULIKOV,
+        overrides: &["sort.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no last-layer cull",
+        graph: KULIKOV,
+        overrides: &["raster.last_layer_cull=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
+    // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
+    // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`
+    // composites the centre layer as is; `lod.enabled=false` draws every
+    // strand at C_max control points.
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1",
+        graph: LIPP,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "filter.enabled=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F",
+        graph: LIPP,
+        overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+L",
+        graph: LIPP,
+        overrides: &["filter.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L (as published)",
+        graph: LIPP,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 2",
+        graph: LIPP_MSAA,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=2",
+            "filter.msaa=2",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 4",
+        graph: LIPP_MSAA,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=4",
+            "filter.msaa=4",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 8",
+        graph: LIPP_MSAA,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "raster.msaa=8",
+            "filter.msaa=8",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 2+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=2", "filter.msaa=2"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 4+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=4", "filter.msaa=4"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 8+L",
+        graph: LIPP_MSAA,
+        overrides: &["raster.msaa=8", "filter.msaa=8"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+];
+
+const LIPP: &str = "scenes/graphs/lipp.ron";
+const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";

@@ -1,0 +1,213 @@
+//! Markdown tables from `strandgraph bench --out DIR`'s `bench.json`.
+
+use serde_json::Value;
+use std::fmt::Write;
+
+/// The cells of one backend, in the file's order.
+fn cells<'a>(json: &'a Value, backend: &'a str) -> impl Iterator<Item = &'a Value> + 'a {
+    json["cells"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(move |c| c["backend"] == backend)
+}
+
+fn label(cell: &Value) -> String {
+    format!(
+        "{}: {}",
+        cell["pipeline"].as_str().unwrap_or("?"),
+        cell["variant"].as_str().unwrap_or("?")
+    )
+}
+
+/// Distinct values of `f` over `items`, first occurrence first.
+fn distinct<'a, T: PartialEq>(
+    items: impl Iterator<Item = &'a Value>,
+    f: impl Fn(&Value) -> T,
+) -> Vec<T> {
+    let mut out = Vec::new();
+    for i in items {
+        let v = f(i);
+        if !out.contains(&v) {
+            out.push(v);
+        }
+    }
+    out
+}
+
+fn devices(json: &Value) -> Result<Vec<(String, String)>, String> {
+    let list = json["devices"]
+        .as_array()
+        .ok_or("no `devices` (not a bench.json)")?;
+    Ok(list
+        .iter()
+        .filter_map(|d| {
+            Some((
+                d["backend"].as_str()?.to_string(),
+                d["device"].as_str()?.to_string(),
+            ))
+        })
+        .collect())
+}
+
+/// What the run was, for a table's caption.
+fn caption(json: &Value, backend: &str, device: &str) -> String {
+    format!(
+        "{device}, {backend}, {}, {} timed frames after {} warm-up",
+        json["size"].as_str().unwrap_or("?"),
+        json["frames"],
+        json["warmup"]
+    )
+}
+
+/// Per backend: a row per pipeline variant, a column per view; each cell the
+/// median frame time with the raster passes' median and their atomics as a
+/// fraction of the same run's atomicMin roofline (Lipp's Table 1 shape).
+pub fn frame_table(json: &Value) -> Result<String, String> {
+    let mut md = String::new();
+    for (backend, device) in devices(json)? {
+        let views = distinct(cells(json, &backend), |c| {
+            c["view"].as_str().unwrap_or("?").to_string()
+        });
+        let rows = distinct(cells(json, &backend), label);
+        let _ = writeln!(
+            md,
+            "{}; ms: median frame (raster median; raster atomics as % of the atomicMin roofline):\n",
+            caption(json, &backend, &device)
+        );
+        let _ = writeln!(md, "| variant | {} |", views.join(" | "));
+        let _ = writeln!(md, "|---|{}", "---:|".repeat(views.len()));
+        for row in &rows {
+            let _ = write!(md, "| {row} |");
+            for view in &views {
+                let cell =
+                    cells(json, &backend).find(|c| label(c) == *row && c["view"] == view.as_str());
+                let _ = write!(md, " {} |", cell.map_or("–".into(), cell_text));
+            }
+            md.push('\n');
+        }
+        md.push_str(&roofline_line(json, &backend));
+    }
+    Ok(md)
+}
+
+fn cell_text(c: &Value) -> String {
+    if c.get("skipped").is_some() {
+        return "skipped".into();
+    }
+    let ms = |k: &str| c[k]["median_ms"].as_f64().unwrap_or(f64::NAN);
+    match c["fraction_of_ceiling"].as_f64() {
+        Some(f) => format!(
+            "{:.2} ({:.2}; {:.0}%)",
+            ms("frame"),
+            ms("raster"),
+            100.0 * f
+        ),
+        None => format!("{:.2} ({:.2})", ms("frame"), ms("raster")),
+    }
+}
+
+fn roofline_line(json: &Value, backend: &str) -> String {
+    let Some(r) = json["roofline"]
+        .as_array()
+        .and_then(|l| l.iter().find(|r| r["backend"] == backend))
+    else {
+        return String::new();
+    };
+    let g = |k: &str, f: &str| {
+        r[k][f]
+            .as_f64()
+            .map_or("–".into(), |x| format!("{:.1} G", x / 1e9))
+    };
+    format!(
+        "\nRoofline of the same run: {} atomicMin/s 32-bit, {} atomicMin/s 64-bit (random addresses), {}B/s copy.\n\n",
+        g("atomic_min32", "ops_per_s"),
+        g("atomic_min64", "ops_per_s"),
+        g("copy", "bytes_moved_per_s")
+    )
+}
+
+/// One variant's per-pass medians on the file's first backend, a column
+/// per view.
+pub fn pass_table(json: &Value, variant: &str) -> Result<String, String> {
+    let mut md = String::new();
+    if let Some((backend, device)) = devices(json)?.into_iter().next() {
+        let mine: Vec<&Value> = cells(json, &backend)
+            .filter(|c| label(c) == variant && c.get("skipped").is_none())
+            .collect();
+        if mine.is_empty() {
+            return Err(format!("no measured cell of `{variant}` on {backend}"));
+        }
+        let views = distinct(mine.iter().copied(), |c| {
+            c["view"].as_str().unwrap_or("?").to_string()
+        });
+        let passes = distinct(
+            mine.iter()
+                .flat_map(|c| c["passes"].as_array().into_iter().flatten()),
+            |p| {
+                (
+                    p["pass"].as_str().unwrap_or("?").to_string(),
+                    p["kind"].as_str().unwrap_or("?").to_string(),
+                )
+            },
+        );
+        let _ = writeln!(
+            md,
+            "{variant}, {}; ms, median per pass:\n",
+            caption(json, &backend, &device)
+        );
+        let _ = writeln!(md, "| pass | kind | {} |", views.join(" | "));
+        let _ = writeln!(md, "|---|---|{}", "---:|".repeat(views.len()));
+        for (pass, kind) in &passes {
+            let _ = write!(md, "| {pass} | `{kind}` |");
+            for c in &mine {
+                let ms = c["passes"]
+                    .as_array()
+                    .and_then(|l| l.iter().find(|p| p["pass"] == pass.as_str()))
+                    .and_then(|p| p["median_ms"].as_f64());
+                let _ = write!(md, " {} |", ms.map_or("–".into(), |m| format!("{m:.3}")));
+            }
+            md.push('\n');
+        }
+    }
+    if md.is_empty() {
+        return Err(format!("no measured cell of `{variant}`"));
+    }
+    Ok(md)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Value {
+        serde_json::from_str(
+            r#"{"size":"1920x1080","frames":10,"warmup":2,
+            "devices":[{"backend":"ash","device":"GPU"}],
+            "roofline":[{"backend":"ash","atomic_min32":{"ops_per_s":5.0e10},
+                         "atomic_min64":{"ops_per_s":6.0e10},"copy":{"bytes_moved_per_s":1.0e12}}],
+            "cells":[
+              {"backend":"ash","pipeline":"K","variant":"all","view":"close",
+               "frame":{"median_ms":2.5},"raster":{"median_ms":1.25},"fraction_of_ceiling":0.4,
+               "passes":[{"pass":"raster","kind":"k.raster","median_ms":1.25}]},
+              {"backend":"ash","pipeline":"L","variant":"all","view":"close","skipped":"no meshes"}]}"#,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn frame_table_has_a_row_per_variant_and_the_roofline() {
+        let md = frame_table(&sample()).unwrap();
+        assert!(md.contains("| K: all | 2.50 (1.25; 40%) |"), "{md}");
+        assert!(md.contains("| L: all | skipped |"), "{md}");
+        assert!(md.contains("50.0 G atomicMin/s 32-bit"), "{md}");
+        assert!(frame_table(&Value::Null).is_err());
+    }
+
+    #[test]
+    fn pass_table_lists_one_variants_passes() {
+        let md = pass_table(&sample(), "K: all").unwrap();
+        assert!(md.contains("| raster | `k.raster` | 1.250 |"), "{md}");
+        assert!(pass_table(&sample(), "L: all").is_err());
+    }
+}
