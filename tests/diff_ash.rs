@@ -4,8 +4,8 @@
 //! synchronization validation: any validation message fails the run.
 //!
 //! Gates, as in `tests/diff_wgpu.rs`: the three visibility layers identical
-//! on at least 99.9% of covered atlas texels (DESIGN.md, "Determinism across
-//! backends"), the debug view identical on 99.9% of pixels, final images
+//! on at least 99.9% of covered atlas texels (docs/architecture.md,
+//! "Agreement across backends"), the debug view identical on 99.9% of pixels, final images
 //! within a mean FLIP of 0.01 (`strandgraph::compare::flip`). The ash run
 //! with the plan's memory aliasing must produce the same images as the run
 //! without (which the atlases are read from: aliased transients are

@@ -1,8 +1,8 @@
 //! WGSL (composed by `strandgraph_passes::wgsl`) to SPIR-V with naga's
 //! `spv-out`, and the descriptor layout the module declares.
 //!
-//! DESIGN.md, "Shaders": SPIR-V 1.3 or later with an explicit capability
-//! set (the device's [`crate::device::Gpu::spirv_caps`]: Int64,
+//! docs/architecture.md, "Shaders": SPIR-V 1.3 or later with an explicit
+//! capability set (the device's [`crate::device::Gpu::spirv_caps`]: Int64,
 //! Int64Atomics, GroupNonUniform* only where the features were enabled) and
 //! `fake_missing_bindings: true`, so `@group(0) @binding(n)` becomes
 //! descriptor set 0, binding n as written.

@@ -3,8 +3,8 @@
 //! trapezoid"); a pixel's coverage is the exact area of trapezoid ∩ pixel.
 //!
 //! Positions are snapped to 1/256 pixel first, so every backend makes the
-//! same coverage and depth decisions from the same inputs (see DESIGN.md,
-//! "Determinism across backends").
+//! same coverage and depth decisions from the same inputs (see
+//! docs/architecture.md, "Agreement across backends").
 
 /// Sub-pixel grid of the snap.
 pub const SNAP: f32 = 256.0;

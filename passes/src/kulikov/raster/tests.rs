@@ -134,7 +134,7 @@ fn grown_coverage(s: &Seg, x: u32, y: u32, n: u32, grow: f32) -> f32 {
 }
 
 fn reference_depth(s: &Seg, x: u32, y: u32) -> u32 {
-    // Endpoints on the 1/256-pixel grid every backend snaps to (DESIGN.md).
+    // Endpoints on the 1/256-pixel grid every backend snaps to (docs/architecture.md).
     let snap = |v: f32| (v * 256.0).round() / 256.0;
     let (a, b) = ([snap(s.a[0]), snap(s.a[1])], [snap(s.b[0]), snap(s.b[1])]);
     let p = [x as f32 + 0.5 - a[0], y as f32 + 0.5 - a[1]];
