@@ -313,9 +313,32 @@ impl Report {
         );
         let _ = writeln!(
             o,
-            "  CPU frame time is the frame's wall clock (its queues run concurrently on threads); GPU frame time is first begin to last end of the per-pass GPU timestamps on ash (its queues overlap), their sum on wgpu (one queue).\n  Raster atomics are counted by an instrumented CPU run of the same configuration (subgroup width {}); GPU rows use that count.\n  Per-pass medians are in bench.csv / bench.json (--out). Bench took {:.0} s.",
+            "  CPU frame time is the frame's wall clock (its queues run concurrently on threads); GPU frame time is first begin to last end of the per-pass GPU timestamps on ash (its queues overlap), their sum on wgpu (one queue).\n  Raster atomics are counted by an instrumented CPU run of the same configuration (subgroup width {}); GPU rows use that count.\n  Every row's per-pass medians are in bench.csv / bench.json (--out). Bench took {:.0} s.",
             self.subgroup, self.elapsed_s
         );
+        o.push_str(&self.pass_tables());
+        o
+    }
+
+    /// Per-pass medians of every row that runs a graph as shipped (no
+    /// overrides: each pipeline as published), on the first backend, one
+    /// column per view.
+    fn pass_tables(&self) -> String {
+        let json = self.json();
+        let mut shipped: Vec<String> = Vec::new();
+        for (_, v, ..) in &self.cells {
+            let label = format!("{}: {}", v.pipeline, v.name);
+            if v.overrides.is_empty() && !shipped.contains(&label) {
+                shipped.push(label);
+            }
+        }
+        let mut o = String::new();
+        for label in shipped {
+            // A pipeline whose every cell was skipped has no passes to show.
+            if let Ok(md) = strandgraph::tables::bench::pass_table(&json, &label) {
+                let _ = write!(o, "\n{md}");
+            }
+        }
         o
     }
 
