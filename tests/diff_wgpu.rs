@@ -2,7 +2,7 @@
 //! and on wgpu (lavapipe in CI, any Vulkan adapter elsewhere) must agree.
 //!
 //! Both sides snap to the same fixed-point grid and pack visibility the same
-//! way (DESIGN.md, "Determinism across backends"), so the three visibility
+//! way (docs/architecture.md, "Agreement across backends"), so the three visibility
 //! layers must be identical on at least 99.9% of covered atlas texels; only
 //! a float rounding that flips a snap may differ. Coverage (an additive
 //! atomic sum) must agree within a small bound.
@@ -96,6 +96,39 @@ fn raster_ablations_match_cpu_on_wgpu() {
 
 fn compare_visibility(variant: &str, overrides: &[&str]) {
     eprintln!("--- {variant}");
+    let p = prepare_visibility(overrides);
+    let frames = Frames::run(&p);
+    frames.print_timings();
+
+    // Everything before the raster is integer bookkeeping: exact.
+    for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
+        assert_eq!(frames.cpu(name), frames.gpu(name), "{name} differs");
+    }
+    report_clip_positions(&frames);
+    report_depth_and_cull(&frames);
+    let atlas = atlas_agreement(&frames);
+    let (cd, gd) = (frames.cpu("debug_layers"), frames.gpu("debug_layers"));
+    let (layers_same, output_same) = image_agreement(&frames, &cd, &gd);
+
+    let pass = atlas.covered > 1000
+        && atlas.agreement >= 0.999
+        && atlas.coverage_error <= 0.002
+        && atlas.texel_error <= 0.002
+        && layers_same >= 0.999
+        && output_same >= 0.99;
+    if !pass {
+        let dir = write_images(&p, &cd, &gd);
+        panic!(
+            "{variant}: CPU and wgpu visibility differ (need >= 99.9% identical covered texels, coverage within 0.2%, \
+             at least 1000 covered texels; images: 99.9% of debug_layers and 99% of output words identical):\n{}\nimages in {}",
+            atlas.differing.join("\n"),
+            dir.display()
+        );
+    }
+}
+
+/// The showcase through the visibility graph at `W`×`H`, with `overrides`.
+fn prepare_visibility(overrides: &[&str]) -> Prepared {
     let graph = root().join("scenes/graphs/kulikov_visibility.ron");
     let mut p = prepare(
         &root().join("scenes/showcase.ron"),
@@ -106,47 +139,73 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
     for o in overrides {
         override_param(&mut p.plan, o).unwrap_or_else(|e| panic!("{e:?}"));
     }
+    p
+}
 
-    let gpu = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| {
-            panic!(
-                "wgpu backend failed: {e}\n(no adapter? install a Vulkan driver: \
-                 apt-get install mesa-vulkan-drivers libvulkan1, or run scripts/test.sh)"
-            )
-        });
-    for n in &gpu.notes {
-        eprintln!("wgpu: {n}");
-    }
-    // Without aliasing, so every transient can be read back at the end (wgpu
-    // cannot alias either); lavapipe's subgroups are 8 wide.
-    let cpu = CpuBackend {
+/// One frame on the CPU simulator, as wgpu runs it: without aliasing, so
+/// every transient can be read back at the end (wgpu cannot alias either);
+/// lavapipe's subgroups are 8 wide.
+fn cpu_frame(p: &Prepared) -> strandgraph_cpu::Frame<'static> {
+    CpuBackend {
         subgroup_width: 8,
         alias: false,
         ..CpuBackend::default()
     }
     .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"))
+}
 
-    eprintln!("{:<16} {:>12} {:>12}", "pass", "cpu ms", "wgpu ms");
-    for (c, g) in cpu.timings.iter().zip(&gpu.timings) {
-        eprintln!("{:<16} {:>12.3} {:>12.3}", c.name, c.millis, g.millis);
+/// One frame of a prepared scene on both backends.
+struct Frames<'p> {
+    p: &'p Prepared,
+    cpu: strandgraph_cpu::Frame<'static>,
+    gpu: strandgraph_wgpu::Frame,
+}
+
+impl<'p> Frames<'p> {
+    fn run(p: &'p Prepared) -> Self {
+        let gpu = WgpuBackend::default()
+            .execute(&p.plan, &p.instance, &p.upload)
+            .unwrap_or_else(|e| {
+                panic!(
+                    "wgpu backend failed: {e}\n(no adapter? install a Vulkan driver: \
+                     apt-get install mesa-vulkan-drivers libvulkan1, or run scripts/test.sh)"
+                )
+            });
+        for n in &gpu.notes {
+            eprintln!("wgpu: {n}");
+        }
+        Self {
+            p,
+            cpu: cpu_frame(p),
+            gpu,
+        }
     }
 
-    let read_gpu = |name: &str| {
-        gpu.read(&p.plan, name)
+    fn cpu(&self, name: &str) -> Vec<u32> {
+        self.cpu.read(&self.p.plan, name).unwrap()
+    }
+
+    /// A resource's words after the frame (it must have memory on wgpu).
+    fn gpu(&self, name: &str) -> Vec<u32> {
+        self.gpu
+            .read(&self.p.plan, name)
             .unwrap_or_else(|e| panic!("{name}: {e}"))
             .unwrap_or_else(|| panic!("{name}: no memory on wgpu"))
-    };
-    let read_cpu = |name: &str| cpu.read(&p.plan, name).unwrap();
-
-    // Everything before the raster is integer bookkeeping: exact.
-    for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
-        assert_eq!(read_cpu(name), read_gpu(name), "{name} differs");
     }
-    // Skinned clip positions are float: report how far apart they are (a
-    // difference can flip a 1/256-pixel snap in the raster).
-    let (cc, gc) = (read_cpu("clip_positions"), read_gpu("clip_positions"));
+
+    fn print_timings(&self) {
+        eprintln!("{:<16} {:>12} {:>12}", "pass", "cpu ms", "wgpu ms");
+        for (c, g) in self.cpu.timings.iter().zip(&self.gpu.timings) {
+            eprintln!("{:<16} {:>12.3} {:>12.3}", c.name, c.millis, g.millis);
+        }
+    }
+}
+
+/// Skinned clip positions are float: report how far apart they are (a
+/// difference can flip a 1/256-pixel snap in the raster).
+fn report_clip_positions(frames: &Frames) {
+    let (cc, gc) = (frames.cpu("clip_positions"), frames.gpu("clip_positions"));
     let ulps = cc
         .iter()
         .zip(&gc)
@@ -181,52 +240,46 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
             f(&gc)
         );
     }
+}
 
-    // The head's depth (hardware raster on the GPU) and the cull's decisions
-    // (occlusion against it) feed the raster too: report where they differ.
-    let (cd, gd) = (read_cpu("scene.depth"), read_gpu("scene.depth"));
+/// The head's depth (hardware raster on the GPU) and the cull's decisions
+/// (occlusion against it) feed the raster too: report where they differ.
+fn report_depth_and_cull(frames: &Frames) {
+    let (cd, gd) = (frames.cpu("scene.depth"), frames.gpu("scene.depth"));
     let depth_words = cd.iter().zip(&gd).filter(|(a, b)| a != b).count();
     let (cs, gs) = (
-        read_cpu("segment_visibility"),
-        read_gpu("segment_visibility"),
+        frames.cpu("segment_visibility"),
+        frames.gpu("segment_visibility"),
     );
     let culled_bits: u32 = cs.iter().zip(&gs).map(|(a, b)| (a ^ b).count_ones()).sum();
     eprintln!(
         "scene.depth: {depth_words} of {} words differ; segment_visibility: {culled_bits} segments decided differently",
         cd.len()
     );
+}
 
-    let (cv, gv) = (read_cpu("vis_atlas"), read_gpu("vis_atlas"));
-    let (cc, gc) = (read_cpu("coverage_atlas"), read_gpu("coverage_atlas"));
+/// How far the two backends' visibility and coverage atlases agree.
+struct AtlasAgreement {
+    /// Texels either side covers.
+    covered: usize,
+    /// The share of covered texels whose three layers are identical.
+    agreement: f64,
+    /// How far apart the coverage sums are, relative to the CPU's.
+    coverage_error: f64,
+    /// How far apart the numbers of covered texels are, relative to the CPU's.
+    texel_error: f64,
+    /// The first texels that differ, described.
+    differing: Vec<String>,
+}
+
+fn atlas_agreement(frames: &Frames) -> AtlasAgreement {
+    let (cv, gv) = (frames.cpu("vis_atlas"), frames.gpu("vis_atlas"));
+    let (cc, gc) = (frames.cpu("coverage_atlas"), frames.gpu("coverage_atlas"));
     assert_eq!(cv.len(), gv.len());
     assert_eq!(cc.len(), gc.len());
-    let texels = cc.len();
-    assert_eq!(cv.len(), 3 * texels, "three visibility layers");
+    assert_eq!(cv.len(), 3 * cc.len(), "three visibility layers");
+    let (covered, same, differing) = compare_texels(&cv, &cc, &gv, &gc);
 
-    let mut covered = 0usize;
-    let mut same = 0usize;
-    let mut differing = Vec::new();
-    for t in 0..texels {
-        if cc[t] == 0 && gc[t] == 0 {
-            continue;
-        }
-        covered += 1;
-        let layers = |v: &[u32]| [v[t], v[texels + t], v[2 * texels + t]];
-        if layers(&cv) == layers(&gv) {
-            same += 1;
-        } else if differing.len() < 12 {
-            differing.push(format!(
-                "texel {t} (tile {}, x {}, y {}): cpu {:08x?} cov {} | wgpu {:08x?} cov {}",
-                t / 4096,
-                t % 64,
-                (t % 4096) / 64,
-                layers(&cv),
-                cc[t],
-                layers(&gv),
-                gc[t]
-            ));
-        }
-    }
     let filled = |v: &[u32]| v.iter().filter(|&&w| w != EMPTY).count();
     let covered_cpu = cc.iter().filter(|&&c| c > 0).count();
     let covered_gpu = gc.iter().filter(|&&c| c > 0).count();
@@ -243,22 +296,53 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
         filled(&gv),
         coverage_error * 100.0
     );
+    AtlasAgreement {
+        covered,
+        agreement,
+        coverage_error,
+        texel_error,
+        differing,
+    }
+}
 
-    let (cd, gd) = (read_cpu("debug_layers"), read_gpu("debug_layers"));
-    let (co, go) = (read_cpu("output"), read_gpu("output"));
-    let identical = |a: &[u32], b: &[u32]| {
-        assert_eq!(a.len(), b.len(), "image sizes differ");
-        a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len().max(1) as f64
-    };
-    let layers_same = identical(&cd, &gd);
+/// Over texels either side covers: how many, how many have identical
+/// layers, and the first dozen that do not, described.
+fn compare_texels(cv: &[u32], cc: &[u32], gv: &[u32], gc: &[u32]) -> (usize, usize, Vec<String>) {
+    let texels = cc.len();
+    let mut covered = 0usize;
+    let mut same = 0usize;
+    let mut differing = Vec::new();
+    for t in 0..texels {
+        if cc[t] == 0 && gc[t] == 0 {
+            continue;
+        }
+        covered += 1;
+        let layers = |v: &[u32]| [v[t], v[texels + t], v[2 * texels + t]];
+        if layers(cv) == layers(gv) {
+            same += 1;
+        } else if differing.len() < 12 {
+            differing.push(format!(
+                "texel {t} (tile {}, x {}, y {}): cpu {:08x?} cov {} | wgpu {:08x?} cov {}",
+                t / 4096,
+                t % 64,
+                (t % 4096) / 64,
+                layers(cv),
+                cc[t],
+                layers(gv),
+                gc[t]
+            ));
+        }
+    }
+    (covered, same, differing)
+}
+
+/// The share of identical words of the debug view (`cd`, `gd`), and of
+/// output channels within tolerance.
+fn image_agreement(frames: &Frames, cd: &[u32], gd: &[u32]) -> (f64, f64) {
+    let (co, go) = (frames.cpu("output"), frames.gpu("output"));
+    let layers_same = identical(cd, gd);
     // The output is shaded in float (opaque lighting, coverage resolve): compare
     // its rgba16float channels with a tolerance, not bit for bit.
-    let halves = |w: &[u32]| -> Vec<f32> {
-        w.iter()
-            .flat_map(|x| [x & 0xFFFF, x >> 16])
-            .map(|h| half::f16::from_bits(h as u16).to_f32())
-            .collect()
-    };
     let (ch, gh) = (halves(&co), halves(&go));
     assert_eq!(ch.len(), gh.len(), "output sizes differ");
     let close = ch
@@ -278,22 +362,21 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
         close * 100.0,
         identical(&co, &go) * 100.0
     );
-    let output_same = close;
-    let pass = covered > 1000
-        && agreement >= 0.999
-        && coverage_error <= 0.002
-        && texel_error <= 0.002
-        && layers_same >= 0.999
-        && output_same >= 0.99;
-    if !pass {
-        let dir = write_images(&p, &cd, &gd);
-        panic!(
-            "{variant}: CPU and wgpu visibility differ (need >= 99.9% identical covered texels, coverage within 0.2%, \
-             at least 1000 covered texels; images: 99.9% of debug_layers and 99% of output words identical):\n{}\nimages in {}",
-            differing.join("\n"),
-            dir.display()
-        );
-    }
+    (layers_same, close)
+}
+
+/// The share of words two images have in common.
+fn identical(a: &[u32], b: &[u32]) -> f64 {
+    assert_eq!(a.len(), b.len(), "image sizes differ");
+    a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len().max(1) as f64
+}
+
+/// An rgba16float image's channels.
+fn halves(w: &[u32]) -> Vec<f32> {
+    w.iter()
+        .flat_map(|x| [x & 0xFFFF, x >> 16])
+        .map(|h| half::f16::from_bits(h as u16).to_f32())
+        .collect()
 }
 
 /// `strandgraph render --backend all` runs both backends, prints their
@@ -350,13 +433,7 @@ fn showcase_composed_matches_cpu_on_wgpu() {
     let gpu = WgpuBackend::default()
         .execute(&p.plan, &p.instance, &p.upload)
         .unwrap_or_else(|e| panic!("wgpu backend failed: {e}"));
-    let cpu = CpuBackend {
-        subgroup_width: 8,
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+    let cpu = cpu_frame(&p);
     let name = "output.composed";
     let c = cpu.read(&p.plan, name).unwrap();
     let g = gpu.read(&p.plan, name).unwrap().unwrap();

@@ -17,10 +17,12 @@
 //! error. Atomic updaters that nothing orders are serialised in topological
 //! order: their results commute, but Vulkan still wants a barrier between them.
 
+mod flow;
+
 use crate::error::{ErrorKind, GraphError, GraphErrors};
 use crate::reach::Reach;
-use crate::resolve::{Access, Graph, PassId, ResourceId};
-use crate::schema::{AccessMode, LifetimeClass};
+use crate::resolve::{Graph, PassId, ResourceId};
+use flow::{Users, data_flow_edges, users};
 use serde::Serialize;
 use std::cmp::Reverse;
 use std::collections::{BTreeSet, BinaryHeap};
@@ -60,182 +62,39 @@ pub struct Dependencies {
     pub order: Vec<PassId>,
 }
 
-struct Users {
-    readers: Vec<(PassId, Access)>,
-    writers: Vec<(PassId, Access)>,
-    updaters: Vec<(PassId, Access)>,
-}
-
-/// Who touches each resource, in one sweep over all accesses.
-fn users(g: &Graph) -> Vec<Users> {
-    let mut all: Vec<Users> = (0..g.resources.len())
-        .map(|_| Users {
-            readers: vec![],
-            writers: vec![],
-            updaters: vec![],
-        })
-        .collect();
-    for (p, pass) in g.passes.iter().enumerate() {
-        for a in &pass.accesses {
-            let u = &mut all[a.resource];
-            match a.mode {
-                AccessMode::Read => u.readers.push((p, *a)),
-                AccessMode::Write => u.writers.push((p, *a)),
-                AccessMode::Atomic => u.updaters.push((p, *a)),
-            }
-        }
-    }
-    all
-}
-
+/// Data-flow edges first; the order they imply then orders the writers
+/// (WAW) and serialises the atomic updaters.
 pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
-    let src = &g.source;
-    let mut errors = Vec::new();
-    let mut edges = Vec::new();
     let all_users = users(g);
-
-    for (r, res) in g.resources.iter().enumerate() {
-        let u = &all_users[r];
-        let class = res.decl.lifetime();
-        let root = res.version_of.is_none();
-        // History: readers see the previous frame, so writers wait for them.
-        let history = root && class == LifetimeClass::History;
-        // An imported resource no pass writes is a pure input.
-        let external = root && class != LifetimeClass::Transient;
-        let pure_input = external && u.writers.is_empty() && u.updaters.is_empty();
-        // Atomic updates need initialised memory: they follow every writer.
-        for &(p, a) in &u.updaters {
-            let sources: Vec<_> = u.writers.iter().filter(|(w, _)| *w != p).collect();
-            if sources.is_empty() && !external {
-                errors.push(
-                    GraphError::new(
-                        ErrorKind::ReadBeforeWrite,
-                        src,
-                        a.span,
-                        format!(
-                            "pass `{}` updates transient `{}` atomically, but no pass writes it first",
-                            g.passes[p].name, res.name
-                        ),
-                    )
-                    .label(res.span, "declared here")
-                    .help("add a pass that clears it, e.g. kind `common.clear`"),
-                );
-            }
-            edges.extend(sources.iter().map(|(w, _)| Edge {
-                from: *w,
-                to: p,
-                resource: r,
-                hazard: Hazard::ReadAfterWrite,
-            }));
-        }
-        for &(p, a) in &u.readers {
-            let sources: Vec<PassId> = u
-                .writers
-                .iter()
-                .chain(&u.updaters)
-                .map(|(w, _)| *w)
-                .filter(|w| *w != p)
-                .collect();
-            if pure_input {
-                continue;
-            }
-            if history {
-                let writers: BTreeSet<PassId> = sources.into_iter().collect();
-                edges.extend(writers.into_iter().map(|w| Edge {
-                    from: p,
-                    to: w,
-                    resource: r,
-                    hazard: Hazard::WriteAfterRead,
-                }));
-                continue;
-            }
-            if sources.is_empty() {
-                errors.push(
-                    GraphError::new(
-                        ErrorKind::ReadBeforeWrite,
-                        src,
-                        a.span,
-                        format!(
-                            "pass `{}` reads `{}`, but no pass writes it",
-                            g.passes[p].name, res.name
-                        ),
-                    )
-                    .label(res.span, "declared here"),
-                );
-            }
-            edges.extend(sources.into_iter().map(|w| Edge {
-                from: w,
-                to: p,
-                resource: r,
-                hazard: Hazard::ReadAfterWrite,
-            }));
-        }
-        // An in-place write (`a -> b`) is the last use of version `a`: every
-        // other reader of `a` runs first, and only one pass may consume it.
-        let mut consumers: Vec<(PassId, Access)> = u
-            .readers
-            .iter()
-            .filter(|(p, _)| {
-                g.passes[*p].accesses.iter().any(|w| {
-                    w.mode.writes() && w.resource != r && g.physical(w.resource) == g.physical(r)
-                })
-            })
-            .copied()
-            .collect();
-        // A pass that lists `a` in `reads` as well as in `a -> b` consumes it once.
-        consumers.dedup_by_key(|(p, _)| *p);
-        if let [(a, _), (b, acc_b), ..] = consumers.as_slice() {
-            errors.push(GraphError::new(
-                ErrorKind::UnorderedWriters,
-                src,
-                acc_b.span,
-                format!(
-                    "passes `{}` and `{}` both write `{}` in place; only one pass may make a new version of it",
-                    g.passes[*a].name, g.passes[*b].name, res.name
-                ),
-            ));
-        }
-        for &(c, _) in &consumers {
-            edges.extend(
-                u.readers
-                    .iter()
-                    .filter(|(p, _)| *p != c)
-                    .map(|(p, _)| Edge {
-                        from: *p,
-                        to: c,
-                        resource: r,
-                        hazard: Hazard::WriteAfterRead,
-                    }),
-            );
-        }
-        if history
-            && u.writers.is_empty()
-            && u.updaters.is_empty()
-            && let Some(&(p, a)) = u.readers.first()
-        {
-            errors.push(GraphError::new(
-                ErrorKind::ReadBeforeWrite,
-                src,
-                a.span,
-                format!(
-                    "pass `{}` reads history `{}`, which no pass ever writes",
-                    g.passes[p].name, res.name
-                ),
-            ));
-        }
-    }
-    if !errors.is_empty() {
-        return Err(GraphErrors(errors));
-    }
-    edges.sort_by_key(|e| (e.from, e.to, e.resource));
-    edges.dedup();
-
+    let mut edges = data_flow_edges(g, &all_users)?;
+    sort_edges(&mut edges);
     let order = topological_order(g.passes.len(), &edges)
         .map_err(|cycle| cycle_error(g, &edges, &cycle))?;
+    // Reachability over the data-flow edges alone: what orders the writers.
     let reach = Reach::new(g.passes.len(), &order, edges.iter().map(|e| (e.from, e.to)));
     let position = positions(&order);
+    edges.extend(writer_edges(g, &all_users, &reach, &position)?);
+    edges.extend(updater_edges(&all_users, &position));
+    sort_edges(&mut edges);
+    Ok(Dependencies { edges, order })
+}
 
-    // Writers must be ordered by the rest of the graph; ordered ones get a WAW edge.
+/// Sorted by pass pair and resource (stable, so hazards keep their order), without repeats.
+fn sort_edges(edges: &mut Vec<Edge>) {
+    edges.sort_by_key(|e| (e.from, e.to, e.resource));
+    edges.dedup();
+}
+
+/// Writers must be ordered by the rest of the graph (`reach`); ordered ones
+/// get a WAW edge, unordered ones are an error.
+fn writer_edges(
+    g: &Graph,
+    all_users: &[Users],
+    reach: &Reach,
+    position: &[usize],
+) -> Result<Vec<Edge>, GraphErrors> {
+    let mut edges = Vec::new();
+    let mut errors = Vec::new();
     for (r, u) in all_users.iter().enumerate() {
         let mut writers = u.writers.clone();
         writers.sort_by_key(|(p, _)| position[*p]);
@@ -252,7 +111,7 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
                     errors.push(
                         GraphError::new(
                             ErrorKind::UnorderedWriters,
-                            src,
+                            &g.source,
                             acc_b.span,
                             format!(
                                 "passes `{}` and `{}` both write `{}`, but nothing orders them",
@@ -271,8 +130,13 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
     if !errors.is_empty() {
         return Err(GraphErrors(errors));
     }
-    // Atomic updaters commute; serialise them along the topological order
-    // (edges forward in that order cannot create a cycle).
+    Ok(edges)
+}
+
+/// Atomic updaters commute; serialise them along the topological order
+/// (edges forward in that order cannot create a cycle).
+fn updater_edges(all_users: &[Users], position: &[usize]) -> Vec<Edge> {
+    let mut edges = Vec::new();
     for (r, u) in all_users.iter().enumerate() {
         let mut ups: Vec<PassId> = u.updaters.iter().map(|(p, _)| *p).collect();
         ups.sort_by_key(|p| position[*p]);
@@ -284,9 +148,7 @@ pub fn analyse(g: &Graph) -> Result<Dependencies, GraphErrors> {
             hazard: Hazard::WriteAfterWrite,
         }));
     }
-    edges.sort_by_key(|e| (e.from, e.to, e.resource));
-    edges.dedup();
-    Ok(Dependencies { edges, order })
+    edges
 }
 
 pub(crate) fn positions(order: &[PassId]) -> Vec<usize> {

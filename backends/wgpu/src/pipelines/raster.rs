@@ -1,0 +1,186 @@
+//! Raster passes: one render pipeline per draw over the same attachments,
+//! and the translation of the pass's draw state into wgpu's.
+
+use super::*;
+use strandgraph_passes::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw};
+
+/// Which of a raster pass's bindings are attachments, and which are bound.
+struct Attachments {
+    color: Vec<usize>,
+    depth: Option<usize>,
+    /// The bindings that are no attachment, bound from binding 1 on.
+    bound: Vec<usize>,
+}
+
+impl Attachments {
+    fn of(prep: &Prepared<'_>) -> Self {
+        let attachment = |usage: Usage| {
+            prep.attachments
+                .iter()
+                .filter(move |(_, u)| *u == usage)
+                .map(|(b, _)| *b)
+        };
+        Self {
+            color: attachment(Usage::Color).collect(),
+            depth: attachment(Usage::Depth).next(),
+            bound: (0..prep.bindings.len())
+                .filter(|b| !prep.attachments.iter().any(|(a, _)| a == b))
+                .collect(),
+        }
+    }
+}
+
+pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<Built, WgpuError> {
+    let at = Attachments::of(cx.prep);
+    let params = cx.uniform(&cx.prep.params);
+    let entries = cx.entries(&params, &at.bound)?;
+    let mut draws = Vec::new();
+    for d in &state.draws {
+        let pipeline = render_pipeline(cx, state, d, &at)?;
+        let bind_group = cx.bind_group(&pipeline.get_bind_group_layout(0), &entries);
+        draws.push((pipeline, bind_group));
+    }
+    let vertices = u32::try_from(state.vertices)
+        .map_err(|_| cx.error(format!("{} vertices are too many", state.vertices)))?;
+    Ok(Built::Raster {
+        draws,
+        color: at
+            .color
+            .iter()
+            .map(|&b| attachment_view(cx, b))
+            .collect::<Result<_, _>>()?,
+        depth: at.depth.map(|b| attachment_view(cx, b)).transpose()?,
+        state: state.clone(),
+        vertices,
+    })
+}
+
+/// The pass's vertex entry and draw `d`'s fragment entry, writing the
+/// attachments `at` as `d` says.
+fn render_pipeline(
+    cx: &PassContext<'_>,
+    state: &RasterState,
+    d: &Draw,
+    at: &Attachments,
+) -> Result<wgpu::RenderPipeline, WgpuError> {
+    let targets: Vec<Option<wgpu::ColorTargetState>> = at
+        .color
+        .iter()
+        .map(|&b| attachment_format(cx, b).map(|format| Some(color_target(format, d))))
+        .collect::<Result<_, _>>()?;
+    let depth_stencil = match at.depth {
+        Some(b) => Some(depth_state(attachment_format(cx, b)?, d)),
+        None => None,
+    };
+    Ok(cx
+        .device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(cx.name),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &cx.module,
+                entry_point: Some(cx.prep.def.shader().entry),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: state.cull_back_faces.then_some(wgpu::Face::Back),
+                ..Default::default()
+            },
+            depth_stencil,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &cx.module,
+                entry_point: Some(d.fragment),
+                compilation_options: Default::default(),
+                targets: &targets,
+            }),
+            multiview_mask: None,
+            cache: None,
+        }))
+}
+
+fn attachment_format(cx: &PassContext<'_>, b: usize) -> Result<wgpu::TextureFormat, WgpuError> {
+    match &cx.memory[cx.prep.bindings[b].1] {
+        Some(Memory::Texture { format, .. }) => Ok(*format),
+        _ => Err(cx.error(format!(
+            "attachment `{}` is not an image",
+            cx.prep.bindings[b].0
+        ))),
+    }
+}
+
+fn attachment_view(cx: &PassContext<'_>, b: usize) -> Result<wgpu::TextureView, WgpuError> {
+    cx.views[b]
+        .clone()
+        .ok_or_else(|| cx.error(format!("`{}` has no view", cx.prep.bindings[b].0)))
+}
+
+fn color_target(format: wgpu::TextureFormat, d: &Draw) -> wgpu::ColorTargetState {
+    wgpu::ColorTargetState {
+        format,
+        blend: blend(d.blend),
+        write_mask: if d.color_writes {
+            wgpu::ColorWrites::ALL
+        } else {
+            wgpu::ColorWrites::empty()
+        },
+    }
+}
+
+fn depth_state(format: wgpu::TextureFormat, d: &Draw) -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(d.depth_write),
+        depth_compare: Some(compare(d.depth_compare)),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+fn compare(c: Compare) -> wgpu::CompareFunction {
+    match c {
+        Compare::Always => wgpu::CompareFunction::Always,
+        Compare::Less => wgpu::CompareFunction::Less,
+        Compare::Equal => wgpu::CompareFunction::Equal,
+    }
+}
+
+fn blend(b: Blend) -> Option<wgpu::BlendState> {
+    match b {
+        Blend::Replace => None,
+        Blend::PremultipliedOverKeepAlpha => Some(wgpu::BlendState {
+            color: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+                operation: wgpu::BlendOperation::Add,
+            },
+            alpha: wgpu::BlendComponent {
+                src_factor: wgpu::BlendFactor::Zero,
+                dst_factor: wgpu::BlendFactor::One,
+                operation: wgpu::BlendOperation::Add,
+            },
+        }),
+    }
+}
+
+pub(crate) fn color_op(c: ColorLoad) -> wgpu::LoadOp<wgpu::Color> {
+    match c {
+        ColorLoad::Load => wgpu::LoadOp::Load,
+        ColorLoad::Clear([r, g, b, a]) => wgpu::LoadOp::Clear(wgpu::Color {
+            r: r.into(),
+            g: g.into(),
+            b: b.into(),
+            a: a.into(),
+        }),
+    }
+}
+
+pub(crate) fn depth_op(d: DepthLoad) -> wgpu::LoadOp<f32> {
+    match d {
+        DepthLoad::Load => wgpu::LoadOp::Load,
+        DepthLoad::Clear(v) => wgpu::LoadOp::Clear(v),
+    }
+}
