@@ -6,7 +6,9 @@
 //! Rows are [`VARIANTS`]: a pipeline's graph plus parameter overrides (the
 //! published optimisations are pass parameters, so an ablation is an
 //! override, as `render --param`). Columns are the scenes given (by default
-//! `scenes/distances/{close,mid,far}.ron`), each prepared for the row's graph.
+//! `scenes/distances/{close,mid,far}.ron`, the showcase and the crowd), each
+//! prepared for the row's graph; a graph that cannot run a scene gets its
+//! cells marked skipped with the reason.
 
 mod report;
 mod variants;
