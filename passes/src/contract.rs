@@ -141,7 +141,7 @@ pub trait PassDef: Send + Sync {
     /// The WGSL parameter block (binding 0) as 32-bit words: the pass's
     /// `#[repr(C)]` GPU block ([`crate::describe::GpuBlock`]) built from its
     /// parameters and the scene counts, as bytes. [`PassDef::gpu_layout`]
-    /// gives its fields (`passes/tests/wgsl.rs` checks them with naga).
+    /// gives its fields (`passes/tests/wgsl_params.rs` checks them with naga).
     ///
     /// For a pass whose `bindings()` is `None` (`common.clear`), the GPU
     /// backends dispatch once per written resource and put that resource's

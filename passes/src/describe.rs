@@ -13,7 +13,7 @@ use strandgraph_graph::Quantities;
 
 /// A pass's GPU parameter block (binding 0): a `#[repr(C)]` `Pod` struct
 /// whose fields are the WGSL struct's members, in order, at the same
-/// offsets (`passes/tests/wgsl.rs` checks them with naga). Declare it with
+/// offsets (`passes/tests/wgsl_params.rs` checks them with naga). Declare it with
 /// [`gpu_block!`](crate::gpu_block).
 pub trait GpuBlock: bytemuck::Pod {
     /// Field names and byte offsets, in declaration order. Fields named

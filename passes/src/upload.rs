@@ -6,10 +6,11 @@ use crate::layout::{
     FrameData, LightData, MODEL_FACIAL_HAIR, MODEL_LOD_ENABLED, ModelData, TriangleData, words_of,
 };
 use glam::{Mat4, Vec3};
+use std::borrow::Cow;
 use std::collections::BTreeMap;
-use strandgraph_assets::Scene;
 use strandgraph_assets::octahedral::pack_unit_vector;
-use strandgraph_assets::scene::Light;
+use strandgraph_assets::scene::{Light, SceneGroom};
+use strandgraph_assets::{Groom, Scene};
 use strandgraph_graph::Quantities;
 
 /// Near plane distance in metres; hair closer than this is clipped.
@@ -66,14 +67,53 @@ pub fn frame(scene: &Scene, width: u32, height: u32, models: u32) -> FrameData {
 /// Packs `scene` for a `width`×`height` frame.
 pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
     let mut up = Upload::default();
-    let mut vertices: Vec<[f32; 4]> = Vec::new();
-    let mut strands: Vec<[u32; 2]> = Vec::new();
-    let mut skinning: Vec<[u32; 4]> = Vec::new();
-    let mut models = Vec::new();
+    let (triangles, triangle_first) = pack_triangles(scene);
+    let hair = pack_grooms(scene, &triangle_first);
+    let lights: Vec<LightData> = scene.desc.lights.iter().map(light_data).collect();
+    let frame = frame(scene, width, height, hair.models.len() as u32);
+    up.quantities = Quantities {
+        strands: hair.strands.len() as u64,
+        vertices: hair.vertices.len() as u64,
+        segments: hair.segments,
+        bundles: scene
+            .grooms
+            .iter()
+            .map(|g| g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64))
+            .sum(),
+        models: hair.models.len() as u64,
+        triangles: triangles.len() as u64,
+        lights: lights.len() as u64,
+        width,
+        height,
+    };
+    up.set("frame", words_of(&[frame]));
+    up.set("models", words_of(&hair.models));
+    up.set("lights", words_of(&lights));
+    up.set("mesh.triangles", words_of(&triangles));
+    up.set(
+        "groom.vertices",
+        bytemuck::cast_slice(&hair.vertices).to_vec(),
+    );
+    up.set(
+        "groom.strands",
+        bytemuck::cast_slice(&hair.strands).to_vec(),
+    );
+    up.set(
+        "groom.skinning",
+        bytemuck::cast_slice(&hair.skinning).to_vec(),
+    );
+    // Lipp: hair-mesh bundles, layers and the environment SH (passes/src/lipp/upload.rs).
+    crate::lipp::upload::pack(scene, &mut up);
+    up.frame = Some(frame);
+    up.models = hair.models;
+    up
+}
+
+/// Every mesh's triangles in world space with packed world normals
+/// (`mesh.triangles`), and the index of each mesh's first triangle.
+fn pack_triangles(scene: &Scene) -> (Vec<TriangleData>, Vec<u32>) {
     let mut triangles = Vec::new();
     let mut triangle_first = Vec::new();
-    let mut segments = 0u64;
-
     for (i, m) in scene.meshes.iter().enumerate() {
         triangle_first.push(triangles.len() as u32);
         let world = m.mesh.transform.matrix();
@@ -94,23 +134,64 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
             });
         }
     }
+    (triangles, triangle_first)
+}
 
+/// The grooms' strands as the pipelines read them: `groom.vertices`,
+/// `groom.strands` and `groom.skinning`, and one model per groom, in scene
+/// order.
+#[derive(Default)]
+struct PackedGrooms {
+    vertices: Vec<[f32; 4]>,
+    strands: Vec<[u32; 2]>,
+    skinning: Vec<[u32; 4]>,
+    models: Vec<ModelData>,
+    /// Segments packed so far (strands × (points − 1)).
+    segments: u64,
+}
+
+fn pack_grooms(scene: &Scene, triangle_first: &[u32]) -> PackedGrooms {
+    let mut hair = PackedGrooms::default();
     for g in &scene.grooms {
-        // The pipelines index segments as strand × (points − 1): resample
-        // grooms whose strands vary in length to the longest strand's count.
-        let resampled;
-        let groom = match g.groom.uniform_points_per_strand() {
-            Some(_) => &g.groom,
-            None => {
-                let n = (0..g.groom.strand_count())
-                    .map(|s| g.groom.strand_range(s).len())
-                    .max()
-                    .unwrap_or(2);
-                tracing::info!(groom = %g.name, points = n, "resampling strands to a uniform point count");
-                resampled = g.groom.resampled(n);
-                &resampled
-            }
-        };
+        let groom = uniform_groom(g);
+        let points = groom.uniform_points_per_strand().unwrap_or(2) as u32;
+        let skinned = g.parent.is_some()
+            && g.skinning
+                .as_ref()
+                .is_some_and(|s| s.len() == groom.strand_count());
+        let model = hair.model(scene, g, &groom, skinned, triangle_first);
+        hair.models.push(model);
+        hair.segments += groom.strand_count() as u64 * u64::from(points - 1);
+        hair.push_strands(g, &groom, skinned);
+    }
+    hair
+}
+
+/// The pipelines index segments as strand × (points − 1): grooms whose
+/// strands vary in length are resampled to the longest strand's count.
+fn uniform_groom(g: &SceneGroom) -> Cow<'_, Groom> {
+    if g.groom.uniform_points_per_strand().is_some() {
+        return Cow::Borrowed(&g.groom);
+    }
+    let n = (0..g.groom.strand_count())
+        .map(|s| g.groom.strand_range(s).len())
+        .max()
+        .unwrap_or(2);
+    tracing::info!(groom = %g.name, points = n, "resampling strands to a uniform point count");
+    Cow::Owned(g.groom.resampled(n))
+}
+
+impl PackedGrooms {
+    /// The model record of groom `g` (its strands `groom`), whose strands
+    /// are packed next.
+    fn model(
+        &self,
+        scene: &Scene,
+        g: &SceneGroom,
+        groom: &Groom,
+        skinned: bool,
+        triangle_first: &[u32],
+    ) -> ModelData {
         let points = groom.uniform_points_per_strand().unwrap_or(2) as u32;
         let bounds = g.world_bounds();
         let mesh_rotation = g
@@ -123,19 +204,15 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
             .color
             .unwrap_or_else(|| melanin_color(g.material.melanin.unwrap_or(0.5)));
         let fedora = g.fedora;
-        let skinned = g.parent.is_some()
-            && g.skinning
-                .as_ref()
-                .is_some_and(|s| s.len() == groom.strand_count());
-        models.push(ModelData {
+        ModelData {
             world: g.world.to_cols_array(),
             bounds_min: [bounds.min.x, bounds.min.y, bounds.min.z, 0.0],
             bounds_max: [bounds.max.x, bounds.max.y, bounds.max.z, 0.0],
-            strand_first: strands.len() as u32,
+            strand_first: self.strands.len() as u32,
             strand_count: groom.strand_count() as u32,
             points_per_strand: points,
-            vertex_first: vertices.len() as u32,
-            segment_first: segments as u32,
+            vertex_first: self.vertices.len() as u32,
+            segment_first: self.segments as u32,
             skinned: u32::from(skinned),
             triangle_first: g.parent.map_or(0, |p| triangle_first[p]),
             flags: if g.lod.enabled { MODEL_LOD_ENABLED } else { 0 }
@@ -158,21 +235,26 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
             }),
             min_fraction: g.lod.min_fraction,
             _pad: [0; 3],
-        });
-        segments += groom.strand_count() as u64 * u64::from(points - 1);
+        }
+    }
+
+    /// Appends each strand of `groom`: its range, its vertices (position,
+    /// thickness) and its root's skinning (zero when not `skinned`).
+    fn push_strands(&mut self, g: &SceneGroom, groom: &Groom, skinned: bool) {
         for s in 0..groom.strand_count() {
             let range = groom.strand_range(s);
-            strands.push([vertices.len() as u32, range.len() as u32]);
+            self.strands
+                .push([self.vertices.len() as u32, range.len() as u32]);
             for p in range {
                 let q = groom.positions[p];
-                vertices.push([q.x, q.y, q.z, groom.thickness[p]]);
+                self.vertices.push([q.x, q.y, q.z, groom.thickness[p]]);
             }
             let info = g
                 .skinning
                 .as_ref()
                 .filter(|_| skinned)
                 .and_then(|k| k.get(s));
-            skinning.push(info.map_or([0; 4], |k| {
+            self.skinning.push(info.map_or([0; 4], |k| {
                 [
                     k.idx_triangle,
                     k.barycentrics,
@@ -182,74 +264,42 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
             }));
         }
     }
+}
 
-    let lights: Vec<LightData> = scene
-        .desc
-        .lights
-        .iter()
-        .map(|l| match *l {
-            Light::Directional {
-                direction,
-                color,
-                intensity,
-            } => {
-                let d = Vec3::from(direction).normalize_or(Vec3::NEG_Y);
-                LightData {
-                    position_or_direction: [d.x, d.y, d.z, 0.0],
-                    radiance: [
-                        color[0] * intensity,
-                        color[1] * intensity,
-                        color[2] * intensity,
-                        0.0,
-                    ],
-                    _pad: [0; 8],
-                }
-            }
-            Light::Point {
-                position,
-                color,
-                intensity,
-            } => LightData {
-                position_or_direction: [position[0], position[1], position[2], 1.0],
-                radiance: [
-                    color[0] * intensity,
-                    color[1] * intensity,
-                    color[2] * intensity,
-                    0.0,
-                ],
-                _pad: [0; 8],
-            },
-        })
-        .collect();
-
-    let frame = frame(scene, width, height, models.len() as u32);
-    up.quantities = Quantities {
-        strands: strands.len() as u64,
-        vertices: vertices.len() as u64,
-        segments,
-        bundles: scene
-            .grooms
-            .iter()
-            .map(|g| g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64))
-            .sum(),
-        models: models.len() as u64,
-        triangles: triangles.len() as u64,
-        lights: lights.len() as u64,
-        width,
-        height,
+/// A scene light as `lights` holds it: w = 0 for a direction (the way the
+/// light travels), 1 for a position; radiance `color × intensity`.
+fn light_data(light: &Light) -> LightData {
+    let radiance = |color: [f32; 3], intensity: f32| {
+        [
+            color[0] * intensity,
+            color[1] * intensity,
+            color[2] * intensity,
+            0.0,
+        ]
     };
-    up.set("frame", words_of(&[frame]));
-    up.set("models", words_of(&models));
-    up.set("lights", words_of(&lights));
-    up.set("mesh.triangles", words_of(&triangles));
-    up.set("groom.vertices", bytemuck::cast_slice(&vertices).to_vec());
-    up.set("groom.strands", bytemuck::cast_slice(&strands).to_vec());
-    up.set("groom.skinning", bytemuck::cast_slice(&skinning).to_vec());
-    // Lipp: hair-mesh bundles, layers and the environment SH (passes/src/lipp/upload.rs).
-    crate::lipp::upload::pack(scene, &mut up);
-    up.frame = Some(frame);
-    up.models = models;
-    up
+    match *light {
+        Light::Directional {
+            direction,
+            color,
+            intensity,
+        } => {
+            let d = Vec3::from(direction).normalize_or(Vec3::NEG_Y);
+            LightData {
+                position_or_direction: [d.x, d.y, d.z, 0.0],
+                radiance: radiance(color, intensity),
+                _pad: [0; 8],
+            }
+        }
+        Light::Point {
+            position,
+            color,
+            intensity,
+        } => LightData {
+            position_or_direction: [position[0], position[1], position[2], 1.0],
+            radiance: radiance(color, intensity),
+            _pad: [0; 8],
+        },
+    }
 }
 
 /// A display colour for a melanin concentration (0 blond … 1 black), for

@@ -3,7 +3,7 @@
 //   #import strandgraph::layout::{FrameData, ModelData}
 // Every record is bound as a storage buffer, so std430 rules apply: the
 // sizes below equal size_of::<T>() of the Rust structs (checked by
-// passes/tests/wgsl.rs).
+// passes/tests/wgsl_shared.rs).
 #define_import_path strandgraph::layout
 
 // `frame`: camera and screen (256 bytes).

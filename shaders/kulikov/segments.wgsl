@@ -6,7 +6,7 @@
 //   #define LOD_MODELS_BINDING 3
 //   #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment, world_of_clip}
 // Each pass numbers its bindings in the order of its definition's
-// bindings() (passes/tests/wgsl.rs checks it), so the importing shader
+// bindings() (passes/tests/wgsl_bindings.rs checks it), so the importing shader
 // says where these three sit with the defines above; naga_oil substitutes
 // them into this module when it composes that shader.
 // naga_oil renames every token that spells an imported name, struct members

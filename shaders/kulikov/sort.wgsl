@@ -24,7 +24,7 @@ struct SortParams {
 // --- scan: sort_bins, sort_offsets, raster_args ---
 // Both entry points bind `sort_offsets` at different numbers (binding 2
 // written here, binding 6 atomic in scatter), so this one carries the
-// entry point as a prefix (`scan_sort_offsets`); passes/tests/wgsl.rs
+// entry point as a prefix (`scan_sort_offsets`); passes/tests/wgsl_bindings.rs
 // accepts `<entry>_<binding>` names for that reason.
 @group(0) @binding(1) var<storage, read> sort_bins: array<u32>;
 @group(0) @binding(2) var<storage, read_write> scan_sort_offsets: array<u32>;

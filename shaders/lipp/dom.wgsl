@@ -7,7 +7,7 @@
 //   #define LIGHTS_BINDING 3
 //   #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 // Each pass numbers its bindings in the order of its definition's
-// bindings() (passes/tests/wgsl.rs checks it), so the importing shader
+// bindings() (passes/tests/wgsl_bindings.rs checks it), so the importing shader
 // says where these three sit with the defines above.
 // naga_oil renames every token that spells an imported name, struct members
 // included: an importer must not use these names for anything else (or

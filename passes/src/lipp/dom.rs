@@ -24,6 +24,7 @@
 
 use super::assemble::{Assembly, assemble};
 use super::strand::ControlPoint;
+use super::walk::Dda;
 use super::{
     BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, cross, dot,
     frame, normalize, scale, sub,
@@ -218,40 +219,25 @@ pub fn light_frames(ctx: &Ctx<'_>, res: u32, maps: usize) -> Vec<LightFrame> {
 }
 
 /// A conservative DDA walk over the texels segment (a, b) crosses (pixel
-/// coordinates, depth), the conservative half of `lipp.raster`'s walk;
-/// `visit(x, y, depth)`.
+/// coordinates, depth), the conservative half of `lipp.raster`'s walk
+/// ([`Dda`]), clipped to the map; `visit(x, y, depth)` with the depth at the
+/// middle of the segment's part in the column.
 pub fn walk(a: [f32; 3], b: [f32; 3], res: u32, visit: &mut dyn FnMut(u32, u32, f32)) {
-    let x_major = (b[0] - a[0]).abs() >= (b[1] - a[1]).abs();
-    let (ma, na, mb, nb) = if x_major {
-        (a[0], a[1], b[0], b[1])
-    } else {
-        (a[1], a[0], b[1], b[0])
-    };
-    let (dm, dn) = (mb - ma, nb - na);
+    let dda = Dda::new([a[0], a[1]], [b[0], b[1]]);
     let limit = res as f32;
-    let lo = ma.min(mb).max(0.0).floor();
-    let hi = ma.max(mb).min(limit - 1.0).floor();
-    let mut col = lo;
-    while col <= hi {
-        let (t0, t1) = if dm != 0.0 {
-            let ta = ((col - ma) / dm).clamp(0.0, 1.0);
-            let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
-            (ta.min(tb), ta.max(tb))
-        } else {
-            (0.0, 1.0)
-        };
-        let (n0, n1) = (na + dn * t0, na + dn * t1);
-        let (r0, r1) = (n0.min(n1).floor(), n0.max(n1).floor());
+    dda.columns(limit, |col, t0, t1| {
+        let (r0, r1) = dda.rows(t0, t1);
         let tm = 0.5 * (t0 + t1);
         let z = a[2] + (b[2] - a[2]) * tm;
+        // Rows as floats, clipped to the map, as `dom_segment_depth` in
+        // shaders/lipp/raster.wgsl walks them.
         let mut row = r0.max(0.0);
         while row <= r1.min(limit - 1.0) {
-            let (x, y) = if x_major { (col, row) } else { (row, col) };
+            let (x, y) = dda.pixel(col, row);
             visit(x as u32, y as u32, z);
             row += 1.0;
         }
-        col += 1.0;
-    }
+    });
 }
 
 fn snap(v: f32) -> f32 {
@@ -265,66 +251,84 @@ pub enum Stage {
     Opacity,
 }
 
-pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = PassKind {
-    kind: "lipp.dom_depth",
-    summary: "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
-    source: "Lipp §3.4; Yuksel and Keyser 2008",
-    bindings: Some(&[
-        Binding::read("frame"),
-        Binding::read("raster_args"),
-        Binding::read("bundle_lod"),
-        Binding::read("hairmesh.bundles"),
-        Binding::read("hairmesh.layers"),
-        Binding::read("models"),
-        Binding::read("lights"),
-        Binding::atomic("dom_depth"),
-    ]),
-    workgroup_size: RASTER_GROUP,
-    dispatch: DOM_DISPATCH,
-    shader: Shader::compute("lipp/raster.wgsl", "dom_depth_pass"),
-    kernel: |p| {
-        Box::new(DomKernel {
-            stage: Stage::Depth,
-            p: *p,
-        })
-    },
-    gpu: |p, q| p.uniform(q),
-    raster: None,
-};
+/// A stage's bindings: what both stages read (the drawn strands, and the
+/// models and lights the light views are fitted to), then the stage's maps.
+macro_rules! dom_bindings {
+    ($($map:expr),+ $(,)?) => {
+        &[
+            Binding::read("frame"),
+            Binding::read("raster_args"),
+            Binding::read("bundle_lod"),
+            Binding::read("hairmesh.bundles"),
+            Binding::read("hairmesh.layers"),
+            Binding::read("models"),
+            Binding::read("lights"),
+            $($map),+
+        ]
+    };
+}
 
-pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = PassKind {
-    kind: "lipp.dom_opacity",
-    summary: "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
-    source: "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
-    bindings: Some(&[
-        Binding::read("frame"),
-        Binding::read("raster_args"),
-        Binding::read("bundle_lod"),
-        Binding::read("hairmesh.bundles"),
-        Binding::read("hairmesh.layers"),
-        Binding::read("models"),
-        Binding::read("lights"),
-        Binding::read("dom_depth"),
-        Binding::atomic("dom_layers"),
-    ]),
-    workgroup_size: RASTER_GROUP,
-    dispatch: DOM_DISPATCH,
-    shader: Shader::compute("lipp/raster.wgsl", "dom_opacity_pass"),
-    kernel: |p| {
-        Box::new(DomKernel {
-            stage: Stage::Opacity,
-            p: *p,
-        })
-    },
-    gpu: |p, q| p.uniform(q),
-    raster: None,
-};
+pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = dom_pass(
+    Stage::Depth,
+    "lipp.dom_depth",
+    "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
+    "Lipp §3.4; Yuksel and Keyser 2008",
+    dom_bindings!(Binding::atomic("dom_depth")),
+);
 
-/// One workgroup per drawn strand, as the main view's rasterizer.
-const DOM_DISPATCH: Dispatch = Dispatch::Indirect {
-    binding: "raster_args",
-    word: 0,
-};
+pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = dom_pass(
+    Stage::Opacity,
+    "lipp.dom_opacity",
+    "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
+    "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
+    dom_bindings!(Binding::read("dom_depth"), Binding::atomic("dom_layers")),
+);
+
+/// A stage's declaration. The two stages differ only in their name, maps,
+/// entry point and kernel stage: both walk the drawn strands in each
+/// light's view with one workgroup per drawn strand, as the main view's
+/// rasterizer, configured by the same parameter block.
+const fn dom_pass(
+    stage: Stage,
+    kind: &'static str,
+    summary: &'static str,
+    source: &'static str,
+    bindings: &'static [Binding],
+) -> PassKind<DomParams, DomGpu> {
+    PassKind {
+        kind,
+        summary,
+        source,
+        bindings: Some(bindings),
+        workgroup_size: RASTER_GROUP,
+        dispatch: Dispatch::Indirect {
+            binding: "raster_args",
+            word: 0,
+        },
+        shader: Shader::compute("lipp/raster.wgsl", stage.entry()),
+        kernel: stage.kernel(),
+        gpu: |p, q| p.uniform(q),
+        raster: None,
+    }
+}
+
+impl Stage {
+    /// The stage's entry point in shaders/lipp/raster.wgsl.
+    const fn entry(self) -> &'static str {
+        match self {
+            Stage::Depth => "dom_depth_pass",
+            Stage::Opacity => "dom_opacity_pass",
+        }
+    }
+
+    /// The stage's CPU kernel, configured by checked parameters.
+    const fn kernel(self) -> fn(&DomParams) -> Box<dyn CpuKernel> {
+        match self {
+            Stage::Depth => |p| DomKernel::boxed(Stage::Depth, p),
+            Stage::Opacity => |p| DomKernel::boxed(Stage::Opacity, p),
+        }
+    }
+}
 
 struct DomKernel {
     stage: Stage,
@@ -332,6 +336,10 @@ struct DomKernel {
 }
 
 impl DomKernel {
+    fn boxed(stage: Stage, p: &DomParams) -> Box<dyn CpuKernel> {
+        Box::new(DomKernel { stage, p: *p })
+    }
+
     /// One texel (x, y) of light `l`'s maps at normalised depth `z`.
     fn visit(
         &self,

@@ -19,6 +19,7 @@ pub mod raster;
 pub mod shade;
 pub mod strand;
 pub mod upload;
+pub mod walk;
 
 use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, read};

@@ -21,7 +21,7 @@
 //! §3.1: every lane recomputes its neighbours instead of shuffling.
 //!
 //! Rasterization: each segment is projected, snapped to a 1/256-pixel grid
-//! (DESIGN.md, "Determinism") and walked column by column along its major
+//! (docs/architecture.md) and walked column by column along its major
 //! axis (a DDA). The conservative layer receives every pixel the segment
 //! crosses; the centre layer only pixels whose centre is within
 //! `centre_diameter / 2` of the line. Depth is tested against `scene.depth`
@@ -41,6 +41,7 @@
 use super::assemble::{Assembly, assemble};
 use super::payload::{Sample, pack};
 use super::strand::{ControlPoint, strand_uv};
+use super::walk::Dda;
 use super::{
     BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, frame, mix,
     normalize, transform,
@@ -269,36 +270,15 @@ impl Target<'_> {
             self.segment_msaa(a, b, self.params.msaa, layers);
             return;
         }
-        let x_major = (b.x - a.x).abs() >= (b.y - a.y).abs();
-        // (major, minor) coordinates.
-        let (ma, na, mb, nb) = if x_major {
-            (a.x, a.y, b.x, b.y)
-        } else {
-            (a.y, a.x, b.y, b.x)
-        };
-        let (dm, dn) = (mb - ma, nb - na);
-        let limit = if x_major { self.width } else { self.height } as f32;
-        let lo = ma.min(mb).max(0.0).floor();
-        let hi = ma.max(mb).min(limit - 1.0).floor();
-        if lo > hi && dm != 0.0 {
-            return;
-        }
+        let dda = Dda::new([a.x, a.y], [b.x, b.y]);
+        let Dda {
+            ma, na, mb, dm, dn, ..
+        } = dda;
         let half = self.params.centre_diameter * 0.5;
         // |cos| of the angle between the line and the major axis.
         let len = (dm * dm + dn * dn).sqrt();
         let cos = if len > 0.0 { dm.abs() / len } else { 1.0 };
-        let pixel = |m: i32, n: i32| if x_major { (m, n) } else { (n, m) };
-        let mut col = lo;
-        while col <= hi {
-            let ci = col as i32;
-            // The segment's t range inside this column.
-            let (t0, t1) = if dm != 0.0 {
-                let ta = ((col - ma) / dm).clamp(0.0, 1.0);
-                let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
-                (ta.min(tb), ta.max(tb))
-            } else {
-                (0.0, 1.0)
-            };
+        dda.columns(dda.limit(self.width, self.height), |col, t0, t1| {
             // Centre layer: the column centre within the segment (half-open,
             // so shared ends are drawn once), rows whose centre is near the line.
             let centre = col + 0.5;
@@ -308,23 +288,17 @@ impl Target<'_> {
                 let r = (n - 0.5).floor() as i32;
                 for row in [r, r + 1] {
                     if ((n - (row as f32 + 0.5)) * cos).abs() <= half {
-                        let (x, y) = pixel(ci, row);
+                        let (x, y) = dda.pixel(col as i32, row);
                         self.write(a, b, t, x, y, 0);
                     }
                 }
             }
             // Conservative layer: every row the segment touches in the column.
             if self.params.conservative_layer {
-                let (n0, n1) = (na + dn * t0, na + dn * t1);
-                let (r0, r1) = (n0.min(n1).floor() as i32, n0.max(n1).floor() as i32);
                 let tm = 0.5 * (t0 + t1);
-                for row in r0..=r1 {
-                    let (x, y) = pixel(ci, row);
-                    self.write(a, b, tm, x, y, 1);
-                }
+                dda.column_pixels(col, t0, t1, |x, y| self.write(a, b, tm, x, y, 1));
             }
-            col += 1.0;
-        }
+        });
     }
 }
 
@@ -351,37 +325,13 @@ pub fn sample_positions(n: u32) -> Vec<[f32; 2]> {
         .collect()
 }
 
-/// The pixels a segment touches (the conservative walk), clipped to the screen.
+/// The pixels a segment touches (the conservative walk), the major axis
+/// clipped to the screen.
 fn walk_pixels(a: &End, b: &End, width: u32, height: u32, visit: &mut dyn FnMut(i32, i32)) {
-    let x_major = (b.x - a.x).abs() >= (b.y - a.y).abs();
-    let (ma, na, mb, nb) = if x_major {
-        (a.x, a.y, b.x, b.y)
-    } else {
-        (a.y, a.x, b.y, b.x)
-    };
-    let (dm, dn) = (mb - ma, nb - na);
-    let limit = if x_major { width } else { height } as f32;
-    let lo = ma.min(mb).max(0.0).floor();
-    let hi = ma.max(mb).min(limit - 1.0).floor();
-    let mut col = lo;
-    while col <= hi {
-        let (t0, t1) = if dm != 0.0 {
-            let ta = ((col - ma) / dm).clamp(0.0, 1.0);
-            let tb = ((col + 1.0 - ma) / dm).clamp(0.0, 1.0);
-            (ta.min(tb), ta.max(tb))
-        } else {
-            (0.0, 1.0)
-        };
-        let (n0, n1) = (na + dn * t0, na + dn * t1);
-        for row in n0.min(n1).floor() as i32..=n0.max(n1).floor() as i32 {
-            if x_major {
-                visit(col as i32, row);
-            } else {
-                visit(row, col as i32);
-            }
-        }
-        col += 1.0;
-    }
+    let dda = Dda::new([a.x, a.y], [b.x, b.y]);
+    dda.columns(dda.limit(width, height), |col, t0, t1| {
+        dda.column_pixels(col, t0, t1, &mut *visit);
+    });
 }
 
 impl CpuKernel for RasterKernel {

@@ -1,0 +1,85 @@
+//! A_p of Chiang's model averaged over the fibre offset h: the offsets
+//! where it is evaluated, their Fresnel and transmittance (pbrt-v4
+//! `HairBxDF::Ap`), the weights of the pieces between them, and the
+//! directional albedo in R and TRT that the probe term uses.
+
+use super::{Material, sigma_a};
+
+const ETA: f32 = 1.55;
+
+/// The light path at one offset h of [`H_NODES`], seen at (sin θ_o, cos θ_o):
+/// Fresnel at entry, the RGB transmittance through the fibre and sin γ_t
+/// (pbrt-v4 `HairBxDF::Ap`'s inputs and `Phi`'s refracted angle).
+pub(super) struct Offset {
+    pub(super) f: f32,
+    pub(super) tr: [f32; 3],
+    pub(super) sin_gt: f32,
+}
+
+/// The light path at each of [`H_NODES`] for a view at (sin θ_o, cos θ_o)
+/// through a fibre of absorption `sigma_a`.
+pub(super) fn offsets(sin_o: f32, cos_o: f32, sigma_a: [f32; 3]) -> [Offset; NODES] {
+    let etap = (ETA * ETA - sin_o * sin_o).sqrt() / cos_o.max(1e-4);
+    let sin_t = sin_o / ETA;
+    let cos_t = (1.0 - sin_t * sin_t).max(1e-4).sqrt();
+    H_NODES.map(|(h, _, cos_gamma_o)| {
+        let sin_gt = h / etap;
+        let cos_gt = (1.0 - sin_gt * sin_gt).max(0.0).sqrt();
+        Offset {
+            f: fresnel(cos_o * cos_gamma_o),
+            tr: sigma_a.map(|a| (-2.0 * a * cos_gt / cos_t).exp()),
+            sin_gt,
+        }
+    })
+}
+
+/// The fibre's directional albedo in R and in TRT seen at sin θ_o: pbrt-v4's
+/// `HairBxDF::Ap` for p = 0 and 2 averaged over h (M_p and N_p integrate to
+/// one, so under uniform light the lobes return exactly this), by the same
+/// offsets and pieces as [`chiang_lobes`]. `lipp.shade`'s probe term weights
+/// its single GGX lobe with it (Lipp §3.4).
+pub fn reflected_albedo(sin_o: f32, m: &Material) -> (f32, [f32; 3]) {
+    let sin_o = sin_o.clamp(-1.0, 1.0);
+    let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
+    let at = offsets(sin_o, cos_o, sigma_a(m.color, m.roughness.clamp(0.02, 1.0)));
+    let node = |j: usize| {
+        let (f, tr) = (at[j].f, at[j].tr);
+        (f, tr.map(|t| (1.0 - f) * (1.0 - f) * t * t * f))
+    };
+    let (mut r, mut trt) = (0.0f32, [0.0f32; 3]);
+    for (j, &(wa, wb)) in PIECES.iter().enumerate() {
+        let ((ra, ta), (rb, tb)) = (node(j), node(j + 1));
+        r += wa * ra + wb * rb;
+        for k in 0..3 {
+            trt[k] += wa * ta[k] + wb * tb[k];
+        }
+    }
+    (r, trt)
+}
+/// Offsets h ∈ [0, 1] (the average is symmetric in h) where Φ_p and A_p
+/// are evaluated: γ = asin h = (π/2) (j/4)^0.8, (h, γ, cos γ).
+pub(super) const NODES: usize = 5;
+pub(super) const H_NODES: [(f32, f32, f32); NODES] = [
+    (0.000000, 0.000000, 1.000000),
+    (0.495291, 0.518170, 0.868727),
+    (0.784684, 0.902186, 0.619896),
+    (0.948310, 1.247869, 0.317344),
+    (1.000000, std::f32::consts::FRAC_PI_2, 0.000000),
+];
+
+/// ∫ A dh over each piece for A linear in γ between its ends: A_j P + A_{j+1} Q.
+pub(super) const PIECES: [(f32, f32); NODES - 1] = [
+    (0.253339, 0.241951),
+    (0.152679, 0.136714),
+    (0.090546, 0.073080),
+    (0.034400, 0.017290),
+];
+
+/// Dielectric Fresnel reflectance from outside (pbrt-v4 `FrDielectric`, η = 1.55).
+pub(super) fn fresnel(cos_i: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (ETA * ETA);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let r_parl = (ETA * cos_i - cos_t) / (ETA * cos_i + cos_t);
+    let r_perp = (cos_i - ETA * cos_t) / (cos_i + ETA * cos_t);
+    0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
