@@ -5,12 +5,13 @@
 #
 #   bash benches/device.sh            # build, stage, print the call
 #
-# One process per backend: on NVIDIA's driver, creating some thirty Vulkan
-# devices in one process (wgpu's and ash's cells together) ends in
-# "vkCreateInstance: Unable to find a Vulkan driver"; each alone is fine.
+# ash and wgpu run in one process (the driver is held loaded, see
+# strandgraph_ash::keep_driver_loaded), so one bench.json holds both; copy it
+# to benches/results/h100.json and run `strandgraph tables` to carry it into
+# README.
 #
-# What travels (carry: .gl .devbin, under 64 MiB): the CLI, the criterion
-# bench binaries, the Vulkan loader and GL debs, and the baked self-shadow
+# What travels (carry: .gl .devbin, under 64 MiB): the CLI (stripped), the
+# Vulkan loader and GL debs, and the baked self-shadow
 # SH cache for the distance views' groom when it fits. Scenes, graphs and
 # shaders are in the copied working tree; the binaries find them relative to
 # the repository root, where the device tool runs commands.
@@ -28,19 +29,10 @@ fi
 grep -qx '/.devbin/' .git/info/exclude 2>/dev/null || printf '/.devbin/\n' >> .git/info/exclude
 
 cargo build --release --locked -p strandgraph --bin strandgraph
-benches=$(cargo bench --locked --no-run --message-format=json -p strandgraph 2>/dev/null |
-  python3 -c '
-import json, sys
-for line in sys.stdin:
-    m = json.loads(line)
-    if m.get("reason") == "compiler-artifact" and m.get("executable") and "bench" in m["target"]["kind"]:
-        print(m["target"]["name"], m["executable"])
-')
 rm -rf .devbin && mkdir -p .devbin
 cp target/release/strandgraph .devbin/
-while read -r name exe; do
-  [ -n "$name" ] && cp "$exe" ".devbin/$name"
-done <<<"$benches"
+# Line tables make the binary ~100 MiB; the device carries 64 MiB in all.
+strip .devbin/strandgraph
 
 # The baked SH of the views' groom, so the device does not bake it again
 # (strandgraph-bake caches by content hash under $STRANDGRAPH_CACHE).
@@ -62,5 +54,5 @@ Device-tool call (kind nvidia-h100-x1):
   carry: [".gl", ".devbin"]
   timeout_s: 600
   command:
-for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig; export XDG_RUNTIME_DIR=/tmp VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json STRANDGRAPH_CACHE=$PWD/.devbin/cache; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; for b in cpu wgpu ash; do mkdir -p $OUT/$b; timeout 180 .devbin/strandgraph bench --backend $b --frames 10 --warmup 2 --out $OUT/$b > $OUT/$b/stdout.txt 2>&1; echo "bench $b exit $?"; done; STRANDGRAPH_BENCH_SIZE=1920x1080 timeout 150 .devbin/frame --bench 'frame/(wgpu|ash)/' > $OUT/criterion_frame.txt 2>&1; cat $OUT/ash/bench.txt; grep -E '^frame/|time:' $OUT/criterion_frame.txt | tail -20
+for f in .gl/*.deb; do dpkg -x $f /; done; ldconfig; export XDG_RUNTIME_DIR=/tmp VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json STRANDGRAPH_CACHE=$PWD/.devbin/cache; nvidia-smi --query-gpu=name,driver_version --format=csv,noheader; mkdir -p $OUT/gpu; timeout 560 .devbin/strandgraph bench --backend ash,wgpu --frames 10 --warmup 2 --out $OUT/gpu > $OUT/gpu/stdout.txt 2>&1; echo "bench exit $?"; head -60 $OUT/gpu/bench.txt
 CALL
