@@ -149,9 +149,10 @@ fn tagged(path: &Path, tag: Option<&str>) -> PathBuf {
 
 /// Writes every image output: the first to `main`, the others beside it;
 /// and the view depth to `depth` (EXR) when asked.
-/// The scene depth every graph keeps (all its versions share the memory, so
-/// this reads the last one: with hair depth after `kulikov.compose`).
-const DEPTH: &str = "scene.depth";
+/// Depth images, first found wins: hair over the scene (`kulikov.compose`
+/// writes it), else the scene depth every graph keeps (all its versions
+/// share the memory, so this reads the last one).
+const DEPTHS: [&str; 2] = ["hair_depth", "scene.depth"];
 /// Per-pixel motion (kulikov.pixel_motion).
 const MOTION: &str = "pixel_motion";
 
@@ -213,17 +214,27 @@ fn write_outputs(
             .frame
             .as_ref()
             .map_or((0.02, 500.0), |f| (f.near, f.far));
-        let words = read(DEPTH)?.ok_or_else(|| {
-            miette::miette!("--depth: graph `{}` has no `{DEPTH}`", p.plan.graph.name)
+        let mut found = None;
+        for name in DEPTHS {
+            if let Some(words) = read(name)? {
+                found = Some((name, words));
+                break;
+            }
+        }
+        let (name, words) = found.ok_or_else(|| {
+            miette::miette!(
+                "--depth: graph `{}` has none of {DEPTHS:?}",
+                p.plan.graph.name
+            )
         })?;
         let img = depth_to_view(&words, near, far, q.width, q.height).ok_or_else(|| {
-            miette::miette!("--depth: `{DEPTH}` is not a screen-sized depth image")
+            miette::miette!("--depth: `{name}` is not a screen-sized depth image")
         })?;
         img.save(depth_path)
             .into_diagnostic()
             .wrap_err_with(|| format!("writing {}", depth_path.display()))?;
         println!(
-            "wrote {} (view depth in metres, from {DEPTH})",
+            "wrote {} (view depth in metres, from {name})",
             depth_path.display()
         );
     }

@@ -217,15 +217,15 @@ fn showcase_composed_matches_cpu_on_ash() {
     let c = cpu.read(&p.plan, name).unwrap();
     let a = read_ash(&session, name);
     assert_flip(&p, name, ("cpu", &c), ("ash", &a), w, h);
-    let cd = cpu.read(&p.plan, "scene.depth.hair").unwrap();
-    let ad = read_ash(&session, "scene.depth.hair");
+    let cd = cpu.read(&p.plan, "hair_depth").unwrap();
+    let ad = read_ash(&session, "hair_depth");
     let depth_close = cd
         .iter()
         .zip(&ad)
         .filter(|(x, y)| (f32::from_bits(**x) - f32::from_bits(**y)).abs() <= 1e-5)
         .count() as f64
         / cd.len().max(1) as f64;
-    eprintln!("scene.depth.hair: {:.3}% within 1e-5", depth_close * 100.0);
+    eprintln!("hair_depth: {:.3}% within 1e-5", depth_close * 100.0);
     assert!(depth_close >= 0.99, "hair depth: {depth_close}");
     session
         .run(&p.upload)

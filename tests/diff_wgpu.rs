@@ -455,8 +455,8 @@ fn showcase_composed_matches_cpu_on_wgpu() {
         d.pixels_over(MAX_PIXEL_FLIP)
     );
     // Hair depth written by fs_depth where coverage reaches the threshold.
-    let cd = cpu.read(&p.plan, "scene.depth.hair").unwrap();
-    let gd = gpu.read(&p.plan, "scene.depth.hair").unwrap().unwrap();
+    let cd = cpu.read(&p.plan, "hair_depth").unwrap();
+    let gd = gpu.read(&p.plan, "hair_depth").unwrap().unwrap();
     assert_eq!(cd.len(), gd.len());
     let depth_close = cd
         .iter()
@@ -464,7 +464,7 @@ fn showcase_composed_matches_cpu_on_wgpu() {
         .filter(|(a, b)| (f32::from_bits(**a) - f32::from_bits(**b)).abs() <= 1e-5)
         .count() as f64
         / cd.len() as f64;
-    eprintln!("scene.depth.hair: {:.3}% within 1e-5", depth_close * 100.0);
+    eprintln!("hair_depth: {:.3}% within 1e-5", depth_close * 100.0);
     if d.mean > MAX_MEAN_FLIP || d.max > MAX_PIXEL_FLIP || depth_close < 0.99 {
         let dir = out_dir();
         cpu_img.save(dir.join("composed.cpu.png")).unwrap();

@@ -204,7 +204,7 @@ fn pixel_motion_follows_the_camera_and_the_vertex_history() {
 
     session.run(&far).unwrap();
     session.run(&near).unwrap();
-    let depth = floats(&session.read(&plan, "scene.depth").unwrap());
+    let depth = floats(&session.read(&plan, "hair_depth").unwrap());
     let motion = floats(&session.read(&plan, "pixel_motion").unwrap());
     let unmoved_hair = (0..depth.len())
         .filter(|&i| depth[i] < 1.0 && motion[2 * i] == 0.0 && motion[2 * i + 1] == 0.0)
@@ -219,7 +219,7 @@ fn pixel_motion_follows_the_camera_and_the_vertex_history() {
     );
 
     session.run(&sideways).unwrap();
-    let depth = floats(&session.read(&plan, "scene.depth").unwrap());
+    let depth = floats(&session.read(&plan, "hair_depth").unwrap());
     let motion = floats(&session.read(&plan, "pixel_motion").unwrap());
     let (mut with_depth, mut agree, mut largest) = (0, 0, 0.0f32);
     for i in 0..depth.len() {

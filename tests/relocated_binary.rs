@@ -41,7 +41,18 @@ fn render(dir: &Path, exe: &Path, args: &[&str], shaders: Option<&Path>) -> Outp
     if let Some(s) = shaders {
         cmd.env("STRANDGRAPH_SHADERS", s);
     }
-    cmd.output().expect("the copied binary runs")
+    // A test on another thread may fork while `fs::copy` still holds the
+    // copy open for writing; the child inherits that descriptor and exec of
+    // the copy fails with ETXTBSY until it execs or exits. Retry briefly.
+    for _ in 0..50 {
+        match cmd.output() {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy => {
+                std::thread::sleep(std::time::Duration::from_millis(20));
+            }
+            other => return other.expect("the copied binary runs"),
+        }
+    }
+    panic!("the copied binary stayed busy (ETXTBSY) for a second")
 }
 
 /// The PNG exists at 160×90 and shows a picture: many colours, and most of

@@ -281,7 +281,7 @@ fn showcase_renders_lit_and_composited_with_its_own_graph() {
     assert!(mean > 0.03 && mean < 1.5, "mean luminance {mean}");
     assert!(bright > n / 50, "{bright} bright pixels");
     // Hair wrote depth where it is nearly opaque: far more than the head alone.
-    let depth = f.read(&p.plan, "scene.depth").unwrap();
+    let depth = f.read(&p.plan, "hair_depth").unwrap();
     let deep = depth.iter().filter(|&&d| f32::from_bits(d) < 1.0).count();
     assert!(deep > n / 6, "{deep} pixels with depth");
 }

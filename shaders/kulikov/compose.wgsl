@@ -1,13 +1,17 @@
-// kulikov.compose: a camera-facing quad per hair model over its atlas
-// tiles, drawn back to front with premultiplied blending (src One, dst
-// OneMinusSrcAlpha) over the opaque image (Kulikov, "Composition").
-// fs_main reconstructs the pixel's hair radiance and coverage from the 3
-// layers and the additive coverage (Kulikov, "Coverage reconstruction");
-// fs_depth, drawn with the same quads into scene.depth, discards where the
-// coverage is below depth_threshold and writes the front layer's depth
-// ("We write hair to depth as we render it").
-// Port of passes/src/kulikov/compose/{mod,reconstruct}.rs; the CPU kernel
-// loops over pixels and models in the order vs_main draws the quads.
+// kulikov.compose: every hair model's visibility atlas lit and blended over
+// the opaque image, back to front (Kulikov, "Composition"), as one compute
+// pass: a lane per screen pixel visits the models in back-to-front order,
+// reconstructs each model's radiance and coverage from its 3 layers and the
+// additive coverage (Kulikov, "Coverage reconstruction"), blends it
+// premultiplied over the pixel (src One, dst OneMinusSrcAlpha, as the talk's
+// per-model quads blend), and writes the front layer's depth where the
+// coverage reaches depth_threshold and is nearer ("We write hair to depth as
+// we render it").
+// Why compute rather than the talk's camera-facing quads: Hopper runs pixel
+// shaders on few of its SMs, and the quads ran the whole reconstruction twice
+// per pixel (colour, then frag_depth); here it runs once, on every SM.
+// Port of passes/src/kulikov/compose/{mod,reconstruct}.rs: the CPU kernel is
+// the same loop over pixels and models.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
 #import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
@@ -35,6 +39,15 @@ struct ComposeParams {
 @group(0) @binding(7) var<storage, read> vertex_lighting: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> groom_vertices: array<vec4<f32>>;
+@group(0) @binding(10) var scene_depth: texture_depth_2d;
+@group(0) @binding(11) var output: texture_storage_2d<rgba16float, read_write>;
+@group(0) @binding(12) var hair_depth: texture_storage_2d<r32float, write>;
+
+const GROUP: u32 = 256u;
+// Models a frame may hold (passes/src/upload.rs refuses more).
+const MAX_MODELS: u32 = 1024u;
+// Back-to-front model order, computed once per workgroup.
+var<workgroup> order: array<u32, MAX_MODELS>;
 
 const POISSON = array<vec2<f32>, 8>(
     vec2<f32>(0.0, 0.0), vec2<f32>(0.62, 0.18), vec2<f32>(-0.45, 0.55), vec2<f32>(0.12, -0.71),
@@ -48,48 +61,18 @@ fn sort_key(m: u32) -> f32 {
     return sqrt(dot(c, c)) + select(0.0, params.facial_hair_bias, (md.flags & MODEL_FACIAL_HAIR) != 0u);
 }
 
-// The model drawn at back-to-front position `rank` (farthest first; ties by index).
-fn model_at(rank: u32) -> u32 {
-    for (var m = 0u; m < frame.model_count; m++) {
-        var r = 0u;
-        let k = sort_key(m);
-        for (var o = 0u; o < frame.model_count; o++) {
-            let ko = sort_key(o);
-            if ko > k || (ko == k && o < m) {
-                r += 1u;
-            }
-        }
-        if r == rank {
-            return m;
+// compose::model_order: the back-to-front rank of model `m` (farthest
+// first; ties by index).
+fn rank_of(m: u32) -> u32 {
+    let k = sort_key(m);
+    var r = 0u;
+    for (var o = 0u; o < frame.model_count; o++) {
+        let ko = sort_key(o);
+        if ko > k || (ko == k && o < m) {
+            r += 1u;
         }
     }
-    return 0u;
-}
-
-struct QuadOut {
-    @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) model: u32,
-}
-
-// Six vertices per model: the screen rectangle of its atlas tiles.
-@vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> QuadOut {
-    var out: QuadOut;
-    let m = model_at(vi / 6u);
-    out.model = m;
-    let t = load_tiles(atlas_tiles[m]);
-    let span = f32(TILE * t.downscale);
-    let lo = vec2<f32>(f32(t.origin_x), f32(t.origin_y)) * span;
-    let hi = lo + vec2<f32>(f32(t.grid_w), f32(t.grid_h)) * span;
-    let corner = array<vec2<f32>, 6>(
-        vec2<f32>(0.0, 0.0), vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 0.0),
-        vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0), vec2<f32>(1.0, 1.0),
-    )[vi % 6u];
-    let p = mix(lo, hi, corner);
-    let ndc = vec2<f32>(p.x / frame.screen.x * 2.0 - 1.0, 1.0 - p.y / frame.screen.y * 2.0);
-    // Invalid models collapse to a degenerate quad.
-    out.position = vec4<f32>(select(vec2<f32>(2.0), ndc, t.valid != 0u), 0.0, 1.0);
-    return out;
+    return r;
 }
 
 fn f16_to_f32(h: u32) -> f32 {
@@ -215,18 +198,42 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
     return out;
 }
 
-@fragment
-fn fs_main(in: QuadOut) -> @location(0) vec4<f32> {
-    let h = compose_pixel(in.model, u32(in.position.x), u32(in.position.y));
-    return vec4<f32>(h.color, h.alpha);
-}
-
-// compose::ndc_depth of the front layer where coverage reaches the threshold.
-@fragment
-fn fs_depth(in: QuadOut) -> @builtin(frag_depth) f32 {
-    let h = compose_pixel(in.model, u32(in.position.x), u32(in.position.y));
-    if h.alpha < params.depth_threshold || h.front_w <= 0.0 {
-        discard;
+@compute @workgroup_size(256)
+fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let models_n = min(frame.model_count, MAX_MODELS);
+    for (var m = lane; m < models_n; m += GROUP) {
+        order[rank_of(m)] = m;
     }
-    return frame.far * (h.front_w - frame.near) / (h.front_w * (frame.far - frame.near));
+    workgroupBarrier();
+    let i = wg.x * GROUP + lane;
+    if i >= params.width * params.height {
+        return;
+    }
+    let x = i % params.width;
+    let y = i / params.width;
+    let scene_z = textureLoad(scene_depth, vec2<u32>(x, y), 0);
+    var z = scene_z;
+    var color = textureLoad(output, vec2<u32>(x, y));
+    var touched = false;
+    for (var r = 0u; r < models_n; r++) {
+        let m = order[r];
+        if load_tiles(atlas_tiles[m]).valid == 0u {
+            continue;
+        }
+        let h = compose_pixel(m, x, y);
+        if h.alpha <= 0.0 && h.front_w <= 0.0 {
+            continue;
+        }
+        color = vec4<f32>(h.color + (1.0 - h.alpha) * color.rgb, color.a);
+        touched = true;
+        // compose::ndc_depth of the front layer, where nearer.
+        if h.alpha >= params.depth_threshold && h.front_w > 0.0 {
+            let hz = frame.far * (h.front_w - frame.near) / (h.front_w * (frame.far - frame.near));
+            z = min(z, hz);
+        }
+    }
+    if touched {
+        textureStore(output, vec2<u32>(x, y), color);
+    }
+    textureStore(hair_depth, vec2<u32>(x, y), vec4<f32>(z, 0.0, 0.0, 1.0));
 }

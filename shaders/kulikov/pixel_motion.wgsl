@@ -24,7 +24,8 @@ struct PixelMotionParams {
 @group(0) @binding(7) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read> groom_vertices: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> vertex_motion: array<vec2<f32>>;
-@group(0) @binding(10) var scene_depth: texture_depth_2d;
+// Hair depth over the scene's (NDC, R32Float), written by kulikov.compose.
+@group(0) @binding(10) var hair_depth: texture_2d<f32>;
 @group(0) @binding(11) var<storage, read_write> pixel_motion: array<vec2<f32>>;
 
 const GROUP: u32 = 64u;
@@ -109,7 +110,7 @@ fn resolve_motion(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocatio
     }
     let x = i % params.width;
     let y = i / params.width;
-    let z = textureLoad(scene_depth, vec2<u32>(x, y), 0);
+    let z = textureLoad(hair_depth, vec2<u32>(x, y), 0).x;
     var m = vec2<f32>(0.0);
     if z < 1.0 {
         var best = Front(false, 0.0, vec2<f32>(0.0));

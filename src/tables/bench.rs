@@ -176,6 +176,68 @@ pub fn pass_table(json: &Value, variant: &str) -> Result<String, String> {
     Ok(md)
 }
 
+/// Per-pass medians of one variant and view in two runs side by side, with
+/// the change: what an optimisation bought, pass by pass.
+pub fn delta_table(
+    before: &Value,
+    after: &Value,
+    variant: &str,
+    view: &str,
+) -> Result<String, String> {
+    let cell = |json: &Value, which: &str| -> Result<(String, Value), String> {
+        let (backend, device) = devices(json)?
+            .into_iter()
+            .next()
+            .ok_or(format!("{which}: no device"))?;
+        let c = cells(json, &backend)
+            .find(|c| label(c) == variant && c["view"] == view && c.get("skipped").is_none())
+            .ok_or(format!(
+                "{which}: no measured cell of `{variant}` at `{view}`"
+            ))?;
+        Ok((format!("{device}, {backend}"), c.clone()))
+    };
+    let ((dev_a, a), (dev_b, b)) = (cell(before, "before")?, cell(after, "after")?);
+    if dev_a != dev_b {
+        return Err(format!(
+            "before ran on {dev_a}, after on {dev_b}: not comparable"
+        ));
+    }
+    let median = |c: &Value, pass: &str| {
+        c["passes"]
+            .as_array()
+            .and_then(|l| l.iter().find(|p| p["pass"] == pass))
+            .and_then(|p| p["median_ms"].as_f64())
+    };
+    let passes = distinct(
+        [&a, &b]
+            .into_iter()
+            .flat_map(|c| c["passes"].as_array().into_iter().flatten()),
+        |p| {
+            (
+                p["pass"].as_str().unwrap_or("?").to_string(),
+                p["kind"].as_str().unwrap_or("?").to_string(),
+            )
+        },
+    );
+    let ms = |v: Option<f64>| v.map_or("–".into(), |m| format!("{m:.3}"));
+    let mut md = format!(
+        "{variant}, {view}, {dev_a}; ms, median per pass:\n\n| pass | kind | before | after | change |\n|---|---|---:|---:|---:|\n"
+    );
+    let frame = |c: &Value| c["frame"]["median_ms"].as_f64();
+    for (pass, kind, x, y) in passes
+        .iter()
+        .map(|(p, k)| (p.as_str(), format!("`{k}`"), median(&a, p), median(&b, p)))
+        .chain([("**frame**", String::new(), frame(&a), frame(&b))])
+    {
+        let change = match (x, y) {
+            (Some(x), Some(y)) if x > 0.0 => format!("{:+.0}%", 100.0 * (y - x) / x),
+            _ => "–".into(),
+        };
+        let _ = writeln!(md, "| {pass} | {kind} | {} | {} | {change} |", ms(x), ms(y));
+    }
+    Ok(md)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,6 +264,25 @@ mod tests {
         assert!(md.contains("| L: all | skipped |"), "{md}");
         assert!(md.contains("50.0 G atomicMin/s 32-bit"), "{md}");
         assert!(frame_table(&Value::Null).is_err());
+    }
+
+    #[test]
+    fn delta_table_shows_both_runs_and_the_change() {
+        let mut after = sample();
+        after["cells"][0]["passes"][0]["median_ms"] = serde_json::json!(0.625);
+        after["cells"][0]["frame"]["median_ms"] = serde_json::json!(1.875);
+        let md = delta_table(&sample(), &after, "K: all", "close").unwrap();
+        assert!(
+            md.contains("| raster | `k.raster` | 1.250 | 0.625 | -50% |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| **frame** |  | 2.500 | 1.875 | -25% |"),
+            "{md}"
+        );
+        let mut other = after.clone();
+        other["devices"][0]["device"] = serde_json::json!("another GPU");
+        assert!(delta_table(&sample(), &other, "K: all", "close").is_err());
     }
 
     #[test]

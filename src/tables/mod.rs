@@ -16,7 +16,9 @@
 //! - `agree FILE.json...`: per-pass agreement ([`crate::agree::summary`]);
 //! - `bench FILE.json`: frame medians per pipeline variant and view;
 //! - `bench-passes FILE.json VARIANT`: one variant's per-pass medians per
-//!   view (`_` in VARIANT stands for a space: `Kulikov:_all_optimisations`).
+//!   view (`_` in VARIANT stands for a space: `Kulikov:_all_optimisations`);
+//! - `bench-delta BEFORE.json AFTER.json VARIANT VIEW`: one cell's per-pass
+//!   medians in two runs of the same device, and the change.
 
 pub mod bench;
 
@@ -105,8 +107,14 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
             bench::pass_table(&read(file)?, &variant.replace('_', " "))
                 .map_err(|e| format!("{file}: {e}"))
         }
+        [kind, before, after, variant, view] if kind == "bench-delta" => bench::delta_table(
+            &read(before)?,
+            &read(after)?,
+            &variant.replace('_', " "),
+            view,
+        ),
         _ => Err(format!(
-            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-passes FILE.json VARIANT)",
+            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-passes FILE.json VARIANT, bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
             command.join(" ")
         )),
     }

@@ -15,9 +15,10 @@
 //! - background, and every pixel of the first frame: zero.
 //!
 //! `pixel_motion` holds two f32 per pixel: this frame's position minus last
-//! frame's, in pixels, y down (as `vertex_motion`). It runs on the final
-//! depth, so it is a separate pass rather than a third composition draw:
-//! the GPU composition is a blend pipeline with one colour target.
+//! frame's, in pixels, y down (as `vertex_motion`). It reads the final hair
+//! depth (`hair_depth`, written by `kulikov.compose`), so it runs after
+//! composition; folding it into the composition pass, as the talk does, is
+//! still to do.
 //!
 //! Deviation: composition samples downscaled tiles with a Poisson jitter;
 //! motion takes the pixel's own texel (a jittered sample's segment would
@@ -66,7 +67,7 @@ pub static PIXEL_MOTION: PassKind<NoParams, PixelMotionGpu> = PassKind {
         Binding::read("clip_positions"),
         Binding::read("groom.vertices"),
         Binding::read("vertex_motion"),
-        Binding::read("scene.depth"),
+        Binding::read("hair_depth"),
         Binding::write("pixel_motion"),
     ]),
     workgroup_size: GROUP,
@@ -115,7 +116,7 @@ impl CpuKernel for PixelMotionKernel {
         let (vis, motion, depth, out) = (
             ctx.words("vis_atlas"),
             ctx.words("vertex_motion"),
-            ctx.words("scene.depth"),
+            ctx.words("hair_depth"),
             ctx.words("pixel_motion"),
         );
         let stride = vis.len() / LAYERS;

@@ -3,11 +3,14 @@
 //!
 //! Kulikov, "Composition": "Sort back to front. Camera-facing quad for each
 //! hair piece ... Output lighting, depth and motion" and "Coverage
-//! reconstruction" ([`reconstruct`]). On the GPU this is a quad per model
-//! with premultiplied blending (`shaders/kulikov/compose.wgsl`); on the CPU
-//! it is one lane per screen pixel that visits the models in the same order
-//! and writes the `output` and `scene.depth` words directly, as
-//! `scene.opaque` does.
+//! reconstruction" ([`reconstruct`]). The talk draws a quad per model with
+//! premultiplied blending; here one compute lane per screen pixel visits the
+//! models in the same back-to-front order and blends the same way, on the
+//! GPU (`shaders/kulikov/compose.wgsl`) as on the CPU: Hopper runs pixel
+//! shaders on few of its SMs, and the quads ran the reconstruction twice per
+//! pixel (colour, then depth). Hair depth goes to the `hair_depth` image
+//! (R32Float, NDC: the scene's depth where no hair is nearer), since compute
+//! cannot write a depth attachment.
 //!
 //! Per pixel and model (parameters in brackets):
 //! - the atlas texel, jittered by a fixed Poisson-disk pattern hashed by
@@ -25,7 +28,7 @@
 //!   from `vertex_lighting` at the pixel centre's projection;
 //! - [`reconstruct`] [`reconstruct_missing`: false uses the 3 front layers only];
 //! - hair depth (the front layer's) where the result's coverage reaches
-//!   [`depth_threshold`] and is nearer than `scene.depth`.
+//!   [`depth_threshold`] and is nearer than `scene.depth`, into `hair_depth`.
 //!
 //! Models sort by the view depth of their bounds' centre; facial hair is
 //! pushed back by [`facial_hair_bias`] metres so it composes before the
@@ -47,7 +50,6 @@ use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
 use crate::layout::MODEL_FACIAL_HAIR;
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use reconstruct::{Layer, reconstruct};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
@@ -163,7 +165,7 @@ crate::gpu_block! {
 
 pub static COMPOSE: PassKind<ComposeParams, ComposeGpu> = PassKind {
     kind: "kulikov.compose",
-    summary: "per-model quad, back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion: kulikov.pixel_motion)",
+    summary: "per pixel, models back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion: kulikov.pixel_motion)",
     source: "Kulikov 2025, 'Composition', 'Motion vectors'",
     bindings: Some(&[
         Binding::read("frame"),
@@ -175,53 +177,21 @@ pub static COMPOSE: PassKind<ComposeParams, ComposeGpu> = PassKind {
         Binding::read("vertex_lighting"),
         Binding::read("clip_positions"),
         Binding::read("groom.vertices"),
-        // Attachments (GPU): blended colour, hair depth.
+        Binding::read("scene.depth"),
+        // Blended in place (read_write storage image).
         Binding::write("output"),
-        Binding::write("scene.depth"),
+        Binding::write("hair_depth"),
     ]),
     workgroup_size: GROUP,
     dispatch: Dispatch::PerElement {
         quantity: Quantity::Pixels,
         per_group: GROUP,
     },
-    shader: Shader {
-        file: "kulikov/compose.wgsl",
-        entry: "vs_main",
-        fragment: Some("fs_main"),
-    },
+    shader: Shader::compute("kulikov/compose.wgsl", "compose"),
     kernel: |p| Box::new(ComposeKernel(*p)),
     gpu: |p, q| p.uniform(q),
-    raster: Some(draw),
+    raster: None,
 };
-
-/// shaders/kulikov/compose.wgsl (header): six vertices per model, drawn
-/// back to front with premultiplied blending over the loaded colour;
-/// then `fs_depth` with the same quads writes hair depth into the
-/// loaded `scene.depth` where nearer (the CPU kernel's `z < depth`).
-fn draw(_: &ComposeParams, q: &Quantities) -> RasterState {
-    RasterState {
-        vertices: q.models * 6,
-        cull_back_faces: false,
-        color_load: ColorLoad::Load,
-        depth_load: DepthLoad::Load,
-        draws: vec![
-            Draw {
-                fragment: "fs_main",
-                blend: Blend::PremultipliedOverKeepAlpha,
-                color_writes: true,
-                depth_compare: Compare::Always,
-                depth_write: false,
-            },
-            Draw {
-                fragment: "fs_depth",
-                blend: Blend::Replace,
-                color_writes: false,
-                depth_compare: Compare::Less,
-                depth_write: true,
-            },
-        ],
-    }
-}
 
 /// Back-to-front model order: farthest (bias included) first.
 pub fn model_order(scene: &Scene, facial_hair_bias: f32) -> Vec<usize> {
@@ -344,16 +314,18 @@ impl CpuKernel for ComposeKernel {
                 _w: std::marker::PhantomData,
             })
             .collect();
-        let (cov, out, depth): (Words<'_>, Words<'_>, Words<'_>) = (
+        let (cov, out, depth, hair_depth): (Words<'_>, Words<'_>, Words<'_>, Words<'_>) = (
             ctx.words("coverage_atlas"),
             ctx.words("output"),
             ctx.words("scene.depth"),
+            ctx.words("hair_depth"),
         );
         let (near, far) = (scene.frame.near, scene.frame.far);
         let mut tally = CounterValues::default();
         for i in group * GROUP..((group + 1) * GROUP).min(pixels) {
             let (x, y) = (i % width, i / width);
             let mut color = load_rgba16f(&out, i as usize);
+            let mut z_out = depth.load_f32(i as usize);
             let mut touched = false;
             for md in &models {
                 let d = md.tiles.downscale;
@@ -390,11 +362,12 @@ impl CpuKernel for ComposeKernel {
                     && let Some((_, w)) = layers.first()
                 {
                     let z = ndc_depth(*w, near, far);
-                    if z < depth.load_f32(i as usize) {
-                        depth.store_f32(i as usize, z);
+                    if z < z_out {
+                        z_out = z;
                     }
                 }
             }
+            hair_depth.store_f32(i as usize, z_out);
             if touched {
                 store_rgba16f(&out, i as usize, color);
                 tally.pixels_written += 1;
