@@ -67,6 +67,14 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    Variant {
+        pipeline: "Kulikov",
+        name: "clipped coverage",
+        graph: KULIKOV,
+        overrides: &["raster.analytic_coverage=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
     // Ours, not the talk's: each compose workgroup skips models whose tiles
     // cannot reach its pixels (passes/src/kulikov/compose/mod.rs).
     Variant {
