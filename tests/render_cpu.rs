@@ -324,3 +324,28 @@ fn hair_shadows_the_head_where_hair_lies_between_it_and_the_light() {
     let mask = f.read(&off, "skin_shadow").unwrap();
     assert!(mask.iter().all(|&m| m == u32::MAX));
 }
+
+/// `compose.workgroup_cull` (ours) only skips models no pixel of a
+/// workgroup can sample: the crowd composes to the same words without it.
+#[test]
+fn compose_workgroup_cull_changes_no_pixel() {
+    let frame = |cull: &str| {
+        let params = [
+            "shade.self_shadow=\"VoxelMarch\"".to_string(),
+            format!("compose.workgroup_cull={cull}"),
+        ];
+        let p = strandgraph::frame::prepare_with(
+            &root().join("scenes/crowd.ron"),
+            None,
+            Some((320, 180)),
+            &params,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+        let f = run(&p, &CpuBackend::default());
+        let words = |name: &str| f.read(&p.plan, name).unwrap();
+        (words("output.composed"), words("hair_depth"))
+    };
+    let (culled, all) = (frame("true"), frame("false"));
+    assert!(culled.0 == all.0, "composed colour differs");
+    assert!(culled.1 == all.1, "hair depth differs");
+}

@@ -27,6 +27,8 @@ struct ComposeParams {
     facial_hair_bias: f32,
     width: u32,
     height: u32,
+    // Skip, per workgroup, models whose tiles cannot reach its pixels.
+    workgroup_cull: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ComposeParams;
@@ -46,8 +48,46 @@ struct ComposeParams {
 const GROUP: u32 = 256u;
 // Models a frame may hold (passes/src/upload.rs refuses more).
 const MAX_MODELS: u32 = 1024u;
-// Back-to-front model order, computed once per workgroup.
+// Back-to-front model order, computed once per workgroup, and per rank
+// whether that model's tiles can reach the workgroup's pixels.
 var<workgroup> order: array<u32, MAX_MODELS>;
+var<workgroup> reaches: array<u32, MAX_MODELS>;
+
+// compose::Span: the screen rectangle of a workgroup's pixels.
+struct Span {
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+}
+
+fn group_span(group: u32) -> Span {
+    let last = params.width * params.height - 1u;
+    let i0 = min(group * GROUP, last);
+    let i1 = min(i0 + GROUP - 1u, last);
+    let y0 = i0 / params.width;
+    let y1 = i1 / params.width;
+    if y0 == y1 {
+        return Span(i0 % params.width, y0, i1 % params.width, y1);
+    }
+    return Span(0u, y0, params.width - 1u, y1);
+}
+
+// compose::reaches: whether any pixel of `s` can sample model `m`'s tiles,
+// its Poisson jitter (at most half the downscale) included.
+fn model_reaches(m: u32, s: Span) -> bool {
+    let t = load_tiles(atlas_tiles[m]);
+    if t.valid == 0u {
+        return false;
+    }
+    let span = TILE * t.downscale;
+    let margin = t.downscale / 2u + 1u;
+    let lo_x = t.origin_x * span;
+    let lo_y = t.origin_y * span;
+    let hi_x = (t.origin_x + t.grid_w) * span;
+    let hi_y = (t.origin_y + t.grid_h) * span;
+    return s.x1 + margin >= lo_x && s.x0 < hi_x + margin && s.y1 + margin >= lo_y && s.y0 < hi_y + margin;
+}
 
 const POISSON = array<vec2<f32>, 8>(
     vec2<f32>(0.0, 0.0), vec2<f32>(0.62, 0.18), vec2<f32>(-0.45, 0.55), vec2<f32>(0.12, -0.71),
@@ -201,8 +241,11 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
 @compute @workgroup_size(256)
 fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let models_n = min(frame.model_count, MAX_MODELS);
+    let span = group_span(wg.x);
     for (var m = lane; m < models_n; m += GROUP) {
-        order[rank_of(m)] = m;
+        let r = rank_of(m);
+        order[r] = m;
+        reaches[r] = select(1u, u32(model_reaches(m, span)), params.workgroup_cull != 0u);
     }
     workgroupBarrier();
     let i = wg.x * GROUP + lane;
@@ -217,7 +260,7 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     var touched = false;
     for (var r = 0u; r < models_n; r++) {
         let m = order[r];
-        if load_tiles(atlas_tiles[m]).valid == 0u {
+        if reaches[r] == 0u || load_tiles(atlas_tiles[m]).valid == 0u {
             continue;
         }
         let h = compose_pixel(m, x, y);

@@ -34,7 +34,7 @@
 #define LOD_MODELS_BINDING 4
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::layout::{ModelLod, ModelTiles}
-#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, trapezoid_depth_at, morton_code}
+#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, quad_pixel_coverage, trapezoid_depth_at, morton_code}
 
 struct RasterParams {
     loop_flattening: u32,
@@ -42,6 +42,8 @@ struct RasterParams {
     depth_test_stack: u32,
     last_layer_cull: u32,
     morton_sort: u32,
+    // Kulikov's analytic slice coverage (registers) rather than clipping.
+    analytic_coverage: u32,
     // Scene quantities: screen size in pixels.
     width: u32,
     height: u32,
@@ -357,6 +359,16 @@ fn morton_sort(seg_in: Segment, index: u32, first: u32) -> Segment {
 }
 
 // A pixel is written when its coverage quantises to at least 1/1024: slivers
+// RasterKernel's Cursor::pixel: the trapezoid's area in pixel (x, y) of the
+// open column, from its edges in registers (the talk's analytic coverage)
+// or by clipping the column slice.
+fn pixel_coverage(seg: Segment, col: Poly, x: i32, y: i32) -> f32 {
+    if params.analytic_coverage != 0u {
+        return quad_pixel_coverage(seg.trap.quad, x, y);
+    }
+    return column_coverage(col, y);
+}
+
 // thinner than that are float noise that backends need not agree on.
 // round_away, as the CPU kernel's f32::round: WGSL's round() sends exactly
 // half a step (a common coverage on the snapped grid) to 0, and dropped those
@@ -434,7 +446,7 @@ fn raster(
             var has = false;
             var req: Request;
             if alive {
-                let coverage = column_coverage(col, y);
+                let coverage = pixel_coverage(seg, col, x, y);
                 if covers(coverage) {
                     has = true;
                     req = pixel_request(seg, x, y, coverage);
@@ -485,7 +497,7 @@ fn raster(
                 var has = false;
                 var req: Request;
                 if busy {
-                    let coverage = column_coverage(col, y);
+                    let coverage = pixel_coverage(seg, col, x, y);
                     if covers(coverage) {
                         has = true;
                         req = pixel_request(seg, x, y, coverage);

@@ -67,6 +67,24 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    Variant {
+        pipeline: "Kulikov",
+        name: "clipped coverage",
+        graph: KULIKOV,
+        overrides: &["raster.analytic_coverage=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    // Ours, not the talk's: each compose workgroup skips models whose tiles
+    // cannot reach its pixels (passes/src/kulikov/compose/mod.rs).
+    Variant {
+        pipeline: "Kulikov",
+        name: "no compose workgroup cull",
+        graph: KULIKOV,
+        overrides: &["compose.workgroup_cull=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
     // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`

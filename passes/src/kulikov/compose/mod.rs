@@ -97,6 +97,9 @@ pub struct ComposeParams {
     pub reconstruct_missing: bool,
     pub depth_threshold: f32,
     pub facial_hair_bias: f32,
+    /// Ours: each workgroup first drops the models whose tiles cannot reach
+    /// its pixels ([`reaches`]), so a pixel visits only nearby models.
+    pub workgroup_cull: bool,
 }
 
 impl Default for ComposeParams {
@@ -108,6 +111,7 @@ impl Default for ComposeParams {
             reconstruct_missing: true,
             depth_threshold: 0.75,
             facial_hair_bias: 0.5,
+            workgroup_cull: true,
         }
     }
 }
@@ -143,6 +147,7 @@ impl ComposeParams {
             facial_hair_bias: self.facial_hair_bias,
             width: q.width,
             height: q.height,
+            workgroup_cull: flag(self.workgroup_cull),
         }
     }
 }
@@ -160,6 +165,7 @@ crate::gpu_block! {
         facial_hair_bias: f32,
         width: u32,
         height: u32,
+        workgroup_cull: u32,
     }
 }
 
@@ -228,6 +234,59 @@ pub fn pixel_hash(x: u32, y: u32) -> u32 {
 /// NDC depth of view depth `w` under `perspective_rh` (inverse of `linear_depth`).
 pub fn ndc_depth(w: f32, near: f32, far: f32) -> f32 {
     far * (w - near) / (w * (far - near))
+}
+
+/// Where pixel `(x, y)` samples a model's atlas downscaled `d` times: a
+/// Poisson-disk jitter of up to half the downscale, hashed by pixel.
+pub fn sample_at(
+    x: u32,
+    y: u32,
+    d: u32,
+    poisson_samples: u32,
+    width: u32,
+    height: u32,
+) -> (u32, u32) {
+    if d <= 1 || poisson_samples == 0 {
+        return (x, y);
+    }
+    let k = pixel_hash(x, y) % poisson_samples;
+    let r = 0.5 * d as f32;
+    let [jx, jy] = POISSON[k as usize];
+    (
+        (x as f32 + 0.5 + jx * r).clamp(0.0, width as f32 - 1.0) as u32,
+        (y as f32 + 0.5 + jy * r).clamp(0.0, height as f32 - 1.0) as u32,
+    )
+}
+
+/// The screen rectangle of workgroup `group`'s pixels (a lane per pixel,
+/// row-major), inclusive.
+pub fn group_span(group: u32, width: u32, height: u32) -> [u32; 4] {
+    let last = width * height - 1;
+    let i0 = (group * GROUP).min(last);
+    let i1 = (i0 + GROUP - 1).min(last);
+    let (y0, y1) = (i0 / width, i1 / width);
+    if y0 == y1 {
+        [i0 % width, y0, i1 % width, y1]
+    } else {
+        [0, y0, width - 1, y1]
+    }
+}
+
+/// Whether any pixel of `span` can sample `t`'s tiles: their screen
+/// rectangle grown by the Poisson jitter (under half the downscale).
+pub fn reaches(t: &ModelTiles, span: [u32; 4]) -> bool {
+    if t.valid == 0 {
+        return false;
+    }
+    let d = t.downscale.max(1);
+    let (edge, margin) = (TILE * d, d / 2 + 1);
+    let (lo_x, lo_y) = (t.origin_x * edge, t.origin_y * edge);
+    let (hi_x, hi_y) = (
+        (t.origin_x + t.grid_w) * edge,
+        (t.origin_y + t.grid_h) * edge,
+    );
+    let [x0, y0, x1, y1] = span;
+    x1 + margin >= lo_x && x0 < hi_x + margin && y1 + margin >= lo_y && y0 < hi_y + margin
 }
 
 struct ComposeKernel(ComposeParams);
@@ -304,9 +363,11 @@ impl CpuKernel for ComposeKernel {
         let pixels = ctx.quantities.count(Quantity::Pixels) as u32;
         let lods = scene.lods(ctx);
         let tiles = scene.tiles(ctx);
+        let span = group_span(group, width, height);
         let models: Vec<Model<'_>> = model_order(&scene, self.0.facial_hair_bias)
             .into_iter()
             .filter(|&m| tiles[m].valid != 0)
+            .filter(|&m| !self.0.workgroup_cull || reaches(&tiles[m], span))
             .map(|m| Model {
                 tiles: tiles[m],
                 seg_first: scene.models[m].segment_first,
@@ -329,14 +390,7 @@ impl CpuKernel for ComposeKernel {
             let mut touched = false;
             for md in &models {
                 let d = md.tiles.downscale;
-                let (mut sx, mut sy) = (x, y);
-                if d > 1 && self.0.poisson_samples > 0 {
-                    let k = pixel_hash(x, y) % self.0.poisson_samples;
-                    let r = 0.5 * d as f32;
-                    let [jx, jy] = POISSON[k as usize];
-                    sx = (x as f32 + 0.5 + jx * r).clamp(0.0, width as f32 - 1.0) as u32;
-                    sy = (y as f32 + 0.5 + jy * r).clamp(0.0, height as f32 - 1.0) as u32;
-                }
+                let (sx, sy) = sample_at(x, y, d, self.0.poisson_samples, width, height);
                 let Some(texel) = md.tiles.texel(sx, sy) else {
                     continue;
                 };

@@ -131,3 +131,48 @@ fn facial_hair_composes_before_the_main_hair() {
             < 1e-5
     );
 }
+
+/// The workgroup cull drops a model only where no pixel of the workgroup
+/// can sample its tiles, jitter included: every (tiles, workgroup) pair
+/// where some pixel's sample lands in the tiles is kept.
+#[test]
+fn workgroup_cull_keeps_every_model_a_pixel_can_sample() {
+    use super::{GROUP, group_span, reaches, sample_at};
+    use crate::kulikov::tile_alloc::ModelTiles;
+    let (width, height) = (333u32, 190u32);
+    let mut kept_elsewhere = 0;
+    for (ox, oy, gw, gh, d) in [
+        (0, 0, 1, 1, 1),
+        (1, 1, 1, 1, 2),
+        (0, 1, 2, 1, 4),
+        (2, 0, 1, 2, 3),
+        (1, 0, 1, 1, 8),
+    ] {
+        let t = ModelTiles {
+            first_tile: 0,
+            grid_w: gw,
+            grid_h: gh,
+            origin_x: ox,
+            origin_y: oy,
+            downscale: d,
+            valid: 1,
+        };
+        for group in 0..(width * height).div_ceil(GROUP) {
+            let span = group_span(group, width, height);
+            let sampled = (group * GROUP..((group + 1) * GROUP).min(width * height)).any(|i| {
+                let (sx, sy) = sample_at(i % width, i / width, d, 8, width, height);
+                t.texel(sx, sy).is_some()
+            });
+            if sampled {
+                assert!(reaches(&t, span), "{t:?} group {group} {span:?}");
+            } else if reaches(&t, span) {
+                kept_elsewhere += 1;
+            }
+        }
+    }
+    // Conservative, but not everything: most workgroups are dropped.
+    assert!(
+        kept_elsewhere < 200,
+        "{kept_elsewhere} workgroups kept needlessly"
+    );
+}

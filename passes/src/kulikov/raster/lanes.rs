@@ -29,6 +29,9 @@ struct Cursor<'l> {
     x_end: i32,
     grid_h: i32,
     col: Poly,
+    /// Coverage from the trapezoid's edges ([`Trapezoid::pixel_coverage`])
+    /// rather than by clipping `col` per pixel.
+    analytic: bool,
     y: i32,
     y_end: i32,
     /// Flattened loop: the lane has a pixel left in its open column.
@@ -38,13 +41,14 @@ struct Cursor<'l> {
 }
 
 impl<'l> Cursor<'l> {
-    fn new(lane: Option<&'l Lane>) -> Self {
+    fn new(lane: Option<&'l Lane>, analytic: bool) -> Self {
         let mut c = Cursor {
             lane,
             x: 0,
             x_end: -1,
             grid_h: 0,
             col: Poly::new(&[]),
+            analytic,
             y: 0,
             y_end: -1,
             alive: false,
@@ -68,7 +72,11 @@ impl<'l> Cursor<'l> {
     /// The pixel at (x, y) of the open column, then the next row.
     fn pixel(&mut self, px: &impl Pixels) -> Option<Request> {
         let lane = self.lane?;
-        let coverage = Trapezoid::coverage(&self.col, self.y);
+        let coverage = if self.analytic {
+            lane.trap.pixel_coverage(self.x, self.y)
+        } else {
+            Trapezoid::coverage(&self.col, self.y)
+        };
         let req =
             covers(coverage).then(|| px.request(lane, self.x as u32, self.y as u32, coverage));
         self.y += 1;
@@ -99,12 +107,13 @@ fn covers(coverage: f32) -> bool {
 pub(super) fn raster(
     lanes: &[Option<&Lane>],
     flattened: bool,
+    analytic: bool,
     stacks: &mut Stacks,
     px: &mut impl Pixels,
 ) {
     let width = stacks.width();
-    let mut cur: Vec<Cursor> = lanes.iter().map(|l| Cursor::new(*l)).collect();
-    cur.resize(width, Cursor::new(None));
+    let mut cur: Vec<Cursor> = lanes.iter().map(|l| Cursor::new(*l, analytic)).collect();
+    cur.resize(width, Cursor::new(None, analytic));
     let mut reqs = vec![None; width];
     if flattened {
         flattened_loop(&mut cur, &mut reqs, stacks, px);
@@ -280,6 +289,14 @@ mod tests {
     }
 
     fn run(flattened: bool, stacks: bool) -> (Vec<(u32, u32, u32)>, LaneTally) {
+        run_with(flattened, stacks, true)
+    }
+
+    fn run_with(
+        flattened: bool,
+        stacks: bool,
+        analytic: bool,
+    ) -> (Vec<(u32, u32, u32)>, LaneTally) {
         // Lane 0: 9 columns of one pixel (shallow); lane 1: one column of 5 (steep).
         let shallow = lane(0, [0.5, 10.5], [8.5, 10.5], 0.25);
         let steep = lane(1, [20.5, 0.5], [20.5, 4.5], 0.25);
@@ -288,6 +305,7 @@ mod tests {
         raster(
             &[Some(&shallow), Some(&steep)],
             flattened,
+            analytic,
             &mut st,
             &mut log,
         );
@@ -321,6 +339,16 @@ mod tests {
         assert_eq!(flat.depth_tests, flat.pixels);
         assert_eq!(nested.writes, nested.pixels);
         assert!(flat.sum().utilisation() > nested.sum().utilisation());
+    }
+
+    #[test]
+    fn analytic_and_clipped_coverage_write_the_same_pixels() {
+        for flattened in [true, false] {
+            let (analytic, a) = run_with(flattened, true, true);
+            let (clipped, c) = run_with(flattened, true, false);
+            assert_eq!(analytic, clipped);
+            assert_eq!(a.pixels, c.pixels);
+        }
     }
 
     #[test]

@@ -49,6 +49,10 @@ pub struct RasterParams {
     pub depth_test_stack: bool,
     pub last_layer_cull: bool,
     pub morton_sort: bool,
+    /// Kulikov: each pixel's coverage computed analytically from the
+    /// trapezoid's edges, in registers; false clips the column slice per
+    /// pixel (Sutherland-Hodgman), whose vertex arrays spill on a GPU.
+    pub analytic_coverage: bool,
     /// Accepted only at its one value: the sort pass's dispatch uses it.
     pub workgroup_size: u32,
     /// Accepted only at its one value: composition decodes with it.
@@ -63,6 +67,7 @@ impl Default for RasterParams {
             depth_test_stack: true,
             last_layer_cull: true,
             morton_sort: true,
+            analytic_coverage: true,
             workgroup_size: GROUP,
             coverage_scale: COVERAGE_SCALE,
         }
@@ -91,13 +96,14 @@ impl PassParams for RasterParams {
 }
 
 crate::gpu_block! {
-    /// `RasterParams`: the five switches, then the screen size.
+    /// `RasterParams`: the six switches, then the screen size.
     pub struct RasterGpu {
         loop_flattening: u32,
         pixel_request_stack: u32,
         depth_test_stack: u32,
         last_layer_cull: u32,
         morton_sort: u32,
+        analytic_coverage: u32,
         width: u32,
         height: u32,
     }
@@ -133,6 +139,7 @@ pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
         depth_test_stack: flag(p.depth_test_stack),
         last_layer_cull: flag(p.last_layer_cull),
         morton_sort: flag(p.morton_sort),
+        analytic_coverage: flag(p.analytic_coverage),
         width: q.width,
         height: q.height,
     },
@@ -346,7 +353,13 @@ impl CpuKernel for RasterKernel {
                 self.0.pixel_request_stack && fit,
             );
             let sub: Vec<Option<&Lane>> = sub.iter().map(Option::as_ref).collect();
-            lanes::raster(&sub, self.0.loop_flattening, &mut st, &mut atlas);
+            lanes::raster(
+                &sub,
+                self.0.loop_flattening,
+                self.0.analytic_coverage,
+                &mut st,
+                &mut atlas,
+            );
             tally.add(&st.tally);
         }
         if ctx.instrument {
