@@ -21,6 +21,9 @@ use std::time::Instant;
 use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
+use strandgraph_graph::schema::Quantity;
+use strandgraph_passes::bench::RasterBenchParams;
+use strandgraph_passes::params::check;
 use strandgraph_passes::upload::Upload;
 use strandgraph_passes::{Definitions, Registry};
 pub use variants::{VARIANTS, Variant};
@@ -433,6 +436,22 @@ fn roofline(
         .graph
         .resource_id("copy_dst")
         .map_or(0, |r| instance.sizes[r].bytes);
+    // The graphics roofline: triangles and shaded fragments the raster passes drew.
+    let q = &instance.quantities;
+    let drawn = |name: &str| -> (u64, u64) {
+        plan.graph
+            .passes
+            .iter()
+            .find(|p| p.name == name)
+            .and_then(|p| check::<RasterBenchParams>(&p.params).ok())
+            .map_or((0, 0), |b| {
+                let layers = u64::from(b.layers);
+                (
+                    b.triangles(q.width, q.height),
+                    layers * q.count(Quantity::Pixels),
+                )
+            })
+    };
     Ok(Roofline {
         device: session.device(),
         notes: session.notes(),
@@ -440,6 +459,8 @@ fn roofline(
             atomic_min32: (atomics32, median("atomic_min32")),
             atomic_min64: (atomics64, median("atomic_min64")),
             copy: (copy_bytes, median("copy")),
+            triangles: (drawn("triangles").0, median("triangles")),
+            fragments: (drawn("fragments").1, median("fragments")),
         },
     })
 }

@@ -72,6 +72,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,
     &bench::COPY,
+    &bench::RASTER,
 ];
 
 /// The built-in pass kinds.

@@ -114,6 +114,9 @@ pub struct Ceilings {
     pub atomic_min64: (u64, f64),
     /// Bytes copied (each read once and written once).
     pub copy: (u64, f64),
+    /// Triangles and shaded fragments through the hardware rasterizer.
+    pub triangles: (u64, f64),
+    pub fragments: (u64, f64),
 }
 
 impl Ceilings {
@@ -122,6 +125,8 @@ impl Ceilings {
         let (n, ms) = match name {
             "atomic_min32" => self.atomic_min32,
             "atomic_min64" => self.atomic_min64,
+            "triangles" => self.triangles,
+            "fragments" => self.fragments,
             _ => return None,
         };
         Some(n as f64 / (ms * 1e-3))
@@ -234,8 +239,8 @@ impl Report {
         );
         let _ = writeln!(
             o,
-            "  {:<5} {:>24} {:>24} {:>22}",
-            "", "32-bit atomicMin", "64-bit atomicMin", "copy"
+            "  {:<5} {:>24} {:>24} {:>22} {:>22} {:>22}",
+            "", "32-bit atomicMin", "64-bit atomicMin", "copy", "hw triangles", "hw fragments"
         );
         for (b, c) in &self.ceilings {
             let atom = |(n, ms): (u64, f64)| {
@@ -243,13 +248,17 @@ impl Report {
             };
             let (bytes, ms) = c.copy;
             let copy = format!("{}B/s ({ms:.3} ms)", rate(2.0 * bytes as f64 / (ms * 1e-3)));
+            let per_s =
+                |(n, ms): (u64, f64)| format!("{}/s ({ms:.3} ms)", rate(n as f64 / (ms * 1e-3)));
             let _ = writeln!(
                 o,
-                "  {:<5} {:>24} {:>24} {:>22}",
+                "  {:<5} {:>24} {:>24} {:>22} {:>22} {:>22}",
                 b.name(),
                 atom(c.atomic_min32),
                 atom(c.atomic_min64),
-                copy
+                copy,
+                per_s(c.triangles),
+                per_s(c.fragments)
             );
         }
         let w = 34;
@@ -438,6 +447,8 @@ impl Report {
                 "atomic_min32": {"ops": c.atomic_min32.0, "median_ms": c.atomic_min32.1, "ops_per_s": c.rate("atomic_min32")},
                 "atomic_min64": {"ops": c.atomic_min64.0, "median_ms": c.atomic_min64.1, "ops_per_s": c.rate("atomic_min64")},
                 "copy": {"bytes": c.copy.0, "median_ms": c.copy.1, "bytes_moved_per_s": 2.0 * c.copy.0 as f64 / (c.copy.1 * 1e-3)},
+                "triangles": {"count": c.triangles.0, "median_ms": c.triangles.1, "per_s": c.rate("triangles")},
+                "fragments": {"count": c.fragments.0, "median_ms": c.fragments.1, "per_s": c.rate("fragments")},
             })).collect::<Vec<_>>(),
             "cells": cells,
             "notes": self.notes,

@@ -119,12 +119,21 @@ fn roofline_line(json: &Value, backend: &str) -> String {
             .as_f64()
             .map_or("–".into(), |x| format!("{:.1} G", x / 1e9))
     };
-    format!(
-        "\nRoofline of the same run: {} atomicMin/s 32-bit, {} atomicMin/s 64-bit (random addresses), {}B/s copy.\n\n",
+    let mut line = format!(
+        "\nRoofline of the same run: {} atomicMin/s 32-bit, {} atomicMin/s 64-bit (random addresses), {}B/s copy",
         g("atomic_min32", "ops_per_s"),
         g("atomic_min64", "ops_per_s"),
         g("copy", "bytes_moved_per_s")
-    )
+    );
+    // Runs before the graphics roofline existed have none.
+    if r["triangles"]["per_s"].is_number() {
+        line.push_str(&format!(
+            "; through the hardware rasterizer {} triangles/s (2x2-pixel pairs) and {} shaded fragments/s (full-screen layers)",
+            g("triangles", "per_s"),
+            g("fragments", "per_s")
+        ));
+    }
+    line + ".\n\n"
 }
 
 /// One variant's per-pass medians on the file's first backend, a column

@@ -9,10 +9,15 @@
 //!   unused, the operation of Lipp's 64-bit visibility buffer.
 //! - `bench.copy`: a buffer-to-buffer copy in a compute shader, the
 //!   bandwidth ceiling.
+//! - `bench.raster`: triangles and shaded fragments per second through the
+//!   hardware rasterizer, the ceiling of every raster pass (few SMs run
+//!   vertex and pixel work on Hopper).
 //!
 //! Addresses and values come from a hash of the invocation's global id, so
 //! every backend performs the same sequence of operations.
 
+mod raster;
 mod roofline;
 
+pub use raster::{RASTER, RasterBenchParams, pixel_colour};
 pub use roofline::{ATOMIC_MIN32, ATOMIC_MIN64, COPY, RooflineParams, pcg};
