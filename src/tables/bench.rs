@@ -115,9 +115,13 @@ fn roofline_line(json: &Value, backend: &str) -> String {
         return String::new();
     };
     let g = |k: &str, f: &str| {
-        r[k][f]
-            .as_f64()
-            .map_or("–".into(), |x| format!("{:.1} G", x / 1e9))
+        r[k][f].as_f64().map_or("–".into(), |x| {
+            if x >= 1e9 {
+                format!("{:.1} G", x / 1e9)
+            } else {
+                format!("{:.0} M", x / 1e6)
+            }
+        })
     };
     let mut line = format!(
         "\nRoofline of the same run: {} atomicMin/s 32-bit, {} atomicMin/s 64-bit (random addresses), {}B/s copy",

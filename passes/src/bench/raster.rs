@@ -74,7 +74,11 @@ impl RasterBenchParams {
             c => (c, c),
         };
         // Corners of the square: 0 top-left, 1 bottom-left, 2 top-right, 3 bottom-right.
-        let corner = if t.is_multiple_of(2) { [0, 1, 2] } else { [2, 1, 3] }[k as usize];
+        let corner = if t.is_multiple_of(2) {
+            [0, 1, 2]
+        } else {
+            [2, 1, 3]
+        }[k as usize];
         [
             ((sx + (corner >> 1)) * cw) as f32,
             ((sy + (corner & 1)) * ch) as f32,
