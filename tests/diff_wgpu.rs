@@ -454,7 +454,7 @@ fn showcase_composed_matches_cpu_on_wgpu() {
         d.max_at,
         d.pixels_over(MAX_PIXEL_FLIP)
     );
-    // Hair depth written by fs_depth where coverage reaches the threshold.
+    // Hair depth written by kulikov.compose where coverage reaches the threshold.
     let cd = cpu.read(&p.plan, "hair_depth").unwrap();
     let gd = gpu.read(&p.plan, "hair_depth").unwrap().unwrap();
     assert_eq!(cd.len(), gd.len());

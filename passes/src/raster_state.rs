@@ -4,8 +4,8 @@
 //! Raster passes draw non-indexed triangle lists with no vertex buffers
 //! (vertex shaders fetch from storage buffers), counter-clockwise front
 //! faces. One pass may issue several draws over the same attachments with
-//! different fragment entries and state: `kulikov.compose` blends colour,
-//! then writes hair depth. The CPU kernels implement the same state in
+//! different fragment entries and state (say, colour blended, then depth
+//! written with the same geometry). The CPU kernels implement the same state in
 //! software; each definition's `raster()` documents the pairing.
 
 /// A raster pass's draws and attachment load operations.
