@@ -177,3 +177,58 @@ fn every_pass_kind_is_checked() {
         "pass kinds no agreement case runs: {missing:?}"
     );
 }
+
+/// `kulikov.compose` keeps the back-to-front model order in workgroup
+/// memory for up to `MAX_MODELS` models and ranks them per lane beyond
+/// that. No shipped scene has that many, so the slow path runs here with the
+/// limit patched down to 2 (the showcase has 3 models), through
+/// `STRANDGRAPH_SHADERS`: it must agree with the CPU as the fast path does.
+#[test]
+fn compose_agrees_when_the_model_order_does_not_fit_in_workgroup_memory() {
+    let dir =
+        std::env::temp_dir().join(format!("strandgraph-compose-order-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_tree(&root().join("shaders"), &dir);
+    let path = dir.join("kulikov/compose.wgsl");
+    let wgsl = std::fs::read_to_string(&path).unwrap();
+    let limit = "const MAX_MODELS: u32 = 1024u;";
+    assert!(
+        wgsl.contains(limit),
+        "compose.wgsl no longer declares `{limit}`"
+    );
+    std::fs::write(&path, wgsl.replace(limit, "const MAX_MODELS: u32 = 2u;")).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_strandgraph"))
+        .current_dir(root())
+        .env("STRANDGRAPH_SHADERS", &dir)
+        .args([
+            "agree",
+            "scenes/showcase.ron",
+            "--size",
+            "120x68",
+            "--pass",
+            "compose",
+        ])
+        .output()
+        .expect("running strandgraph agree");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("all outputs agree"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}

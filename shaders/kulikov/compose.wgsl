@@ -46,7 +46,8 @@ struct ComposeParams {
 @group(0) @binding(12) var hair_depth: texture_storage_2d<r32float, write>;
 
 const GROUP: u32 = 256u;
-// Models a frame may hold (passes/src/upload.rs refuses more).
+// Models whose order fits in workgroup memory; a frame with more takes the
+// slow path (each lane ranks the models itself), not a limit.
 const MAX_MODELS: u32 = 1024u;
 // Back-to-front model order, computed once per workgroup, and per rank
 // whether that model's tiles can reach the workgroup's pixels.
@@ -99,6 +100,17 @@ fn sort_key(m: u32) -> f32 {
     let md = models[m];
     let c = 0.5 * (md.bounds_min.xyz + md.bounds_max.xyz) - frame.camera_pos.xyz;
     return sqrt(dot(c, c)) + select(0.0, params.facial_hair_bias, (md.flags & MODEL_FACIAL_HAIR) != 0u);
+}
+
+// The model at back-to-front rank `rank` (slow path for frames whose order
+// does not fit in workgroup memory).
+fn model_at(rank: u32) -> u32 {
+    for (var m = 0u; m < frame.model_count; m++) {
+        if rank_of(m) == rank {
+            return m;
+        }
+    }
+    return 0u;
 }
 
 // compose::model_order: the back-to-front rank of model `m` (farthest
@@ -240,9 +252,10 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
 
 @compute @workgroup_size(256)
 fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let models_n = min(frame.model_count, MAX_MODELS);
+    let models_n = frame.model_count;
+    let shared_order = models_n <= MAX_MODELS;
     let span = group_span(wg.x);
-    for (var m = lane; m < models_n; m += GROUP) {
+    for (var m = lane; shared_order && m < models_n; m += GROUP) {
         let r = rank_of(m);
         order[r] = m;
         reaches[r] = select(1u, u32(model_reaches(m, span)), params.workgroup_cull != 0u);
@@ -259,8 +272,16 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     var color = textureLoad(output, vec2<u32>(x, y));
     var touched = false;
     for (var r = 0u; r < models_n; r++) {
-        let m = order[r];
-        if reaches[r] == 0u || load_tiles(atlas_tiles[m]).valid == 0u {
+        var m = 0u;
+        var reach = 1u;
+        if shared_order {
+            m = order[r];
+            reach = reaches[r];
+        } else {
+            m = model_at(r);
+            reach = select(1u, u32(model_reaches(m, span)), params.workgroup_cull != 0u);
+        }
+        if reach == 0u || load_tiles(atlas_tiles[m]).valid == 0u {
             continue;
         }
         let h = compose_pixel(m, x, y);
