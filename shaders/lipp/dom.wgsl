@@ -1,5 +1,5 @@
 // What the deep opacity map's writers (lipp.dom_depth, lipp.dom_opacity in
-// raster.wgsl) and its reader (lipp.shade) share: the map's constants and
+// dom_maps.wgsl) and its reader (lipp.shade) share: the map's constants and
 // the light frames, with the scene bindings those read (frame, models,
 // lights) declared once. Composed with naga_oil:
 //   #define FRAME_BINDING 1

@@ -88,7 +88,7 @@ impl PassParams for DomParams {
 }
 
 crate::gpu_block! {
-    /// `DomParams` in shaders/lipp/raster.wgsl.
+    /// `DomParams` in shaders/lipp/dom_maps.wgsl.
     pub struct DomGpu {
         resolution: u32,
         layers: u32,
@@ -230,7 +230,7 @@ pub fn walk(a: [f32; 3], b: [f32; 3], res: u32, visit: &mut dyn FnMut(u32, u32, 
         let tm = 0.5 * (t0 + t1);
         let z = a[2] + (b[2] - a[2]) * tm;
         // Rows as floats, clipped to the map, as `dom_segment_depth` in
-        // shaders/lipp/raster.wgsl walks them.
+        // shaders/lipp/dom_maps.wgsl walks them.
         let mut row = r0.max(0.0);
         while row <= r1.min(limit - 1.0) {
             let (x, y) = dda.pixel(col, row);
@@ -305,7 +305,7 @@ const fn dom_pass(
             binding: "raster_args",
             word: 0,
         },
-        shader: Shader::compute("lipp/raster.wgsl", stage.entry()),
+        shader: Shader::compute("lipp/dom_maps.wgsl", stage.entry()),
         kernel: stage.kernel(),
         gpu: |p, q| p.uniform(q),
         raster: None,
@@ -313,7 +313,7 @@ const fn dom_pass(
 }
 
 impl Stage {
-    /// The stage's entry point in shaders/lipp/raster.wgsl.
+    /// The stage's entry point in shaders/lipp/dom_maps.wgsl.
     const fn entry(self) -> &'static str {
         match self {
             Stage::Depth => "dom_depth_pass",

@@ -6,7 +6,7 @@
 //! callers pick their rows.
 //!
 //! The WGSL ports (`walk_columns` and `walk_column` in
-//! `shaders/lipp/raster.wgsl`, and the raster's segment loop) do the same
+//! `shaders/lipp/dom_maps.wgsl`, and the raster's segment loop) do the same
 //! operations in the same order, so the CPU kernels and the shaders visit the
 //! same pixels with the same bits.
 

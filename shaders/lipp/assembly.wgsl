@@ -1,0 +1,354 @@
+// Lipp's strand assembly (§3.1, Appendix B Code 1), shared by lipp.raster
+// (raster.wgsl) and the deep opacity maps (dom_maps.wgsl): bundles and their
+// layers, control points evaluated with styling, one 32-lane workgroup per
+// strand with cooperative assembly by subgroup shuffles. Port of
+// passes/src/lipp/strand.rs. A neighbour held by a lane of another subgroup
+// (subgroups narrower than 32, e.g. lavapipe's 8) or by a lane whose shuffle
+// partner is not its index neighbour is evaluated instead of shuffled; the
+// bits are the same, so the result does not depend on the subgroup width.
+// Composed with naga_oil:
+//   #import strandgraph::lipp_assembly::{load_strand, pass_one, pass_two, ...}
+// Every importer binds raster_args, bundle_lod, hairmesh.bundles and
+// hairmesh.layers at 2-5 (their definitions list them second to fifth, after
+// frame; passes/tests/wgsl_bindings.rs checks it).
+#define_import_path strandgraph::lipp_assembly
+
+#import strandgraph::hash::pcg
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+
+@group(0) @binding(2) var<storage, read> raster_args: array<u32>;
+@group(0) @binding(3) var<storage, read> bundle_lod: array<u32>;
+@group(0) @binding(4) var<storage, read> hairmesh_bundles: array<u32>;
+@group(0) @binding(5) var<storage, read> hairmesh_layers: array<vec4<f32>>;
+
+// Lipp Code 1's smLayer: the base layers with finite-difference tangents.
+var<workgroup> sm_pos: array<vec3<f32>, 16>;
+var<workgroup> sm_tangent: array<vec3<f32>, 16>;
+var<workgroup> sm_axis: array<vec3<f32>, 16>;
+var<workgroup> sm_ao: array<f32, 16>;
+
+// Points per lane: (MAX_CONTROL_POINTS - 1) / 32.
+const MAX_STRIP: u32 = 4u;
+
+struct Bundle {
+    first_layer: u32,
+    layers: u32,
+    seed: u32,
+    curl_radius: f32,
+    curl_turns: f32,
+    twist: f32,
+    noise: f32,
+}
+
+fn load_bundle(b: u32) -> Bundle {
+    let o = b * BUNDLE_WORDS;
+    return Bundle(
+        hairmesh_bundles[o],
+        clamp(hairmesh_bundles[o + 1u], 2u, MAX_LAYERS),
+        hairmesh_bundles[o + 8u],
+        bitcast<f32>(hairmesh_bundles[o + 4u]),
+        bitcast<f32>(hairmesh_bundles[o + 5u]),
+        bitcast<f32>(hairmesh_bundles[o + 6u]),
+        bitcast<f32>(hairmesh_bundles[o + 7u]),
+    );
+}
+
+struct LayerPoint {
+    pos: vec3<f32>,
+    axis: vec3<f32>,
+    ao: f32,
+}
+
+fn bilinear(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>, c3: vec3<f32>, u: f32, v: f32) -> vec3<f32> {
+    let bottom = lerp_vec(c0, c1, u);
+    let top = lerp_vec(c3, c2, u);
+    return lerp_vec(bottom, top, v);
+}
+
+// strand::layer_point.
+fn layer_point(b: Bundle, i: u32, uv: vec2<f32>) -> LayerPoint {
+    let base = (b.first_layer + i) * LAYER_VEC4S;
+    let k0 = hairmesh_layers[base];
+    let k1 = hairmesh_layers[base + 2u];
+    let k2 = hairmesh_layers[base + 4u];
+    let k3 = hairmesh_layers[base + 6u];
+    let w = hairmesh_layers[base + 1u].w;
+    let angle = b.twist * TAU * w;
+    let s = sin(angle);
+    let co = cos(angle);
+    let x = uv.x - 0.5;
+    let y = uv.y - 0.5;
+    let u = x * co - y * s + 0.5;
+    let v = x * s + y * co + 0.5;
+    let pos = bilinear(k0.xyz, k1.xyz, k2.xyz, k3.xyz, u, v);
+    let axis = ((k1.xyz - k0.xyz) + (k2.xyz - k3.xyz)) * 0.5;
+    let ao_b = k0.w + (k1.w - k0.w) * u;
+    let ao_t = k3.w + (k2.w - k3.w) * u;
+    return LayerPoint(pos, axis, ao_b + (ao_t - ao_b) * v);
+}
+
+struct ControlPoint {
+    pos: vec3<f32>,
+    w: f32,
+    ao: f32,
+}
+
+// strand::eval_cp over the layers in workgroup memory.
+fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32, styling: bool) -> ControlPoint {
+    let n = b.layers;
+    let w = f32(k) / f32(c - 1u);
+    let f = w * f32(n - 1u);
+    let i = min(u32(floor(f)), n - 2u);
+    let t = f - f32(i);
+    let p0 = sm_pos[i];
+    let p1 = sm_pos[i + 1u];
+    let t0 = sm_tangent[i];
+    let t1 = sm_tangent[i + 1u];
+    let d = p1 - p0;
+    let len = sqrt(dot(d, d));
+    let t2 = t * t;
+    let t3 = t * t * t;
+    let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+    let h10 = t3 - 2.0 * t2 + t;
+    let h01 = -2.0 * t3 + 3.0 * t2;
+    let h11 = t3 - t2;
+    var pos = (p0 * h00 + t0 * (h10 * len)) + (p1 * h01 + t1 * (h11 * len));
+    let ao = sm_ao[i] + (sm_ao[i + 1u] - sm_ao[i]) * t;
+    if styling {
+        let dir = safe_normalize(lerp_vec(t0, t1, t));
+        let axis = lerp_vec(sm_axis[i], sm_axis[i + 1u], t);
+        let b1 = safe_normalize(axis - dir * dot(axis, dir));
+        let b2 = cross(dir, b1);
+        let ramp = min(w * 8.0, 1.0);
+        var off = vec3<f32>(0.0);
+        if b.curl_radius > 0.0 {
+            let a = TAU * (b.curl_turns * w + id.x);
+            off = off + (b1 * cos(a) + b2 * sin(a)) * b.curl_radius;
+        }
+        if b.noise > 0.0 {
+            let amp = b.noise * sin(PI * w * (1.0 + 2.0 * id.y));
+            off = off + (id * 2.0 - vec3<f32>(1.0)) * amp;
+        }
+        pos = pos + off * ramp;
+    }
+    return ControlPoint(pos, w, ao);
+}
+
+// Snapped to the sub-pixel grid every backend uses (lipp::raster::SNAP).
+fn snap(v: f32) -> f32 {
+    return floor(v * SNAP + 0.5) / SNAP;
+}
+// The last bundle whose first strand is at most s (lipp::bundle_of_strand).
+fn bundle_of_strand(count: u32, s: u32) -> u32 {
+    var lo = 0u;
+    var hi = count;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if bundle_lod[mid * LOD_WORDS + 2u] <= s {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return max(lo, 1u) - 1u;
+}
+
+// One strand's assembly state (Code 1), shared by the raster and the DOM entries.
+struct Strand {
+    bundle: Bundle,
+    id: vec3<f32>,
+    uv: vec2<f32>,
+    k: u32,
+    c: u32,
+    // N / N_LOD of the strand's bundle (the DOM's density compensation).
+    thinning: f32,
+    styling: bool,
+}
+
+fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
+    let bi = bundle_of_strand(count, s);
+    let drawn = max(bundle_lod[bi * LOD_WORDS], 1u);
+    let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
+    let b = load_bundle(bi);
+    let k = s - bundle_lod[bi * LOD_WORDS + 2u];
+    let full = hairmesh_bundles[bi * BUNDLE_WORDS + 2u];
+    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling);
+}
+
+// Whether this lane's shuffle partners are its index neighbours.
+struct Lanes {
+    lane: u32,
+    has_up: bool,
+    has_down: bool,
+}
+
+fn lanes_of(lane: u32, sg_lane: u32, sg_size: u32, coop: bool) -> Lanes {
+    let up_lane = subgroupShuffleUp(lane, 1u);
+    let down_lane = subgroupShuffleDown(lane, 1u);
+    return Lanes(
+        lane,
+        coop && sg_lane > 0u && up_lane + 1u == lane,
+        coop && sg_lane + 1u < sg_size && down_lane == lane + 1u && lane + 1u < RASTER_GROUP,
+    );
+}
+
+// Pass 1 (Code 1 lines 14-28): one layer per lane into smLayer. The caller
+// puts a workgroupBarrier after it.
+fn pass_one(st: Strand, l: Lanes) {
+    let b = st.bundle;
+    let n = b.layers;
+    let lane = l.lane;
+    var mine = LayerPoint(vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
+    if lane < n {
+        mine = layer_point(b, lane, st.uv);
+    }
+    let up_pos = subgroupShuffleUp(mine.pos, 1u);
+    let down_pos = subgroupShuffleDown(mine.pos, 1u);
+    if lane < n {
+        var prev = mine.pos;
+        if lane > 0u {
+            prev = select(layer_point(b, lane - 1u, st.uv).pos, up_pos, l.has_up);
+        }
+        var next = mine.pos;
+        if lane + 1u < n {
+            next = select(layer_point(b, lane + 1u, st.uv).pos, down_pos, l.has_down);
+        }
+        sm_pos[lane] = mine.pos;
+        sm_tangent[lane] = calc_tangent(lane, n, prev, mine.pos, next);
+        sm_axis[lane] = mine.axis;
+        sm_ao[lane] = mine.ao;
+    }
+}
+
+// A lane's strip of control points with final tangents, and the next lane's
+// first point and tangent (Code 1 lines 30-50).
+struct Strip {
+    cps: array<ControlPoint, 4>,
+    tangents: array<vec3<f32>, 4>,
+    have: u32,
+    next: ControlPoint,
+    next_tangent: vec3<f32>,
+    has_next: bool,
+}
+
+fn pass_two(st: Strand, l: Lanes) -> Strip {
+    let b = st.bundle;
+    let id = st.id;
+    let c = st.c;
+    let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
+    let first = l.lane * strip;
+    let have = min(select(0u, c - first, first < c), strip);
+    var cps: array<ControlPoint, 4>;
+    for (var m = 0u; m < have; m++) {
+        cps[m] = eval_cp(b, id, first + m, c, st.styling);
+    }
+    let first_cp = cps[0];
+    let last_cp = cps[max(have, 1u) - 1u];
+    let up_cp_pos = subgroupShuffleUp(last_cp.pos, 1u);
+    let up_cp_w = subgroupShuffleUp(last_cp.w, 1u);
+    let up_cp_ao = subgroupShuffleUp(last_cp.ao, 1u);
+    let down_cp_pos = subgroupShuffleDown(first_cp.pos, 1u);
+    let down_cp_w = subgroupShuffleDown(first_cp.w, 1u);
+    let down_cp_ao = subgroupShuffleDown(first_cp.ao, 1u);
+    let end = first + have;
+    var prev = first_cp;
+    if have > 0u && first > 0u {
+        if l.has_up {
+            prev = ControlPoint(up_cp_pos, up_cp_w, up_cp_ao);
+        } else {
+            prev = eval_cp(b, id, first - 1u, c, st.styling);
+        }
+    }
+    let has_next = have > 0u && end < c;
+    var next = last_cp;
+    if has_next {
+        if l.has_down {
+            next = ControlPoint(down_cp_pos, down_cp_w, down_cp_ao);
+        } else {
+            next = eval_cp(b, id, end, c, st.styling);
+        }
+    }
+    var tangents: array<vec3<f32>, 4>;
+    for (var m = 0u; m < have; m++) {
+        var p = cps[m].pos;
+        if m > 0u {
+            p = cps[m - 1u].pos;
+        } else if first > 0u {
+            p = prev.pos;
+        }
+        var q = cps[m].pos;
+        if m + 1u < have {
+            q = cps[m + 1u].pos;
+        } else if has_next {
+            q = next.pos;
+        }
+        tangents[m] = calc_tangent(first + m, c, p, cps[m].pos, q);
+    }
+    // The next lane's first tangent (Code 1 line 46).
+    let down_t = subgroupShuffleDown(tangents[0], 1u);
+    var tn = vec3<f32>(0.0);
+    if has_next {
+        if l.has_down {
+            tn = down_t;
+        } else {
+            var after = next.pos;
+            if end + 1u < c {
+                after = eval_cp(b, id, end + 1u, c, st.styling).pos;
+            }
+            tn = calc_tangent(end, c, cps[have - 1u].pos, next.pos, after);
+        }
+    }
+    return Strip(cps, tangents, have, next, tn, has_next);
+}
+
+// Segment m of a strip: (a, ta, b, tb); valid for m + 1 < have, or the last with has_next.
+fn strip_segment_end(st: Strip, m: u32) -> ControlPoint {
+    if m + 1u < st.have {
+        return st.cps[m + 1u];
+    }
+    return st.next;
+}
+
+fn strip_segment_tangent(st: Strip, m: u32) -> vec3<f32> {
+    if m + 1u < st.have {
+        return st.tangents[m + 1u];
+    }
+    return st.next_tangent;
+}
+
+fn strip_segments(st: Strip) -> u32 {
+    return select(max(st.have, 1u) - 1u, st.have, st.has_next);
+}
+
+// The DDA column walk of a segment (lipp::walk), shared by the raster and
+// the deep opacity maps.
+// One column of dom::walk: (first row, last row, depth), for column `col`.
+fn walk_column(a: vec3<f32>, b: vec3<f32>, x_major: bool, col: f32) -> vec3<f32> {
+    let ma = select(a.y, a.x, x_major);
+    let na = select(a.x, a.y, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let nb = select(b.x, b.y, x_major);
+    let dm = mb - ma;
+    let dn = nb - na;
+    var t0 = 0.0;
+    var t1 = 1.0;
+    if dm != 0.0 {
+        let ta = clamp((col - ma) / dm, 0.0, 1.0);
+        let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
+        t0 = min(ta, tb);
+        t1 = max(ta, tb);
+    }
+    let n0 = na + dn * t0;
+    let n1 = na + dn * t1;
+    let tm = 0.5 * (t0 + t1);
+    return vec3<f32>(floor(min(n0, n1)), floor(max(n0, n1)), a.z + (b.z - a.z) * tm);
+}
+
+// The columns dom::walk visits: (first, last, x_major as 0/1).
+fn walk_columns(a: vec3<f32>, b: vec3<f32>, res: u32) -> vec3<f32> {
+    let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
+    let ma = select(a.y, a.x, x_major);
+    let mb = select(b.y, b.x, x_major);
+    let limit = f32(res);
+    return vec3<f32>(floor(max(min(ma, mb), 0.0)), floor(min(max(ma, mb), limit - 1.0)), select(0.0, 1.0, x_major));
+}

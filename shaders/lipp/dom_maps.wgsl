@@ -1,0 +1,169 @@
+// The deep opacity maps lipp.dom_depth and lipp.dom_opacity (entries
+// `dom_depth_pass`, `dom_opacity_pass`; Lipp §3.4, Yuksel and Keyser 2008):
+// each strand assembled as the raster assembles it (assembly.wgsl), its
+// segments walked through every light's map. Port of passes/src/lipp/dom.rs.
+
+// Bindings 1 (frame), 6 (models) and 7 (lights) are declared in dom.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 6
+#define LIGHTS_BINDING 7
+#import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
+#import strandgraph::layout::{FrameData, ModelData, LightData}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, walk_column, walk_columns}
+
+// Bindings 0 and 8.. are the DOM entries' own.
+
+struct DomParams {
+    resolution: u32,
+    layers: u32,
+    layer_thickness: f32,
+    strand_opacity: f32,
+    density_compensation: u32,
+    cooperative_assembly: u32,
+    styling: u32,
+    bundles: u32,
+}
+
+@group(0) @binding(0) var<uniform> dom_params: DomParams;
+@group(0) @binding(8) var<storage, read_write> dom_depth: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read> dom_opacity_pass_dom_depth: array<u32>;
+@group(0) @binding(9) var<storage, read_write> dom_layers: array<atomic<u32>>;
+
+// dom::MAX_DOM_LIGHTS.
+const MAX_DOM_LIGHTS: u32 = 4u;
+
+// Number of lights the maps have room for (dom::light_frames).
+fn dom_light_count(res: u32, map_words: u32) -> u32 {
+    return min(min(frame.light_count, MAX_DOM_LIGHTS), min(arrayLength(&lights), map_words / max(res * res, 1u)));
+}
+
+
+
+// Light-space segment ends: texel coordinates snapped, normalised depth.
+fn dom_end(lf: LightFrame, p: vec3<f32>, res: u32) -> vec3<f32> {
+    let q = light_project(lf, p);
+    let r = f32(res);
+    return vec3<f32>(snap(q.x * r), snap(q.y * r), q.z);
+}
+
+fn dom_amount(st: Strand) -> u32 {
+    var thinning = 1.0;
+    if dom_params.density_compensation != 0u {
+        thinning = st.thinning;
+    }
+    return u32(floor(dom_params.strand_opacity * thinning * OPACITY_SCALE + 0.5));
+}
+
+fn dom_segment_depth(a: ControlPoint, b: ControlPoint, l: u32, lf: LightFrame) {
+    let res = dom_params.resolution;
+    {
+        let pa = dom_end(lf, a.pos, res);
+        let pb = dom_end(lf, b.pos, res);
+        let cols = walk_columns(pa, pb, res);
+        let x_major = cols.z != 0.0;
+        for (var col = cols.x; col <= cols.y; col += 1.0) {
+            let span = walk_column(pa, pb, x_major, col);
+            let z = span.z;
+            if !(z >= 0.0 && z <= 1.0) {
+                continue;
+            }
+            for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
+                let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
+                let texel = l * res * res + u32(xy.y) * res + u32(xy.x);
+                // A plain load first (see dom.rs): skips most atomics.
+                let bits = bitcast<u32>(z);
+                if bits < atomicLoad(&dom_depth[texel]) {
+                    atomicMin(&dom_depth[texel], bits);
+                }
+            }
+        }
+    }
+}
+
+fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32, l: u32, lf: LightFrame) {
+    let res = dom_params.resolution;
+    {
+        let pa = dom_end(lf, a.pos, res);
+        let pb = dom_end(lf, b.pos, res);
+        let cols = walk_columns(pa, pb, res);
+        let x_major = cols.z != 0.0;
+        for (var col = cols.x; col <= cols.y; col += 1.0) {
+            let span = walk_column(pa, pb, x_major, col);
+            let z = span.z;
+            if !(z >= 0.0 && z <= 1.0) {
+                continue;
+            }
+            for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
+                let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
+                let texel = u32(xy.y) * res + u32(xy.x);
+                let first = dom_opacity_pass_dom_depth[l * res * res + texel];
+                if first == NO_HIT {
+                    continue;
+                }
+                // Depth behind the first hit, in layers.
+                let d = (z - bitcast<f32>(first)) * lf.depth_extent / dom_params.layer_thickness;
+                let k = min(u32(max(floor(d), 0.0)), dom_params.layers - 1u);
+                atomicAdd(&dom_layers[(l * dom_params.layers + k) * res * res + texel], amount);
+            }
+        }
+    }
+}
+
+@compute @workgroup_size(32)
+fn dom_depth_pass(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_depth));
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        // Each light's view once per strand, the strip's segments in it.
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_depth(strip.cps[m], strip_segment_end(strip, m), li, lf);
+            }
+        }
+        workgroupBarrier();
+    }
+}
+
+@compute @workgroup_size(32)
+fn dom_opacity_pass(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_opacity_pass_dom_depth));
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        let amount = dom_amount(st);
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount, li, lf);
+            }
+        }
+        workgroupBarrier();
+    }
+}
