@@ -322,6 +322,18 @@ fn strip_segments(st: Strip) -> u32 {
 
 // The DDA column walk of a segment (lipp::walk), shared by the raster and
 // the deep opacity maps.
+// walk::Dda: the segment's parameter range (t0, t1) inside column `col` of
+// its major axis, from the major coordinate `ma` at t = 0 and its change
+// `dm` (all of it when the segment does not move along the axis).
+fn column_params(ma: f32, dm: f32, col: f32) -> vec2<f32> {
+    if dm == 0.0 {
+        return vec2<f32>(0.0, 1.0);
+    }
+    let ta = clamp((col - ma) / dm, 0.0, 1.0);
+    let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
+    return vec2<f32>(min(ta, tb), max(ta, tb));
+}
+
 // One column of dom::walk: (first row, last row, depth), for column `col`.
 fn walk_column(a: vec3<f32>, b: vec3<f32>, x_major: bool, col: f32) -> vec3<f32> {
     let ma = select(a.y, a.x, x_major);
@@ -330,14 +342,9 @@ fn walk_column(a: vec3<f32>, b: vec3<f32>, x_major: bool, col: f32) -> vec3<f32>
     let nb = select(b.x, b.y, x_major);
     let dm = mb - ma;
     let dn = nb - na;
-    var t0 = 0.0;
-    var t1 = 1.0;
-    if dm != 0.0 {
-        let ta = clamp((col - ma) / dm, 0.0, 1.0);
-        let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
-        t0 = min(ta, tb);
-        t1 = max(ta, tb);
-    }
+    let t = column_params(ma, dm, col);
+    let t0 = t.x;
+    let t1 = t.y;
     let n0 = na + dn * t0;
     let n1 = na + dn * t1;
     let tm = 0.5 * (t0 + t1);

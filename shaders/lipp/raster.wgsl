@@ -15,7 +15,7 @@
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -109,14 +109,9 @@ fn draw_segment(a: End, b: End, uv: vec2<f32>) {
     let cosa = select(1.0, abs(dm) / len, len > 0.0);
     for (var col = lo; col <= hi; col += 1.0) {
         let ci = i32(col);
-        var t0 = 0.0;
-        var t1 = 1.0;
-        if dm != 0.0 {
-            let ta = clamp((col - ma) / dm, 0.0, 1.0);
-            let tb = clamp((col + 1.0 - ma) / dm, 0.0, 1.0);
-            t0 = min(ta, tb);
-            t1 = max(ta, tb);
-        }
+        let t = column_params(ma, dm, col);
+        let t0 = t.x;
+        let t1 = t.y;
         let centre = col + 0.5;
         if dm != 0.0 && centre >= min(ma, mb) && centre < max(ma, mb) {
             let t = (centre - ma) / dm;
