@@ -20,6 +20,23 @@ fn label(cell: &Value) -> String {
     )
 }
 
+fn view_of(cell: &Value) -> String {
+    cell["view"].as_str().unwrap_or("?").to_string()
+}
+
+/// The (pass, kind) pairs of `cells`, in the order they first appear.
+fn passes_of<'a>(cells: impl Iterator<Item = &'a Value>) -> Vec<(String, String)> {
+    distinct(
+        cells.flat_map(|c| c["passes"].as_array().into_iter().flatten()),
+        |p| {
+            (
+                p["pass"].as_str().unwrap_or("?").to_string(),
+                p["kind"].as_str().unwrap_or("?").to_string(),
+            )
+        },
+    )
+}
+
 /// Distinct values of `f` over `items`, first occurrence first.
 fn distinct<'a, T: PartialEq>(
     items: impl Iterator<Item = &'a Value>,
@@ -66,9 +83,7 @@ fn caption(json: &Value, backend: &str, device: &str) -> String {
 pub fn frame_table(json: &Value) -> Result<String, String> {
     let mut md = String::new();
     for (backend, device) in devices(json)? {
-        let views = distinct(cells(json, &backend), |c| {
-            c["view"].as_str().unwrap_or("?").to_string()
-        });
+        let views = distinct(cells(json, &backend), view_of);
         let rows = distinct(cells(json, &backend), label);
         let _ = writeln!(
             md,
@@ -151,19 +166,8 @@ pub fn pass_table(json: &Value, variant: &str) -> Result<String, String> {
         if mine.is_empty() {
             return Err(format!("no measured cell of `{variant}` on {backend}"));
         }
-        let views = distinct(mine.iter().copied(), |c| {
-            c["view"].as_str().unwrap_or("?").to_string()
-        });
-        let passes = distinct(
-            mine.iter()
-                .flat_map(|c| c["passes"].as_array().into_iter().flatten()),
-            |p| {
-                (
-                    p["pass"].as_str().unwrap_or("?").to_string(),
-                    p["kind"].as_str().unwrap_or("?").to_string(),
-                )
-            },
-        );
+        let views = distinct(mine.iter().copied(), view_of);
+        let passes = passes_of(mine.iter().copied());
         let _ = writeln!(
             md,
             "{variant}, {}; ms, median per pass:\n",
@@ -221,17 +225,7 @@ pub fn delta_table(
             .and_then(|l| l.iter().find(|p| p["pass"] == pass))
             .and_then(|p| p["median_ms"].as_f64())
     };
-    let passes = distinct(
-        [&a, &b]
-            .into_iter()
-            .flat_map(|c| c["passes"].as_array().into_iter().flatten()),
-        |p| {
-            (
-                p["pass"].as_str().unwrap_or("?").to_string(),
-                p["kind"].as_str().unwrap_or("?").to_string(),
-            )
-        },
-    );
+    let passes = passes_of([&a, &b].into_iter());
     let ms = |v: Option<f64>| v.map_or("–".into(), |m| format!("{m:.3}"));
     let mut md = format!(
         "{variant}, {view}, {dev_a}; ms, median per pass:\n\n| pass | kind | before | after | change |\n|---|---|---:|---:|---:|\n"
