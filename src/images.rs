@@ -5,24 +5,34 @@ use image::{Rgb32FImage, Rgba32FImage, RgbaImage};
 use strandgraph_graph::Plan;
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl};
 
-/// Linear to sRGB, for display.
-fn srgb(x: f32) -> u8 {
-    let x = x.clamp(0.0, 1.0);
-    let s = if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0).round() as u8
+pub use crate::tonemap::Tonemap;
+
+/// How linear images become display pictures.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Display {
+    pub tonemap: Tonemap,
+    /// Exposure in EV (stops) applied before the tone mapper.
+    pub exposure: f32,
 }
 
-/// An image resource's words as a picture; `None` for buffers and formats we do not display.
+impl Display {
+    /// No tone mapping and no exposure: clip and sRGB-encode (what the
+    /// image-comparing tests calibrated their thresholds on).
+    pub const CLIP: Display = Display {
+        tonemap: Tonemap::None,
+        exposure: 0.0,
+    };
+}
+
+/// An image resource's words as a picture; `None` for buffers and formats we
+/// do not display. Float images go through `display`'s tone mapper.
 pub fn to_picture(
     plan: &Plan,
     resource: usize,
     words: &[u32],
     width: u32,
     height: u32,
+    display: Display,
 ) -> Option<RgbaImage> {
     let r = plan.graph.physical(resource);
     let ResourceDecl::Image { format, .. } = plan.graph.resources[r].decl else {
@@ -36,7 +46,8 @@ pub fn to_picture(
                 let (lo, hi) = (words[2 * i], words[2 * i + 1]);
                 let c =
                     [lo & 0xFFFF, lo >> 16, hi & 0xFFFF].map(|h| f16::from_bits(h as u16).to_f32());
-                *px = image::Rgba([srgb(c[0]), srgb(c[1]), srgb(c[2]), 255]);
+                let [r, g, b] = display.tonemap.display8(c, display.exposure);
+                *px = image::Rgba([r, g, b, 255]);
             }
         }
         ImageFormat::Rgba8Unorm if words.len() >= texels => {

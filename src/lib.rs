@@ -8,3 +8,4 @@ pub mod frame;
 pub mod images;
 pub mod runner;
 pub mod tables;
+pub mod tonemap;

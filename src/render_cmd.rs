@@ -4,7 +4,7 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, parse_size, prepare_with};
-use strandgraph::images::{depth_to_view, motion_image, to_linear, to_picture};
+use strandgraph::images::{Display, Tonemap, depth_to_view, motion_image, to_linear, to_picture};
 use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
 use strandgraph_passes::backend::Clock;
@@ -50,6 +50,12 @@ pub struct Args {
     /// Give every transient its own memory instead of the plan's aliasing.
     #[arg(long)]
     pub no_alias: bool,
+    /// The display transform of PNG outputs (EXR stays scene-linear).
+    #[arg(long, value_enum, default_value = "aces")]
+    pub tonemap: Tonemap,
+    /// Exposure in stops, applied before the tone mapper.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
     /// Override a pass parameter, as PASS.PARAM=VALUE (repeatable), e.g.
     /// `--param raster.loop_flattening=false`.
     #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
@@ -127,6 +133,7 @@ pub fn run(args: Args) -> Result<()> {
 struct Extras {
     depth: Option<PathBuf>,
     motion: Option<PathBuf>,
+    display: Display,
 }
 
 impl Extras {
@@ -134,6 +141,10 @@ impl Extras {
         Self {
             depth: args.depth.as_deref().map(|p| tagged(p, tag)),
             motion: args.motion.as_deref().map(|p| tagged(p, tag)),
+            display: Display {
+                tonemap: args.tonemap,
+                exposure: args.exposure,
+            },
         }
     }
 }
@@ -181,7 +192,7 @@ fn write_outputs(
         };
         let saved = match (exr, to_linear(&p.plan, r, &words, q.width, q.height)) {
             (true, Some(img)) => img.save(&path),
-            _ => match to_picture(&p.plan, r, &words, q.width, q.height) {
+            _ => match to_picture(&p.plan, r, &words, q.width, q.height, extras.display) {
                 Some(img) if !exr => img.save(&path),
                 Some(img) => img.save(path.with_extension("png")),
                 None => continue,

@@ -16,7 +16,7 @@
 
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
-use strandgraph::images::to_picture;
+use strandgraph::images::{Display, to_picture};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
 
@@ -63,8 +63,8 @@ fn assert_flip(
     h: u32,
 ) {
     let r = p.plan.graph.resource_id(name).unwrap();
-    let a = to_picture(&p.plan, r, reference.1, w, h).unwrap();
-    let b = to_picture(&p.plan, r, test.1, w, h).unwrap();
+    let a = to_picture(&p.plan, r, reference.1, w, h, Display::CLIP).unwrap();
+    let b = to_picture(&p.plan, r, test.1, w, h, Display::CLIP).unwrap();
     let d = flip(&a, &b).unwrap();
     eprintln!(
         "{name}: {} vs {}: mean FLIP {:.5}, max {:.4} at {:?}",

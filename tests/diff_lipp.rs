@@ -23,7 +23,7 @@
 use std::path::PathBuf;
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
-use strandgraph::images::to_picture;
+use strandgraph::images::{Display, to_picture};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
 
@@ -190,8 +190,8 @@ fn check_flip(p: &Prepared, label: &str, reference: &[u32], test: &[u32]) {
     let label = &format!("{}.{label}", p.plan.graph.name);
     let name = "output.final";
     let r = p.plan.graph.resource_id(name).unwrap();
-    let a = to_picture(&p.plan, r, reference, W, H).unwrap();
-    let b = to_picture(&p.plan, r, test, W, H).unwrap();
+    let a = to_picture(&p.plan, r, reference, W, H, Display::CLIP).unwrap();
+    let b = to_picture(&p.plan, r, test, W, H, Display::CLIP).unwrap();
     let d = flip(&a, &b).unwrap();
     eprintln!(
         "{name} {label}: mean FLIP {:.5}, max {:.4} at {:?}",

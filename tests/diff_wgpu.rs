@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, override_param, prepare};
-use strandgraph::images::to_picture;
+use strandgraph::images::{Display, to_picture};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
 
@@ -44,7 +44,7 @@ fn write_images(p: &Prepared, cpu: &[u32], gpu: &[u32]) -> PathBuf {
     let dir = out_dir();
     let r = p.plan.graph.resource_id("debug_layers").unwrap();
     for (name, words) in [("cpu", cpu), ("wgpu", gpu)] {
-        if let Some(img) = to_picture(&p.plan, r, words, W, H) {
+        if let Some(img) = to_picture(&p.plan, r, words, W, H, Display::CLIP) {
             img.save(dir.join(format!("debug_layers.{name}.png")))
                 .unwrap();
         }
@@ -443,8 +443,8 @@ fn showcase_composed_matches_cpu_on_wgpu() {
     // transcendentals), so single pixels may differ by a few code values.
     let r = p.plan.graph.resource_id(name).unwrap();
     let (cpu_img, gpu_img) = (
-        to_picture(&p.plan, r, &c, w, h).unwrap(),
-        to_picture(&p.plan, r, &g, w, h).unwrap(),
+        to_picture(&p.plan, r, &c, w, h, Display::CLIP).unwrap(),
+        to_picture(&p.plan, r, &g, w, h, Display::CLIP).unwrap(),
     );
     let d = flip(&cpu_img, &gpu_img).unwrap();
     eprintln!(

@@ -22,7 +22,7 @@
 use std::path::Path;
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, override_param, prepare};
-use strandgraph::images::to_picture;
+use strandgraph::images::{Display, to_picture};
 use strandgraph_cpu::CpuBackend;
 
 const W: u32 = 960;
@@ -35,7 +35,7 @@ fn render(p: &Prepared) -> image::RgbaImage {
     let name = "output.final";
     let words = frame.read(&p.plan, name).unwrap();
     let r = p.plan.graph.resource_id(name).unwrap();
-    to_picture(&p.plan, r, &words, W, H).unwrap()
+    to_picture(&p.plan, r, &words, W, H, Display::CLIP).unwrap()
 }
 
 /// The hair's rows and columns: where any of the images differs from the

@@ -9,8 +9,11 @@
 //!   `loaders::*::parse` functions parse bytes and report byte offsets or lines.
 //! - [`Groom`]: structure-of-arrays strands; `shuffled` (Kulikov's stable random strand
 //!   order), `lod_prefix`, `resampled`, `bounds`, `memory_bytes`.
-//! - [`procedural::GroomParams::generate`] grows straight, wavy, curly, long, short,
-//!   ponytail, beard, eyebrow and fur grooms on a [`procedural::Surface`].
+//! - [`procedural::GroomParams::generate`] grows grooms (guides with gravity and head
+//!   collisions, clumped children; straight, wavy, curly, long, bob, short, ponytail,
+//!   bun, beard, eyebrows, eyelashes, fur) on a [`procedural::Surface`], such as the
+//!   sculpted [`procedural::HeadParams`] head.
+//! - [`hair_color`]: melanin and redness to absorption and colour (d'Eon 2011, Chiang 2016).
 //! - [`HairMesh`]: `procedural`, `fit` (k-means bundles), `to_groom`, and
 //!   [`hairmesh::strandgen::strand_point`], the (bundle, uv, w) -> point function (Lipp §2).
 //! - [`skinning::bake`]: `hairRootSkinningInfo_t` records for strand roots (Kulikov).
@@ -20,6 +23,7 @@
 pub mod bounds;
 pub mod error;
 pub mod groom;
+pub mod hair_color;
 pub mod hairmesh;
 pub mod loaders;
 pub mod mesh;

@@ -56,7 +56,9 @@ pub struct ModelData {
     pub fedora_sphere: [f32; 4],
     /// Never draw fewer than this fraction of strands (scene LOD setting).
     pub min_fraction: f32,
-    pub _pad: [u32; 3],
+    /// Cuticle tilt α in radians (the material's `highlight_shift_deg`).
+    pub highlight_shift: f32,
+    pub _pad: [u32; 2],
 }
 
 pub const MODEL_LOD_ENABLED: u32 = 1;

@@ -199,10 +199,7 @@ impl PackedGrooms {
             .map_or(Mat4::IDENTITY, |p| scene.meshes[p].mesh.transform.matrix());
         let rot = glam::Mat3::from_mat4(mesh_rotation);
         let row = |r: usize| [rot.row(r).x, rot.row(r).y, rot.row(r).z, 0.0];
-        let color = g
-            .material
-            .color
-            .unwrap_or_else(|| melanin_color(g.material.melanin.unwrap_or(0.5)));
+        let color = g.material.color();
         let fedora = g.fedora;
         ModelData {
             world: g.world.to_cols_array(),
@@ -234,7 +231,8 @@ impl PackedGrooms {
                 ]
             }),
             min_fraction: g.lod.min_fraction,
-            _pad: [0; 3],
+            highlight_shift: g.material.highlight_shift_deg.to_radians(),
+            _pad: [0; 2],
         }
     }
 
@@ -300,15 +298,6 @@ fn light_data(light: &Light) -> LightData {
             _pad: [0; 8],
         },
     }
-}
-
-/// A display colour for a melanin concentration (0 blond … 1 black), for
-/// visualisations before the shading passes run.
-pub fn melanin_color(melanin: f32) -> [f32; 3] {
-    let m = melanin.clamp(0.0, 1.0);
-    let blond = [0.75, 0.55, 0.30];
-    let black = [0.04, 0.03, 0.02];
-    [0, 1, 2].map(|i| blond[i] + (black[i] - blond[i]) * m.powf(0.5))
 }
 
 /// The packed resource [`bake_shadow_sh`] fills: 4 × f32 per packed vertex.

@@ -45,7 +45,9 @@ struct ModelData {
     fedora_max: vec4<f32>,
     fedora_sphere: vec4<f32>,
     min_fraction: f32,
-    _pad: array<u32, 3>,
+    // Cuticle tilt α, radians (the material's highlight_shift_deg).
+    highlight_shift: f32,
+    _pad: array<u32, 2>,
 }
 
 const MODEL_LOD_ENABLED: u32 = 1u;

@@ -19,7 +19,6 @@
 struct ShadeParams {
     // r, tt, trt scales; scatter (0 = no multiple scattering).
     lobes: vec4<f32>,
-    shift: f32,
     // 0 None, 1 VoxelMarch, 2 Baked.
     self_shadow: u32,
     absorption: f32,
@@ -56,7 +55,7 @@ fn hair_f(cos_theta: f32) -> f32 {
 }
 
 // karis::hair_shading.
-fn hair_shading(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, color: vec3<f32>, roughness: f32, shadow: f32) -> vec3<f32> {
+fn hair_shading(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, color: vec3<f32>, roughness: f32, shift: f32, shadow: f32) -> vec3<f32> {
     let rough = clamp(roughness, 1.0 / 255.0, 1.0);
     let vol = dot(v, l);
     let sin_l = clamp(dot(t, l), -1.0, 1.0);
@@ -67,7 +66,6 @@ fn hair_shading(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, color: vec3<f32>, roug
     let cos_phi = dot(lp, vp) / sqrt(dot(lp, lp) * dot(vp, vp) + 1e-4);
     let cos_half_phi = sqrt(clamp(0.5 + 0.5 * cos_phi, 0.0, 1.0));
     let n_prime = 1.19 / cos_d + 0.36 * cos_d;
-    let shift = params.shift;
     let r2 = rough * rough;
     var s = vec3<f32>(0.0);
     // Karis 2016, R lobe.
@@ -194,7 +192,7 @@ fn shade_vertex(model: u32, vertex: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32
         } else if params.self_shadow == 2u {
             visibility = baked_visibility(groom_shadow_sh[vertex], to_light);
         }
-        out += light.radiance.xyz * falloff * hair_shading(t, v, to_light, color, md.color.w, visibility);
+        out += light.radiance.xyz * falloff * hair_shading(t, v, to_light, color, md.color.w, md.highlight_shift, visibility);
     }
     return out;
 }

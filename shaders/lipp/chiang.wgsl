@@ -10,12 +10,15 @@
 
 const ETA: f32 = 1.55;
 
-// chiang::TILT: sin 2kα, cos 2kα of the cuticle tilt of θ_o and v_p / v_0.
-const TILT: array<vec3<f32>, 3> = array<vec3<f32>, 3>(
-    vec3<f32>(-0.06975647, 0.9975641, 1.0),
-    vec3<f32>(0.0348995, 0.9993908, 0.25),
-    vec3<f32>(0.1391731, 0.99026805, 4.0),
-);
+// chiang::tilt: sin, cos of the cuticle tilt of θ_o (R −2α, TT α, TRT 4α)
+// and v_p / v_0.
+fn tilt(alpha: f32) -> array<vec3<f32>, 3> {
+    return array<vec3<f32>, 3>(
+        vec3<f32>(sin(-2.0 * alpha), cos(-2.0 * alpha), 1.0),
+        vec3<f32>(sin(alpha), cos(alpha), 0.25),
+        vec3<f32>(sin(4.0 * alpha), cos(4.0 * alpha), 4.0),
+    );
+}
 
 // chiang::H_NODES: (h, γ, cos γ).
 const NODES: u32 = 5u;
@@ -135,7 +138,7 @@ fn reflected_albedo(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> vec4<f32
 }
 
 // chiang::chiang: R + TT + TRT, pbrt's f · |cos| averaged over h.
-fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
+fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> vec3<f32> {
     let sin_i = clamp(dot(t, l), -1.0, 1.0);
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
     let cos_i = sqrt(max(1.0 - sin_i * sin_i, 0.0));
@@ -148,10 +151,10 @@ fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness:
     let x0 = 0.726 * b + 0.812 * b * b + 3.7 * pow(b, 20.0);
     let v0 = x0 * x0;
     let s = 0.626657 * (0.265 * b + 1.194 * b * b + 5.372 * pow(b, 22.0));
-    var tilt = TILT;
+    var tilts = tilt(alpha);
     var mps = array<f32, 3>(0.0, 0.0, 0.0);
     for (var p = 0u; p < 3u; p++) {
-        let k = tilt[p];
+        let k = tilts[p];
         let sin_p = sin_o * k.y + cos_o * k.x;
         let cos_p = abs(cos_o * k.y - sin_o * k.x);
         mps[p] = mp(cos_i, cos_p, sin_i, sin_p, k.z * v0);

@@ -101,12 +101,11 @@ struct ProbeLobe {
 }
 
 // probe::specular_lobe: one GGX lobe for R + TRT.
-fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32) -> ProbeLobe {
+fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> ProbeLobe {
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
     let bm = clamp(roughness, 0.02, 1.0);
     let x0 = 0.726 * bm + 0.812 * bm * bm + 3.7 * pow(bm, 20.0);
     let v0 = x0 * x0;
-    let alpha = radians(2.0);
     let albedo = reflected_albedo(sin_o, color, roughness);
     let w_r = albedo.x;
     let a_trt = albedo.yzw;

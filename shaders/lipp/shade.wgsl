@@ -120,8 +120,8 @@ fn probe_level(k: u32, d: vec3<f32>) -> vec3<f32> {
 }
 
 // probe::specular: the R + TRT stand-in lobe's prefiltered radiance, weighted.
-fn probe_specular(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32) -> vec3<f32> {
-    let lobe = probe_lobe(t, v, n, color, roughness);
+fn probe_specular(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> vec3<f32> {
+    let lobe = probe_lobe(t, v, n, color, roughness, alpha);
     let lod = probe_alpha_lod(lobe.alpha);
     let k0 = min(u32(floor(lod)), PROBE_LEVELS - 1u);
     let k1 = min(k0 + 1u, PROBE_LEVELS - 1u);
@@ -141,6 +141,7 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
     let c = models[params.model_index].color;
     let color = clamp(c.xyz * vary, vec3<f32>(0.0), vec3<f32>(1.0));
     let roughness = c.w;
+    let alpha = models[params.model_index].highlight_shift;
     var out = vec3<f32>(0.0);
     let count = min(frame.light_count, arrayLength(&lipp_dom::lights));
     for (var i = 0u; i < count; i++) {
@@ -161,7 +162,7 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
             shadow = dom_transmittance(i, pos, delta);
         }
         let rad = lipp_dom::lights[i].radiance.xyz * atten * shadow;
-        var f = chiang(t, l, v, color, roughness) * params.specular;
+        var f = chiang(t, l, v, color, roughness, alpha) * params.specular;
         if params.multiple_scattering != 0u {
             let sin_tl = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
             f += color * (sin_tl / PI);
@@ -173,7 +174,7 @@ fn shade_sample(s: Sample, x: u32, y: u32) -> vec3<f32> {
         let e = max(sh_irradiance(n), vec3<f32>(0.0));
         var spec = vec3<f32>(0.0);
         if params.probe_specular != 0u {
-            spec = probe_specular(t, v, n, color, roughness);
+            spec = probe_specular(t, v, n, color, roughness, alpha);
         }
         out += (e / PI * color + spec * params.specular) * s.ao;
     }

@@ -1,5 +1,5 @@
 //! Fitting a hair mesh to a strand groom: cluster strands into bundles by k-means on root
-//! positions, then fit each bundle's layers to the strands' cross-sections (centre and
+//! positions and the strands' direction, then fit each bundle's layers to the strands' cross-sections (centre and
 //! principal axes of the points at each w).
 
 use glam::{Vec2, Vec3};
@@ -53,8 +53,16 @@ impl HairMesh {
     pub fn fit(groom: &Groom, params: &HairMeshParams) -> HairMesh {
         let layers = params.layers.max(2) as usize;
         let resampled = groom.resampled(layers);
-        let roots = resampled.roots();
-        let assign = kmeans(&roots, params.bundles as usize, 10, params.seed, 20_000);
+        // Cluster on the root and the point a third of the way along: strands
+        // planted side by side but combed apart (at a parting) land in
+        // different bundles, so no bundle spans both ways.
+        let features: Vec<Vec3> = (0..resampled.strand_count())
+            .map(|s| {
+                let p = resampled.strand(s);
+                (p[0] + p[p.len() / 3]) * 0.5
+            })
+            .collect();
+        let assign = kmeans(&features, params.bundles as usize, 10, params.seed, 20_000);
         let k = assign.iter().copied().max().map_or(0, |m| m as usize + 1);
         let mut members: Vec<Vec<usize>> = vec![Vec::new(); k];
         for (s, &a) in assign.iter().enumerate() {

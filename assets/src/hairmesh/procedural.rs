@@ -18,13 +18,10 @@ impl HairMesh {
     ) -> HairMesh {
         let layers = params.layers.max(2);
         let guides = GroomParams {
-            strands: params.bundles.max(1),
-            points: layers,
             seed: guide.seed ^ params.seed,
             ..*guide
         }
-        .generate(surface)
-        .groom;
+        .guides(surface, params.bundles.max(1), layers);
         let count = guides.strand_count().max(1);
         // Bundle size from the area each bundle covers.
         let area: f32 = (0..surface.mesh.triangle_count())

@@ -1,6 +1,8 @@
-//! Parametric groom generators: straight, wavy, curly (helical), long with gravity,
-//! short, ponytail, facial hair (beard, eyebrows) and fur. Strands are grown in parallel,
-//! each from its own seeded generator, so the output does not depend on thread count.
+//! The groom generator: guides grown on the head (`guides`), children
+//! interpolated around them (`children`), with a style's defaults (`styles`)
+//! and any of them overridden from the scene. Strands are grown in parallel,
+//! each from its own seeded generator, so the output does not depend on
+//! thread count.
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
@@ -8,25 +10,17 @@ use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::children::{self, Guide, RootGrid};
+use super::guides;
+use super::styles::Resolved;
+pub use super::styles::Style;
 pub use super::surface::Region;
 use super::surface::{Surface, sample_triangle};
 use crate::groom::Groom;
 use crate::skinning::RootSkinningInfo;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Style {
-    Straight,
-    Wavy,
-    Curly,
-    Long,
-    Short,
-    Ponytail,
-    Beard,
-    Eyebrows,
-    Fur,
-}
-
-/// Generator parameters; fields left `None` take the style's defaults.
+/// Generator parameters; fields left `None` take the style's defaults
+/// (`styles.rs`). Lengths are metres.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GroomParams {
@@ -35,23 +29,35 @@ pub struct GroomParams {
     pub points: u32,
     pub seed: u64,
     pub region: Option<Region>,
-    /// Strand length in metres.
     pub length: Option<f32>,
-    /// Relative random variation of the length (0.2 = +-20%).
+    /// Up to this fraction shorter, at random (0.2 = 20%).
     pub length_variation: Option<f32>,
-    /// Diameter at root and tip, metres.
+    /// Diameter at root and tip.
     pub root_thickness: Option<f32>,
     pub tip_thickness: Option<f32>,
-    /// 0 = strands grow along the normal, 1 = they fall straight down.
+    /// Curvature towards the ground, radians per metre (0 = stiff).
     pub gravity: Option<f32>,
-    /// Wave amplitude (m) and waves per metre.
+    /// Wave amplitude and waves per metre.
     pub wave_amplitude: Option<f32>,
     pub wave_frequency: Option<f32>,
-    /// Helix radius (m) and turns per metre.
+    /// Helix radius and turns per metre.
     pub curl_radius: Option<f32>,
     pub curl_frequency: Option<f32>,
-    /// Random low-frequency offset amplitude (m).
-    pub noise: Option<f32>,
+    /// Random displacement at the tips.
+    pub frizz: Option<f32>,
+    /// Fraction of strands that leave their clump.
+    pub stray_fraction: Option<f32>,
+    /// Pull of children to their guide at the tip, 0..=1, and the profile's exponent.
+    pub clump: Option<f32>,
+    pub clump_profile: Option<f32>,
+    /// Strands per guide (1 = every strand its own guide).
+    pub strands_per_guide: Option<u32>,
+    /// The parting's x (head frame) for the parted styles.
+    pub parting: Option<f32>,
+    /// Height (head frame) below which strands are cut.
+    pub cut_height: Option<f32>,
+    /// How high the hair stands off the skull.
+    pub volume: Option<f32>,
 }
 
 impl Default for GroomParams {
@@ -71,55 +77,48 @@ impl Default for GroomParams {
             wave_frequency: None,
             curl_radius: None,
             curl_frequency: None,
-            noise: None,
+            frizz: None,
+            stray_fraction: None,
+            clump: None,
+            clump_profile: None,
+            strands_per_guide: None,
+            parting: None,
+            cut_height: None,
+            volume: None,
         }
     }
 }
 
-/// Fully resolved parameters.
-#[derive(Debug, Clone, Copy)]
-struct Resolved {
-    region: Region,
-    length: f32,
-    length_variation: f32,
-    root_thickness: f32,
-    tip_thickness: f32,
-    gravity: f32,
-    wave_amplitude: f32,
-    wave_frequency: f32,
-    curl_radius: f32,
-    curl_frequency: f32,
-    noise: f32,
-}
-
 impl GroomParams {
     fn resolve(&self) -> Resolved {
-        use Style::*;
-        // (region, length, gravity, wave amp, wave freq, curl r, curl freq, root thickness)
-        let (region, length, gravity, wa, wf, cr, cf, th) = match self.style {
-            Straight => (Region::Scalp, 0.25, 0.8, 0.0, 0.0, 0.0, 0.0, 70e-6),
-            Wavy => (Region::Scalp, 0.3, 0.8, 0.012, 9.0, 0.0, 0.0, 70e-6),
-            Curly => (Region::Scalp, 0.2, 0.5, 0.0, 0.0, 0.008, 25.0, 80e-6),
-            Long => (Region::Scalp, 0.45, 1.0, 0.003, 4.0, 0.0, 0.0, 70e-6),
-            Short => (Region::Scalp, 0.04, 0.35, 0.0, 0.0, 0.0, 0.0, 80e-6),
-            Ponytail => (Region::Scalp, 0.4, 1.0, 0.004, 5.0, 0.0, 0.0, 70e-6),
-            Beard => (Region::Beard, 0.025, 0.6, 0.0, 0.0, 0.002, 60.0, 100e-6),
-            Eyebrows => (Region::Eyebrows, 0.011, 0.1, 0.0, 0.0, 0.0, 0.0, 90e-6),
-            Fur => (Region::Everywhere, 0.02, 0.4, 0.0, 0.0, 0.0, 0.0, 60e-6),
-        };
-        let root_thickness = self.root_thickness.unwrap_or(th);
+        let d = self.style.defaults();
+        let or = |v: Option<f32>, default: f32| v.unwrap_or(default);
+        let root_thickness = or(self.root_thickness, d.root_thickness);
         Resolved {
-            region: self.region.unwrap_or(region),
-            length: self.length.unwrap_or(length),
-            length_variation: self.length_variation.unwrap_or(0.15),
+            region: self.region.unwrap_or(d.region),
+            length: or(self.length, d.length),
+            length_variation: or(self.length_variation, d.length_variation),
             root_thickness,
-            tip_thickness: self.tip_thickness.unwrap_or(root_thickness * 0.3),
-            gravity: self.gravity.unwrap_or(gravity),
-            wave_amplitude: self.wave_amplitude.unwrap_or(wa),
-            wave_frequency: self.wave_frequency.unwrap_or(wf),
-            curl_radius: self.curl_radius.unwrap_or(cr),
-            curl_frequency: self.curl_frequency.unwrap_or(cf),
-            noise: self.noise.unwrap_or(0.002),
+            tip_thickness: self
+                .tip_thickness
+                .unwrap_or(d.tip_thickness * root_thickness / d.root_thickness),
+            gravity: or(self.gravity, d.gravity),
+            wave_amplitude: or(self.wave_amplitude, d.wave_amplitude),
+            wave_frequency: or(self.wave_frequency, d.wave_frequency),
+            curl_radius: or(self.curl_radius, d.curl_radius),
+            curl_frequency: or(self.curl_frequency, d.curl_frequency),
+            frizz: or(self.frizz, d.frizz),
+            stray_fraction: or(self.stray_fraction, d.stray_fraction),
+            clump: or(self.clump, d.clump),
+            clump_profile: or(self.clump_profile, d.clump_profile),
+            strands_per_guide: self.strands_per_guide.unwrap_or(d.strands_per_guide),
+            comb: match (d.comb, self.parting) {
+                (super::styles::Comb::Parted(_), Some(x)) => super::styles::Comb::Parted(x),
+                (c, _) => c,
+            },
+            cut_height: self.cut_height.or(d.cut_height),
+            volume: or(self.volume, d.volume),
+            ..d
         }
     }
 
@@ -135,10 +134,67 @@ impl GroomParams {
             return Err(format!("points = {} must be in 2..=1024", self.points));
         }
         let r = self.resolve();
-        if !(r.length > 0.0 && r.length.is_finite()) {
-            return Err("length must be positive".into());
+        let checks = [
+            ("length", r.length > 0.0 && r.length < 10.0),
+            (
+                "length_variation",
+                (0.0..=0.95).contains(&r.length_variation),
+            ),
+            (
+                "root_thickness",
+                r.root_thickness > 0.0 && r.root_thickness < 0.01,
+            ),
+            (
+                "tip_thickness",
+                r.tip_thickness > 0.0 && r.tip_thickness < 0.01,
+            ),
+            ("gravity", (0.0..=1000.0).contains(&r.gravity)),
+            ("wave_amplitude", (0.0..=0.2).contains(&r.wave_amplitude)),
+            ("wave_frequency", (0.0..=1000.0).contains(&r.wave_frequency)),
+            ("curl_radius", (0.0..=0.2).contains(&r.curl_radius)),
+            ("curl_frequency", (0.0..=1000.0).contains(&r.curl_frequency)),
+            ("frizz", (0.0..=0.1).contains(&r.frizz)),
+            ("stray_fraction", (0.0..=1.0).contains(&r.stray_fraction)),
+            ("clump", (0.0..=1.0).contains(&r.clump)),
+            (
+                "clump_profile",
+                r.clump_profile > 0.0 && r.clump_profile <= 20.0,
+            ),
+            (
+                "strands_per_guide",
+                (1..=100_000).contains(&r.strands_per_guide),
+            ),
+            ("volume", (0.0..=0.2).contains(&r.volume)),
+        ];
+        match checks.iter().find(|(_, ok)| !ok) {
+            // NaN fails every range check too.
+            Some((name, _)) => Err(format!("{name} is out of range")),
+            None => Ok(()),
         }
-        Ok(())
+    }
+
+    /// Grows `count` guides with `points` points each (the hair mesh's bundles).
+    pub fn guides(&self, surface: &Surface, count: u32, points: u32) -> Groom {
+        let r = self.resolve();
+        let cdf = surface.region_cdf(r.region);
+        let n = points.max(2) as usize;
+        let grown: Vec<Vec<Vec3>> = (0..count as u64)
+            .into_par_iter()
+            .filter_map(|i| {
+                let mut rng = strand_rng(self.seed ^ 0x6a09_e667, i);
+                let (root, normal, _) = plant(surface, &cdf, &mut rng)?;
+                Some(guides::grow(surface, &r, root, normal, &mut rng).resampled(n))
+            })
+            .collect();
+        let thickness = (0..grown.len() * n)
+            .map(|i| children::thickness(&r, (i % n) as f32 / (n - 1) as f32))
+            .collect();
+        Groom {
+            strand_offsets: (0..=grown.len()).map(|s| (s * n) as u32).collect(),
+            positions: grown.concat(),
+            thickness,
+            ..Default::default()
+        }
     }
 
     /// Grows the groom on `surface` in the surface's local space.
@@ -151,32 +207,65 @@ impl GroomParams {
         } else {
             0
         };
+        // Children's roots, planted first: with one strand per guide, each
+        // root grows its own guide.
+        let roots: Vec<_> = (0..count as u64)
+            .into_par_iter()
+            .map(|s| {
+                let mut rng = strand_rng(self.seed, s);
+                plant(surface, &cdf, &mut rng).map(|p| (p, rng))
+            })
+            .collect();
+        let per_guide = r.strands_per_guide.max(1) as usize;
+        let guide_count = if per_guide == 1 {
+            count
+        } else {
+            (count / per_guide).max(16)
+        };
+        let guides: Vec<Guide> = (0..guide_count as u64)
+            .into_par_iter()
+            .map(|g| {
+                let mut rng = strand_rng(self.seed ^ 0x6a09_e667, g);
+                let planted = if per_guide == 1 {
+                    roots[g as usize].as_ref().map(|(p, _)| *p)
+                } else {
+                    plant(surface, &cdf, &mut rng)
+                };
+                let (root, normal, _) = planted.unwrap_or((surface.center, Vec3::Y, (0, Vec3::X)));
+                Guide {
+                    path: guides::grow(surface, &r, root, normal, &mut rng),
+                    phase: rng.random::<f32>() * std::f32::consts::TAU,
+                }
+            })
+            .collect();
+        // Guide spacing from the region's area (the CDF's total).
+        let area = cdf.last().copied().unwrap_or(0.0);
+        let spacing = (area / guide_count.max(1) as f32).sqrt().max(1e-4);
+        let grid = RootGrid::new(
+            guides.iter().map(|g| g.path.points[0]).collect(),
+            spacing * 2.0,
+        );
         let mut positions = vec![Vec3::ZERO; count * n];
         let mut skinning = vec![RootSkinningInfo::default(); count];
-        let seed = self.seed;
-        let style = self.style;
         positions
             .par_chunks_mut(n)
             .zip(skinning.par_iter_mut())
+            .zip(roots.into_par_iter())
             .enumerate()
-            .for_each(|(s, (out, skin))| {
-                let mut rng =
-                    Pcg64Mcg::seed_from_u64(seed ^ (s as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-                let Some((tri, bary)) =
-                    sample_triangle(&cdf, rng.random(), rng.random(), rng.random())
-                else {
+            .for_each(|(s, ((out, skin), planted))| {
+                let Some(((root, _, (tri, bary)), mut rng)) = planted else {
                     return;
                 };
                 *skin = RootSkinningInfo::new(&surface.mesh, tri, bary);
-                let root = surface.point(tri, bary);
-                let normal = surface.normal(tri, bary);
-                grow(surface, style, &r, root, normal, &mut rng, out);
+                let g = if per_guide == 1 {
+                    s as u32
+                } else {
+                    grid.nearest(root).unwrap_or(0)
+                };
+                children::grow(surface, &r, &guides[g as usize], root, &mut rng, out);
             });
         let thickness = (0..count * n)
-            .map(|i| {
-                let t = (i % n) as f32 / (n - 1) as f32;
-                r.root_thickness + (r.tip_thickness - r.root_thickness) * t
-            })
+            .map(|i| children::thickness(&r, (i % n) as f32 / (n - 1) as f32))
             .collect();
         GeneratedGroom {
             groom: Groom {
@@ -188,6 +277,23 @@ impl GroomParams {
             skinning,
         }
     }
+}
+
+/// Strand `i`'s own generator.
+fn strand_rng(seed: u64, i: u64) -> Pcg64Mcg {
+    Pcg64Mcg::seed_from_u64(seed ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
+/// A root planted in the region: position, smooth normal, (triangle, barycentrics).
+type Planted = (Vec3, Vec3, (u32, Vec3));
+
+fn plant(surface: &Surface, cdf: &[f32], rng: &mut Pcg64Mcg) -> Option<Planted> {
+    let (tri, bary) = sample_triangle(cdf, rng.random(), rng.random(), rng.random())?;
+    Some((
+        surface.point(tri, bary),
+        surface.normal(tri, bary),
+        (tri, bary),
+    ))
 }
 
 /// A generated groom and the skinning record of every root on its parent mesh.
@@ -202,91 +308,6 @@ pub fn perpendiculars(t: Vec3) -> (Vec3, Vec3) {
     (a, t.cross(a))
 }
 
-/// Grows one strand into `out` (first point = root, exactly on the surface).
-fn grow(
-    surface: &Surface,
-    style: Style,
-    r: &Resolved,
-    root: Vec3,
-    normal: Vec3,
-    rng: &mut Pcg64Mcg,
-    out: &mut [Vec3],
-) {
-    let n = out.len();
-    let length = r.length * (1.0 + r.length_variation * (2.0 * rng.random::<f32>() - 1.0));
-    let step = length / (n - 1) as f32;
-    let down = -Vec3::Y;
-    // Comb direction: tangential, towards the back and down, or towards the temples for brows.
-    let comb_world = match style {
-        Style::Eyebrows => Vec3::new((root - surface.center).x.signum(), 0.25, 0.0),
-        Style::Beard => Vec3::new(0.0, -1.0, 0.2),
-        _ => Vec3::new(0.0, -0.6, -1.0),
-    };
-    let comb = comb_world.reject_from(normal).normalize_or_zero();
-    let lift = match style {
-        Style::Eyebrows => 0.25,
-        Style::Fur | Style::Short => 0.7,
-        Style::Beard => 0.5,
-        _ => 0.9,
-    };
-    let tie = surface.center + Vec3::new(0.0, 0.04, -0.125);
-    let tie_offset = {
-        let (a, b) = perpendiculars(Vec3::new(0.0, -0.9, -0.4).normalize());
-        let (ang, rad) = (
-            rng.random::<f32>() * std::f32::consts::TAU,
-            rng.random::<f32>().sqrt() * 0.018,
-        );
-        (a * ang.cos() + b * ang.sin()) * rad
-    };
-    let phase = rng.random::<f32>() * std::f32::consts::TAU;
-    let noise_dir = Vec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - Vec3::ONE;
-    let noise_freq = 3.0 + 4.0 * rng.random::<f32>();
-    let margin = 0.0015;
-
-    // Base path: direction blends from the lifted normal to gravity along the strand.
-    let mut base = Vec::with_capacity(n);
-    base.push(root);
-    let mut p = root;
-    let to_tie = (tie - root).length();
-    for i in 1..n {
-        let t = i as f32 / (n - 1) as f32;
-        let s = t * length;
-        let dir = if style == Style::Ponytail && s < to_tie {
-            (tie + tie_offset - p).normalize_or_zero() * 0.7 + normal * 0.3 * (1.0 - s / to_tie)
-        } else if style == Style::Ponytail {
-            Vec3::new(0.0, -0.9, -0.35)
-        } else {
-            let g = (r.gravity * (0.35 + t)).min(1.0);
-            let start = (normal * lift + comb * (1.0 - lift)).normalize_or_zero();
-            start.lerp(down, g)
-        };
-        p += dir.normalize_or_zero() * step;
-        p = surface.push_out(p, margin * (1.0 + 2.0 * t));
-        base.push(p);
-    }
-
-    // Styling offsets perpendicular to the path, ramped in from the root.
-    out[0] = root;
-    for i in 1..n {
-        let t = i as f32 / (n - 1) as f32;
-        let s = t * length;
-        let tangent = (base[i] - base[i - 1]).normalize_or_zero();
-        let (b1, b2) = perpendiculars(tangent);
-        let ramp = (s / (0.1 * length).max(1e-4)).min(1.0);
-        let mut off = Vec3::ZERO;
-        if r.wave_amplitude > 0.0 {
-            off += b1
-                * (r.wave_amplitude * (std::f32::consts::TAU * r.wave_frequency * s + phase).sin());
-        }
-        if r.curl_radius > 0.0 {
-            let a = std::f32::consts::TAU * r.curl_frequency * s + phase;
-            off += (b1 * a.cos() + b2 * a.sin()) * r.curl_radius;
-        }
-        off += noise_dir * (r.noise * (noise_freq * s + phase).sin() * t);
-        out[i] = surface.push_out(base[i] + off * ramp, margin);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,49 +315,64 @@ mod tests {
     use crate::procedural::head::{BodyParams, HeadParams};
     use crate::procedural::surface::Shape;
 
-    fn outside_mesh_everywhere(surface: &Surface, g: &Groom) {
+    fn head() -> Surface {
+        Surface::procedural(Shape::Head(HeadParams {
+            resolution: 128,
+            ..Default::default()
+        }))
+    }
+
+    /// Roots on the mesh; every later point outside the shape (by its
+    /// distance field, to half the skin margin).
+    fn planted_and_outside(surface: &Surface, g: &Groom) {
         let bvh = Bvh::new(&surface.mesh);
+        let shape = surface.shape.unwrap();
         for s in (0..g.strand_count()).step_by(7) {
             let pts = g.strand(s);
-            // The root lies on the mesh surface...
             let hit = bvh.closest(pts[0]).unwrap();
             assert!(
                 hit.distance_squared.sqrt() < 1e-5,
                 "root {s} is off the surface"
             );
-            // ...and no later point is inside the mesh.
             for (i, &p) in pts.iter().enumerate().skip(1) {
-                let h = bvh.closest(p).unwrap();
-                let n = surface.mesh.face_normal(h.triangle as usize);
-                let outside = (p - h.point).dot(n) >= -1e-6;
-                assert!(outside, "strand {s} point {i} is inside the mesh");
+                let d = shape.distance(p - surface.center);
+                assert!(
+                    d > 0.5 * guides::SKIN_MARGIN,
+                    "strand {s} point {i} at {p} is {d} from the skin"
+                );
             }
         }
     }
 
+    const HEAD_STYLES: [Style; 11] = [
+        Style::Straight,
+        Style::Wavy,
+        Style::Curly,
+        Style::Long,
+        Style::Bob,
+        Style::Short,
+        Style::Ponytail,
+        Style::Bun,
+        Style::Beard,
+        Style::Eyebrows,
+        Style::Eyelashes,
+    ];
+
     #[test]
-    fn every_style_starts_on_the_surface_and_stays_outside() {
-        let head = Surface::procedural(Shape::Head(HeadParams::default()));
-        for style in [
-            Style::Straight,
-            Style::Wavy,
-            Style::Curly,
-            Style::Long,
-            Style::Short,
-            Style::Ponytail,
-            Style::Beard,
-            Style::Eyebrows,
-        ] {
+    fn every_style_starts_on_the_skin_and_stays_outside() {
+        let head = head();
+        for style in HEAD_STYLES {
             let p = GroomParams {
                 style,
                 strands: 700,
                 points: 16,
                 ..Default::default()
             };
+            p.validate().unwrap();
             let g = p.generate(&head);
             assert_eq!(g.groom.strand_count(), 700, "{style:?}");
             g.groom.validate().unwrap();
-            outside_mesh_everywhere(&head, &g.groom);
+            planted_and_outside(&head, &g.groom);
         }
         let body = Surface::procedural(Shape::Body(BodyParams::default()));
         let g = GroomParams {
@@ -346,12 +382,12 @@ mod tests {
             ..Default::default()
         }
         .generate(&body);
-        outside_mesh_everywhere(&body, &g.groom);
+        planted_and_outside(&body, &g.groom);
     }
 
     #[test]
     fn generation_is_deterministic_and_seeded() {
-        let head = Surface::procedural(Shape::Head(HeadParams::default()));
+        let head = head();
         let p = GroomParams {
             strands: 300,
             ..Default::default()
@@ -361,39 +397,107 @@ mod tests {
         assert_ne!(p.generate(&head).groom, q.generate(&head).groom);
     }
 
+    fn grow(style: Style, strands: u32) -> Groom {
+        GroomParams {
+            style,
+            strands,
+            points: 16,
+            ..Default::default()
+        }
+        .generate(&head())
+        .groom
+    }
+
     #[test]
     fn regions_are_where_they_should_be() {
-        let head = Surface::procedural(Shape::Head(HeadParams::default()));
-        let beard = GroomParams {
-            style: Style::Beard,
-            strands: 500,
-            points: 4,
-            ..Default::default()
+        let beard = grow(Style::Beard, 500);
+        assert!(beard.roots().iter().all(|r| r.z > 0.0 && r.y < -0.02));
+        let brows = grow(Style::Eyebrows, 500);
+        // Roots lie in triangles whose centres are in the region: allow a cell.
+        assert!(
+            brows
+                .roots()
+                .iter()
+                .all(|r| r.z > 0.06 && r.y > 0.017 && r.y < 0.045)
+        );
+        let lashes = grow(Style::Eyelashes, 200);
+        assert!(
+            lashes
+                .roots()
+                .iter()
+                .all(|r| r.z > 0.075 && (r.y - 0.01).abs() < 0.01)
+        );
+        // Scalp hair: none on the face (below the hairline, in front of the ears).
+        let scalp = grow(Style::Short, 3000);
+        assert!(
+            !scalp.roots().iter().any(|r| r.z > 0.06 && r.y < 0.06),
+            "hair on the forehead"
+        );
+    }
+
+    #[test]
+    fn long_hair_frames_the_face_and_falls_onto_the_shoulders() {
+        let g = grow(Style::Long, 3000);
+        // Nothing hangs in front of the face: no point within the face's box.
+        for p in &g.positions {
+            let in_face = p.x.abs() < 0.04 && p.y < 0.04 && p.y > -0.11 && p.z > 0.05;
+            assert!(!in_face, "{p} hangs in front of the face");
         }
-        .generate(&head);
-        assert!(beard.groom.roots().iter().all(|r| r.z > 0.0 && r.y < 0.0));
-        let brows = GroomParams {
-            style: Style::Eyebrows,
-            strands: 500,
-            points: 4,
+        // Tips reach below the shoulders' top and some lie in front of them.
+        let tips: Vec<Vec3> = (0..g.strand_count())
+            .map(|s| *g.strand(s).last().unwrap())
+            .collect();
+        assert!(tips.iter().filter(|t| t.y < -0.3).count() > tips.len() / 3);
+        assert!(
+            tips.iter().any(|t| t.z > 0.03 && t.x.abs() > 0.1),
+            "none over the shoulders"
+        );
+    }
+
+    #[test]
+    fn curls_coil_and_bobs_are_cut_level() {
+        // Curly strands are much longer than the distance root to tip.
+        let curly = grow(Style::Curly, 300);
+        let ratio: f32 = (0..curly.strand_count())
+            .map(|s| {
+                let p = curly.strand(s);
+                let arc: f32 = p.windows(2).map(|w| w[0].distance(w[1])).sum();
+                arc / p[0].distance(*p.last().unwrap())
+            })
+            .sum::<f32>()
+            / curly.strand_count() as f32;
+        assert!(ratio > 1.3, "curls: arc/chord {ratio}");
+        let bob = grow(Style::Bob, 1000);
+        // Cut level: no tip far below the cut, most tips near it.
+        let lowest = bob
+            .positions
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::INFINITY, f32::min);
+        assert!(lowest > -0.11, "bob below its cut: {lowest}");
+        let level = (0..bob.strand_count())
+            .filter(|&s| bob.strand(s).last().unwrap().y < -0.08)
+            .count();
+        assert!(level > bob.strand_count() / 2, "{level} tips at the cut");
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        let p = GroomParams {
+            clump: Some(2.0),
             ..Default::default()
-        }
-        .generate(&head);
-        assert!(brows.groom.roots().iter().all(|r| r.z > 0.05 && r.y > 0.0));
-        let scalp = GroomParams {
-            strands: 500,
-            points: 4,
+        };
+        assert_eq!(p.validate().unwrap_err(), "clump is out of range");
+        let p = GroomParams {
+            length: Some(f32::NAN),
             ..Default::default()
-        }
-        .generate(&head);
-        // Long strands fall below the roots.
-        let b = scalp.groom.bounds();
-        assert!(b.min.y < -0.05, "{b:?}");
+        };
+        assert_eq!(p.validate().unwrap_err(), "length is out of range");
     }
 
     #[test]
     fn lipp_sized_groom_130k_by_32() {
-        let head = Surface::procedural(Shape::Head(HeadParams::default()));
+        let head = head();
         let t = std::time::Instant::now();
         let g = GroomParams {
             style: Style::Long,

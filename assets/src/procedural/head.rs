@@ -1,77 +1,148 @@
-//! Procedural head (a deformed ellipsoid with a neck) and body (a deformed ellipsoid),
-//! both star-shaped about their origin so that `radial(direction)` gives the surface and
-//! an exact outside test.
+//! The procedural head, a signed-distance sculpt (skull, brow, eye sockets
+//! with eyes, nose, lips, jaw, ears, neck and shoulders) meshed with Surface
+//! Nets, and the furry body, a star-shaped deformed ellipsoid whose
+//! `radial(direction)` gives its surface.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::sdf::{capsule, ellipsoid, mesh_sdf, smax, smin, sphere};
 use crate::mesh::TriMesh;
 use crate::transform::Transform;
-
-/// Polynomial smooth minimum (Quilez).
-pub fn smin(a: f32, b: f32, k: f32) -> f32 {
-    let h = (k - (a - b).abs()).max(0.0) / k;
-    a.min(b) - h * h * k * 0.25
-}
-pub fn smax(a: f32, b: f32, k: f32) -> f32 {
-    -smin(-a, -b, k)
-}
 
 /// Radius of the ellipsoid with semi-axes `s` along unit direction `d`.
 fn ellipsoid_radial(d: Vec3, s: Vec3) -> f32 {
     1.0 / (d / s).length()
 }
 
-/// A head in metres: y up, +z forward (the face), origin at the head's centre.
+/// A human head in metres: y up, +z forward (the face), origin at the head's
+/// centre (between the ears, at eye height); the crown is 0.12 m above it and
+/// the chin 0.11 m below. Proportions follow the classical canon: eyes
+/// halfway between crown and chin, the nose's base and the brow dividing the
+/// face into thirds, ears between brow and nose base.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HeadParams {
-    /// Half width (x), half height above and below the centre (y), half depth (z).
-    pub half_width: f32,
-    pub half_height_top: f32,
-    pub half_height_bottom: f32,
-    pub half_depth: f32,
-    pub neck_radius: f32,
-    /// How far the neck reaches below the centre.
-    pub neck_length: f32,
-    /// Longitude segments; latitude rings are 3/4 of this.
+    /// Surface Nets cells along the bust's height (0.555 m with shoulders,
+    /// 0.395 m without): 192 gives cells of 2.9 mm.
     pub resolution: u32,
+    /// Add a neck base, shoulders and upper chest for hair to fall onto.
+    pub shoulders: bool,
 }
 
 impl Default for HeadParams {
     fn default() -> Self {
         HeadParams {
-            half_width: 0.076,
-            half_height_top: 0.112,
-            half_height_bottom: 0.1,
-            half_depth: 0.098,
-            neck_radius: 0.054,
-            neck_length: 0.26,
-            resolution: 128,
+            resolution: 192,
+            shoulders: true,
         }
     }
 }
 
+fn v(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+/// Where the eyes are (the right one; the left mirrors x).
+pub const EYE_CENTRE: Vec3 = Vec3::new(0.032, 0.004, 0.073);
+pub const EYE_RADIUS: f32 = 0.0125;
+
 impl HeadParams {
-    /// Distance from the origin to the surface along unit direction `d`.
-    pub fn radial(&self, d: Vec3) -> f32 {
-        let hy = if d.y >= 0.0 {
-            self.half_height_top
+    /// The sculpt's signed distance (metres, negative inside).
+    pub fn sdf(&self, p: Vec3) -> f32 {
+        // Mirror for the paired features (ears, eyes, cheeks, jaw).
+        let q = v(p.x.abs(), p.y, p.z);
+        // Cranium and the face's mass.
+        let mut d = ellipsoid(p - v(0.0, 0.024, -0.012), v(0.077, 0.096, 0.1));
+        d = smin(
+            d,
+            ellipsoid(p - v(0.0, -0.035, 0.02), v(0.063, 0.08, 0.075)),
+            0.03,
+        );
+        // Jaw: from the angle below the ear to the chin, and the chin itself.
+        d = smin(
+            d,
+            capsule(q, v(0.056, -0.05, -0.008), v(0.02, -0.1, 0.058), 0.014),
+            0.025,
+        );
+        d = smin(
+            d,
+            ellipsoid(p - v(0.0, -0.098, 0.06), v(0.025, 0.018, 0.018)),
+            0.016,
+        );
+        // Cheekbones and the brow ridge.
+        d = smin(
+            d,
+            ellipsoid(q - v(0.047, -0.014, 0.058), v(0.02, 0.014, 0.02)),
+            0.02,
+        );
+        d = smin(
+            d,
+            capsule(q, v(0.0, 0.03, 0.087), v(0.05, 0.027, 0.071), 0.01),
+            0.016,
+        );
+        // Eye sockets, carved, with the eyeballs set in them.
+        d = smax(
+            d,
+            -ellipsoid(q - v(0.032, 0.005, 0.094), v(0.02, 0.013, 0.017)),
+            0.008,
+        );
+        d = d.min(sphere(q - EYE_CENTRE, EYE_RADIUS));
+        // Nose: bridge, tip and wings.
+        let mut nose = capsule(p, v(0.0, 0.014, 0.089), v(0.0, -0.026, 0.108), 0.0075);
+        nose = smin(nose, sphere(p - v(0.0, -0.03, 0.104), 0.0115), 0.008);
+        nose = smin(nose, sphere(q - v(0.0125, -0.035, 0.096), 0.0085), 0.006);
+        d = smin(d, nose, 0.008);
+        // Lips, with the mouth's line pressed between them.
+        let lips = ellipsoid(p - v(0.0, -0.055, 0.09), v(0.024, 0.0075, 0.012)).min(ellipsoid(
+            p - v(0.0, -0.067, 0.087),
+            v(0.021, 0.0085, 0.012),
+        ));
+        d = smin(d, lips, 0.008);
+        d = smax(
+            d,
+            -ellipsoid(p - v(0.0, -0.0607, 0.104), v(0.023, 0.0012, 0.01)),
+            0.002,
+        );
+        // Ears, with a hollow (the concha).
+        let ear = ellipsoid(q - v(0.078, -0.002, -0.012), v(0.011, 0.031, 0.019));
+        d = smin(d, ear, 0.006);
+        d = smax(d, -sphere(q - v(0.091, -0.006, -0.007), 0.0085), 0.004);
+        // Neck.
+        d = smin(
+            d,
+            capsule(p, v(0.0, -0.06, -0.025), v(0.0, -0.24, -0.02), 0.054),
+            0.03,
+        );
+        if self.shoulders {
+            // Trapezius, deltoids and the chest, cut flat as a bust.
+            let mut torso = ellipsoid(p - v(0.0, -0.33, -0.015), v(0.185, 0.1, 0.11));
+            torso = smin(
+                torso,
+                capsule(q, v(0.0, -0.215, -0.03), v(0.15, -0.265, -0.03), 0.045),
+                0.05,
+            );
+            torso = smin(torso, sphere(q - v(0.18, -0.315, -0.02), 0.055), 0.05);
+            d = smin(d, torso, 0.05);
+            d = d.max(-(p.y + 0.41));
         } else {
-            self.half_height_bottom
-        };
-        // A slightly narrower jaw: squeeze x in the lower front.
-        let jaw = 1.0 - 0.12 * (-d.y).max(0.0) * d.z.max(0.0);
-        let head = ellipsoid_radial(d, Vec3::new(self.half_width * jaw, hy, self.half_depth));
-        // The neck: a rounded superellipsoid column (|h/r|^4 + |y/l|^4 = 1), short above the centre.
-        let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-        let l = if d.y < 0.0 { self.neck_length } else { 0.03 };
-        let neck = 1.0 / ((horizontal / self.neck_radius).powi(4) + (d.y / l).powi(4)).powf(0.25);
-        smax(head, neck, 0.025)
+            d = d.max(-(p.y + 0.25));
+        }
+        d
+    }
+
+    /// The bust's box, a few cells larger than the sculpt.
+    fn bounds(&self) -> (Vec3, Vec3) {
+        let low = if self.shoulders { -0.42 } else { -0.26 };
+        let half_width = if self.shoulders { 0.25 } else { 0.11 };
+        (v(-half_width, low, -0.13), v(half_width, 0.135, 0.13))
     }
 
     pub fn build(&self) -> TriMesh {
-        star_mesh(|d| self.radial(d), self.resolution)
+        let (min, max) = self.bounds();
+        let cell = (max.y - min.y) / self.resolution.clamp(16, 1024) as f32;
+        let pad = Vec3::splat(2.0 * cell);
+        mesh_sdf(|p| self.sdf(p), min - pad, max + pad, cell)
     }
 }
 
@@ -162,13 +233,9 @@ pub fn star_mesh(radial: impl Fn(Vec3) -> f32, resolution: u32) -> TriMesh {
 mod tests {
     use super::*;
 
-    #[test]
-    fn head_is_closed_outward_and_smooth() {
-        let p = HeadParams::default();
-        let m = p.build();
-        m.validate().unwrap();
-        assert!(m.signed_volume() > 0.0);
-        // Closed: every edge is shared by exactly two triangles.
+    /// Watertight: every edge has an even number of triangles (two, or four
+    /// where Surface Nets pinches a thin feature into a non-manifold edge).
+    fn closed(m: &TriMesh) -> bool {
         let mut edges = std::collections::HashMap::new();
         for t in &m.triangles {
             for k in 0..3 {
@@ -176,22 +243,52 @@ mod tests {
                 *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
             }
         }
-        assert!(edges.values().all(|&c| c == 2));
-        // Smooth: adjacent vertex normals differ by less than 25 degrees.
-        let n = m.vertex_normals();
-        for t in &m.triangles {
-            for k in 0..3 {
-                let a = n[t[k] as usize].angle_between(n[t[(k + 1) % 3] as usize]);
-                assert!(
-                    a < 25f32.to_radians(),
-                    "{a} at {}",
-                    m.positions[t[k] as usize]
-                );
-            }
+        edges.values().all(|&c| c % 2 == 0)
+    }
+
+    #[test]
+    fn head_is_closed_outward_and_on_its_distance_field() {
+        let p = HeadParams {
+            resolution: 128,
+            ..Default::default()
+        };
+        let m = p.build();
+        m.validate().unwrap();
+        assert!(m.signed_volume() > 0.0);
+        assert!(
+            closed(&m),
+            "every edge is shared by an even number of triangles"
+        );
+        let cell = 0.555 / 128.0;
+        for q in m.positions.iter().step_by(13) {
+            assert!(p.sdf(*q).abs() < 0.5 * cell, "{q}: {}", p.sdf(*q));
         }
         let b = m.bounds();
-        assert!(b.size().y > 0.3, "the neck reaches down: {:?}", b);
-        assert!(m.contains(Vec3::ZERO) && m.contains(Vec3::new(0.0, -0.2, 0.0)));
+        assert!(b.size().x > 0.4, "shoulders: {b:?}");
+        assert!(m.contains(Vec3::ZERO) && m.contains(Vec3::new(0.0, -0.2, -0.02)));
+    }
+
+    #[test]
+    fn the_face_has_its_features_where_a_face_has_them() {
+        let h = HeadParams::default();
+        let inside = |x, y, z| h.sdf(v(x, y, z)) < 0.0;
+        // The nose's tip stands proud of the cheeks and the lips in front of the chin.
+        assert!(inside(0.0, -0.03, 0.112));
+        assert!(!inside(0.03, -0.03, 0.104));
+        assert!(inside(0.0, -0.055, 0.099) && !inside(0.0, -0.1, 0.085));
+        // The eyes sit in sockets: the eyeball's front is behind the brow's front.
+        assert!(inside(0.032, 0.004, 0.084) && !inside(0.032, 0.004, 0.09));
+        assert!(inside(0.032, 0.03, 0.086) && !inside(0.032, 0.03, 0.095));
+        // Ears stick out at the sides; the neck is narrower than the head.
+        assert!(inside(0.086, 0.0, -0.012) && !inside(0.086, 0.06, -0.012));
+        assert!(!inside(0.07, -0.17, -0.02) && inside(0.0, -0.17, -0.02));
+        // Shoulders only when asked.
+        assert!(inside(0.17, -0.3, -0.02));
+        let bare = HeadParams {
+            shoulders: false,
+            ..h
+        };
+        assert!(bare.sdf(v(0.17, -0.3, -0.02)) > 0.0);
     }
 
     #[test]

@@ -1,10 +1,12 @@
-//! A mesh to plant strands on: root sampling by region, interpolated normals and, for
-//! the procedural star-shaped meshes, an exact push-out so strands never enter it.
+//! A mesh to plant strands on: root sampling by region, interpolated normals
+//! and, for the procedural shapes, a push-out along the distance field so
+//! strands lie on the skin and never enter it.
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::head::{BodyParams, HeadParams};
+use super::head::{BodyParams, EYE_CENTRE, EYE_RADIUS, HeadParams};
+use super::sdf::gradient;
 use crate::mesh::TriMesh;
 
 /// The analytic shape behind a procedural mesh.
@@ -15,10 +17,18 @@ pub enum Shape {
 }
 
 impl Shape {
-    pub fn radial(&self, d: Vec3) -> f32 {
+    /// Signed distance to the surface (the body's is radial: exact in sign,
+    /// approximate in size, which is all push-out needs).
+    pub fn distance(&self, p: Vec3) -> f32 {
         match self {
-            Shape::Head(h) => h.radial(d),
-            Shape::Body(b) => b.radial(d),
+            Shape::Head(h) => h.sdf(p),
+            Shape::Body(b) => {
+                let len = p.length();
+                if len < 1e-9 {
+                    return -b.radial(Vec3::Y);
+                }
+                len - b.radial(p / len)
+            }
         }
     }
     pub fn build(&self) -> TriMesh {
@@ -29,42 +39,89 @@ impl Shape {
     }
 }
 
-/// Where on a mesh roots are planted (directions are about the mesh's centre; y up, +z front).
+/// Where on a mesh roots are planted, in the procedural head's frame (metres
+/// from the head's centre; y up, +z the face). See [`HeadParams`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Region {
-    /// Above a hairline: high on the forehead, low at the nape.
+    /// Above a hairline: a forehead of a third of the face, temples, sideburns
+    /// in front of the ears, above and behind the ears, down to the nape.
     Scalp,
-    /// Chin, jaw and upper lip.
+    /// Moustache, cheeks below the cheekbones, jaw, chin and under the chin.
     Beard,
-    /// Two arcs above the eyes.
+    /// Two arcs along the brow ridge.
     Eyebrows,
+    /// The upper eyelids' rims.
+    Eyelashes,
     /// The whole surface (fur).
     Everywhere,
 }
 
+/// Piecewise-linear interpolation in a table of (x, y) rows sorted by x.
+fn lerp_table(table: &[(f32, f32)], x: f32) -> f32 {
+    let i = table.partition_point(|r| r.0 < x).clamp(1, table.len() - 1);
+    let ((x0, y0), (x1, y1)) = (table[i - 1], table[i]);
+    let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
+    y0 + (y1 - y0) * t
+}
+
+/// The scalp's hairline height by azimuth (0 = the face's centre line, π =
+/// the nape's): forehead, temple corners, sideburns, above the ear, nape.
+const HAIRLINE: [(f32, f32); 11] = [
+    (0.0, 0.07),
+    (0.45, 0.078),
+    (0.75, 0.05),
+    (1.0, 0.0),
+    (1.2, -0.028),
+    (1.38, -0.024),
+    (1.46, 0.036),
+    (2.0, 0.036),
+    (2.3, -0.03),
+    (2.7, -0.08),
+    (std::f32::consts::PI, -0.092),
+];
+
+/// The beard's upper edge by azimuth: the moustache, the cheeks, the sideburns.
+const BEARDLINE: [(f32, f32); 5] = [
+    (0.0, -0.043),
+    (0.3, -0.046),
+    (0.6, -0.04),
+    (1.0, -0.02),
+    (1.3, -0.025),
+];
+
 impl Region {
-    /// Whether the surface point in direction `d` (unit, from the centre) is in the region.
-    pub fn contains(self, d: Vec3) -> bool {
-        let elev = d.y.clamp(-1.0, 1.0).asin();
-        let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-        let front = if horizontal > 1e-6 {
-            d.z / horizontal
-        } else {
-            0.0
-        };
-        let azimuth = d.x.atan2(d.z);
+    /// Whether the surface point `p` (head frame, metres) is in the region.
+    pub fn contains(self, p: Vec3) -> bool {
+        let q = Vec3::new(p.x.abs(), p.y, p.z);
+        let azimuth = q.x.atan2(q.z);
+        let on_head = p.length() < 0.16;
         match self {
             Region::Scalp => {
-                let hairline = if front > 0.0 {
-                    0.12 + 0.42 * front
-                } else {
-                    0.12 + 0.75 * front
-                };
-                elev > hairline
+                let ear = ((q - Vec3::new(0.08, -0.004, -0.012)) / Vec3::new(0.025, 0.044, 0.032))
+                    .length()
+                    < 1.0;
+                on_head && !ear && p.y > -0.1 && p.y > lerp_table(&HAIRLINE, azimuth)
             }
-            Region::Beard => front > 0.45 && elev < -0.12 && elev > -0.95,
+            Region::Beard => {
+                let lips = q.x < 0.029 && p.y < -0.047 && p.y > -0.078 && p.z > 0.07;
+                on_head
+                    && azimuth < 1.3
+                    && !lips
+                    && p.y > -0.135
+                    && p.y < lerp_table(&BEARDLINE, azimuth)
+            }
             Region::Eyebrows => {
-                elev > 0.2 && elev < 0.27 && azimuth.abs() > 0.1 && azimuth.abs() < 0.6
+                let x = q.x;
+                let centre = 0.029
+                    + 0.006 * (std::f32::consts::PI * ((x - 0.012) / 0.045).clamp(0.0, 1.0)).sin();
+                p.z > 0.06 && (0.012..0.054).contains(&x) && (p.y - centre).abs() < 0.0045
+            }
+            Region::Eyelashes => {
+                let r = (q - EYE_CENTRE).length();
+                r > EYE_RADIUS - 0.001
+                    && r < EYE_RADIUS + 0.0045
+                    && p.y > EYE_CENTRE.y + 0.003
+                    && p.z > EYE_CENTRE.z + 0.004
             }
             Region::Everywhere => true,
         }
@@ -113,17 +170,30 @@ impl Surface {
         }
     }
 
-    /// Moves `p` out of the analytic shape to at least `margin` above its surface.
+    /// Moves `p` out of the analytic shape to at least `margin` above its
+    /// surface, along the distance field's gradient.
     pub fn push_out(&self, p: Vec3, margin: f32) -> Vec3 {
         let Some(shape) = self.shape else { return p };
-        let v = p - self.center;
-        let len = v.length();
-        if len < 1e-9 {
-            return p;
+        let mut q = p - self.center;
+        // Newton steps: the field is a distance bound, not exact, near blends,
+        // so one step can fall short.
+        for _ in 0..6 {
+            let d = shape.distance(q);
+            if d >= margin {
+                break;
+            }
+            q += gradient(|x| shape.distance(x), q, 2e-4) * (margin - d);
         }
-        let d = v / len;
-        let min = shape.radial(d) + margin;
-        if len < min { self.center + d * min } else { p }
+        self.center + q
+    }
+
+    /// The distance field's outward normal at `p` (the mesh's nearest face
+    /// normal is not known here; without an analytic shape, +y).
+    pub fn field_normal(&self, p: Vec3) -> Vec3 {
+        match self.shape {
+            Some(shape) => gradient(|x| shape.distance(x), p - self.center, 2e-4),
+            None => Vec3::Y,
+        }
     }
 
     /// Area-weighted cumulative distribution over the triangles in `region`.
@@ -132,8 +202,7 @@ impl Surface {
         (0..self.mesh.triangle_count())
             .map(|t| {
                 let [a, b, c] = self.mesh.corners(t);
-                let d = ((a + b + c) / 3.0 - self.center).normalize_or_zero();
-                if region.contains(d) {
+                if region.contains((a + b + c) / 3.0 - self.center) {
                     acc += self.mesh.face_area(t);
                 }
                 acc

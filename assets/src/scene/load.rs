@@ -243,6 +243,9 @@ fn load_groom(
             None => Surface::from_mesh(m.mesh.clone()),
         })
     };
+    g.material
+        .validate()
+        .map_err(|m| err(&name, format!("groom {:?}: material: {m}", g.name)))?;
     let mut skinning = None;
     let mut hair_mesh = None;
     let mut groom = match &g.source {

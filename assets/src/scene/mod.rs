@@ -184,28 +184,81 @@ pub enum GroomSource {
     },
 }
 
-/// Hair appearance: melanin concentration or a colour, and roughness. The
-/// cuticle tilt is the shading pass's parameter (`kulikov.shade`'s `shift`;
-/// Chiang's fixed α in `lipp.shade`), not the material's: a key nothing read
-/// would be accepted and do nothing.
+/// Hair appearance: pigments (or a colour), roughness and cuticle tilt.
+/// Every pipeline takes its colour from [`Material::color`] and its cuticle
+/// tilt from `highlight_shift_deg`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Material {
-    /// Eumelanin concentration (0 = white, about 1.3 = black). Ignored when `color` is set.
+    /// Total melanin concentration on Chiang 2016's scale (σa per unit
+    /// concentration, see [`crate::hair_color`]): about 0.1 platinum, 0.3
+    /// blond, 1.3 brown, 8 black. Ignored when `color` is set.
     pub melanin: Option<f32>,
-    /// A direct linear RGB colour instead of melanin.
+    /// The fraction of the melanin that is pheomelanin (0 = none, 1 = all):
+    /// auburn and red hair.
+    pub redness: f32,
+    /// A dye's linear RGB colour, added as a second absorber.
+    pub dye: Option<[f32; 3]>,
+    /// A direct linear RGB colour instead of pigments.
     pub color: Option<[f32; 3]>,
-    /// Longitudinal roughness in [0, 1].
+    /// Longitudinal roughness in [0, 1] (also Chiang's βn for the colour).
     pub roughness: f32,
+    /// Cuticle scale tilt α in degrees: shifts R's highlight towards the tip by
+    /// α, TRT's towards the root by about 1.5α (Marschner 2003, Chiang 2016).
+    pub highlight_shift_deg: f32,
 }
 
 impl Default for Material {
     fn default() -> Self {
         Material {
             melanin: Some(0.6),
+            redness: 0.0,
+            dye: None,
             color: None,
             roughness: 0.3,
+            highlight_shift_deg: 2.0,
         }
+    }
+}
+
+impl Material {
+    /// The linear RGB colour the shading models take: `color` if set, else
+    /// the colour of the pigments' (and dye's) absorption (Chiang 2016 Eq. 9).
+    pub fn color(&self) -> [f32; 3] {
+        use crate::hair_color::{color_from_sigma_a, sigma_a_from_color, sigma_a_from_melanin};
+        if let Some(c) = self.color {
+            return c;
+        }
+        let beta_n = self.roughness.clamp(0.02, 1.0);
+        let mut sigma = sigma_a_from_melanin(self.melanin.unwrap_or(0.0), self.redness);
+        if let Some(dye) = self.dye {
+            let d = sigma_a_from_color(dye, beta_n);
+            sigma = [0, 1, 2].map(|i| sigma[i] + d[i]);
+        }
+        color_from_sigma_a(sigma, beta_n)
+    }
+
+    /// What is wrong with the material, if anything.
+    pub fn validate(&self) -> Result<(), String> {
+        let unit = |x: f32| (0.0..=1.0).contains(&x);
+        if self.melanin.is_some_and(|m| !(0.0..=50.0).contains(&m)) {
+            return Err("melanin must be in 0..=50".into());
+        }
+        if !unit(self.redness) {
+            return Err("redness must be in 0..=1".into());
+        }
+        if !unit(self.roughness) {
+            return Err("roughness must be in 0..=1".into());
+        }
+        if !(-10.0..=10.0).contains(&self.highlight_shift_deg) {
+            return Err("highlight_shift_deg must be in -10..=10".into());
+        }
+        for c in self.color.iter().chain(self.dye.iter()) {
+            if !c.iter().all(|&x| unit(x)) {
+                return Err("colours are linear RGB in 0..=1".into());
+            }
+        }
+        Ok(())
     }
 }
 

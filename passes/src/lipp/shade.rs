@@ -268,6 +268,7 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
     let m = Material {
         color: [c[0] * vary, c[1] * vary, c[2] * vary].map(|x| x.clamp(0.0, 1.0)),
         roughness: c[3],
+        alpha: inp.model.highlight_shift,
     };
     let mut out = [0.0f32; 3];
     for (li, light) in inp.lights.iter().enumerate() {
@@ -303,7 +304,7 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
         let n = probe::view_facing_normal(t, v);
         let e = sh_irradiance(&inp.sh, n);
         let spec = if inp.params.probe_specular {
-            probe::specular(&inp.prefiltered, t, v, n, m.color, m.roughness)
+            probe::specular(&inp.prefiltered, t, v, n, &m)
         } else {
             [0.0; 3]
         };

@@ -79,8 +79,6 @@ pub struct ShadeParams {
     /// Karis's multiple-scattering weight; off with `multiple_scattering: false`.
     pub scatter: f32,
     pub multiple_scattering: bool,
-    /// Cuticle tilt in radians (Karis: 0.035).
-    pub shift: f32,
     // The offline bake `"Baked"` reads (ignored by the other modes).
     pub bake_rays: u32,
     pub max_scatter_events: f32,
@@ -115,7 +113,6 @@ impl Default for ShadeParams {
             trt_scale: 1.0,
             scatter: 1.0,
             multiple_scattering: true,
-            shift: 0.035,
             bake_rays: DEFAULT_BAKE_RAYS,
             max_scatter_events: HAIR_MAX_SCATTER_EVENTS,
             bake_max_distance: DEFAULT_BAKE_MAX_DISTANCE,
@@ -146,7 +143,8 @@ impl PassParams for ShadeParams {
 }
 
 impl ShadeParams {
-    /// The per-lobe scalars the shading reads.
+    /// The per-lobe scalars the shading reads (the cuticle tilt is each
+    /// model's, from its material; this gives Karis's 0.035 rad).
     pub fn lobes(&self) -> Lobes {
         Lobes {
             r: self.r_scale,
@@ -157,7 +155,7 @@ impl ShadeParams {
             } else {
                 0.0
             },
-            shift: self.shift,
+            shift: 0.035,
         }
     }
 
@@ -178,7 +176,6 @@ impl ShadeParams {
         let l = self.lobes();
         ShadeGpu {
             lobes: [l.r, l.tt, l.trt, l.scatter],
-            shift: l.shift,
             self_shadow: self.self_shadow.code(),
             absorption: self.absorption,
             resolution: self.resolution,
@@ -194,7 +191,6 @@ crate::gpu_block! {
     pub struct ShadeGpu {
         /// r, tt, trt scales; scatter (0 = no multiple scattering).
         lobes: [f32; 4],
-        shift: f32,
         /// 0 None, 1 VoxelMarch, 2 Baked.
         self_shadow: u32,
         absorption: f32,
@@ -204,6 +200,7 @@ crate::gpu_block! {
         // WGSL rounds the struct to its vec4 alignment.
         _pad0: u32,
         _pad1: u32,
+        _pad2: u32,
     }
 }
 
@@ -306,6 +303,10 @@ impl ShadeKernel {
         let v = (cam - p).normalize_or(Vec3::Z);
         let color = Vec3::from_slice(&md.color[..3]);
         let g = Grid::of(md, k.resolution);
+        let lobes = Lobes {
+            shift: md.highlight_shift,
+            ..self.lobes
+        };
         let mut out = color * k.ambient;
         for l in lights {
             let [x, y, z, kind] = l.position_or_direction;
@@ -330,8 +331,7 @@ impl ShadeKernel {
                 SelfShadow::None => 1.0,
             };
             let radiance = Vec3::from_slice(&l.radiance[..3]) * falloff;
-            out += radiance
-                * hair_shading(t, v, to_light, color, md.color[3], visibility, &self.lobes);
+            out += radiance * hair_shading(t, v, to_light, color, md.color[3], visibility, &lobes);
         }
         out
     }

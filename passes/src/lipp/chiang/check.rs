@@ -95,6 +95,7 @@ pub fn measure(color: [f32; 3], beta: f32, sin_o: f64) -> [Lobe; 4] {
     let m = Material {
         color,
         roughness: beta,
+        alpha: super::DEFAULT_ALPHA,
     };
     let us = midpoints(N_U, -1.0, 1.0);
     let phis = midpoints(N_PHI, -PI64, PI64);
@@ -133,6 +134,7 @@ pub fn peak(beta: f32, sin_o: f64, p: usize) -> (f64, f64) {
     let m = Material {
         color: HAIRS[0].color,
         roughness: beta,
+        alpha: super::DEFAULT_ALPHA,
     };
     let bxdf = pbrt::Params {
         color: m.color.map(f64::from),

@@ -1,14 +1,16 @@
 //! M_p of Chiang's model (d'Eon et al. 2011, Chiang Eq. 6 and 7) with
 //! pbrt-v4's cuticle tilts, evaluated in log form.
 
-/// Per lobe: sin 2kα, cos 2kα of the cuticle tilt applied to θ_o (α = 2°;
-/// R: −2α, TT: +α, TRT: +4α, pbrt-v4 `HairBxDF::f`) and v_p / v_0 (Chiang
+/// Per lobe: sin, cos of the cuticle tilt applied to θ_o for scale tilt α
+/// (R: −2α, TT: +α, TRT: +4α, pbrt-v4 `HairBxDF::f`) and v_p / v_0 (Chiang
 /// Eq. 7: v_1 = v_0 / 4, v_2 = 4 v_0).
-pub(super) const TILT: [(f32, f32, f32); 3] = [
-    (-0.069_756_47, 0.997_564_1, 1.0),
-    (0.034_899_5, 0.999_390_8, 0.25),
-    (0.139_173_1, 0.990_268_05, 4.0),
-];
+pub(super) fn tilt(alpha: f32) -> [(f32, f32, f32); 3] {
+    let at = |k: f32, var: f32| {
+        let (s, c) = (k * alpha).sin_cos();
+        (s, c, var)
+    };
+    [at(-2.0, 1.0), at(1.0, 0.25), at(4.0, 4.0)]
+}
 
 /// ln I0(x), x ≥ 0: Abramowitz and Stegun 9.8.1 and 9.8.2 (relative error
 /// below 2e-7).

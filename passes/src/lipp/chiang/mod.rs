@@ -76,7 +76,7 @@ mod longitudinal;
 
 use super::{dot, normalize, scale, sub};
 use attenuation::{H_NODES, NODES, PIECES, fresnel, offsets};
-use longitudinal::{TILT, mp};
+use longitudinal::{mp, tilt};
 
 pub use attenuation::reflected_albedo;
 
@@ -87,7 +87,12 @@ const PI: f32 = std::f32::consts::PI;
 pub struct Material {
     pub color: [f32; 3],
     pub roughness: f32,
+    /// Cuticle scale tilt α, radians (the scene material's `highlight_shift_deg`).
+    pub alpha: f32,
 }
+
+/// pbrt-v4's and Chiang 2016's default scale tilt, 2°.
+pub const DEFAULT_ALPHA: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
 /// Chiang 2016 Eq. 9 inverted: absorption from a desired colour.
 pub fn sigma_a(color: [f32; 3], beta_n: f32) -> [f32; 3] {
@@ -134,8 +139,9 @@ pub fn chiang_lobes(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [[f3
     };
     let s = 0.626_657 * (0.265 * b + 1.194 * b * b + 5.372 * b.powi(22));
     // M_p with the cuticle tilt.
+    let tilts = tilt(m.alpha);
     let mps: [f32; 3] = std::array::from_fn(|p| {
-        let (sin_k, cos_k, var) = TILT[p];
+        let (sin_k, cos_k, var) = tilts[p];
         let var = var * v0;
         let sin_p = sin_o * cos_k + cos_o * sin_k;
         let cos_p = (cos_o * cos_k - sin_o * sin_k).abs();
@@ -205,6 +211,7 @@ mod tests {
         let m = Material {
             color: [0.3, 0.2, 0.1],
             roughness: 0.3,
+            alpha: DEFAULT_ALPHA,
         };
         let t = [0.0, 1.0, 0.0];
         let v = normalize([0.0, 0.0, 1.0]);

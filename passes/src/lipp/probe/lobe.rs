@@ -43,21 +43,15 @@ pub struct SpecularLobe {
 ///   (Walter et al. 2007), so α = √(σ² / 2). The GGX lobe is isotropic: the
 ///   azimuthal spread of R and TRT across the fibre's width (N_p) is not
 ///   represented — the price of Lipp's single lobe.
-pub fn specular_lobe(
-    t: [f32; 3],
-    v: [f32; 3],
-    n: [f32; 3],
-    color: [f32; 3],
-    roughness: f32,
-) -> SpecularLobe {
+pub fn specular_lobe(t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> SpecularLobe {
     let sin_o = dot(t, v).clamp(-1.0, 1.0);
-    let bm = roughness.clamp(0.02, 1.0);
+    let bm = m.roughness.clamp(0.02, 1.0);
     let v0 = {
         let x = 0.726 * bm + 0.812 * bm * bm + 3.7 * bm.powi(20);
         x * x
     };
-    let alpha = 2.0f32.to_radians();
-    let (w_r, a_trt) = reflected_albedo(sin_o, &Material { color, roughness });
+    let alpha = m.alpha;
+    let (w_r, a_trt) = reflected_albedo(sin_o, m);
     let w_trt = (a_trt[0] + a_trt[1] + a_trt[2]) / 3.0;
     // Where M_p peaks in sin θ_i + sin θ_o (tangent root to tip, as in
     // `chiang`): R at +2α, TRT at −4α.
@@ -89,15 +83,8 @@ pub fn view_facing_normal(t: [f32; 3], v: [f32; 3]) -> [f32; 3] {
 }
 
 /// Radiance of the R + TRT probe term (before AO and the `specular` scale).
-pub fn specular(
-    w: &Words<'_>,
-    t: [f32; 3],
-    v: [f32; 3],
-    n: [f32; 3],
-    color: [f32; 3],
-    roughness: f32,
-) -> [f32; 3] {
-    let lobe = specular_lobe(t, v, n, color, roughness);
+pub fn specular(w: &Words<'_>, t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> [f32; 3] {
+    let lobe = specular_lobe(t, v, n, m);
     let l = sample(w, lobe.direction, lobe.alpha);
     std::array::from_fn(|k| l[k] * lobe.weight[k])
 }
@@ -108,6 +95,14 @@ mod tests {
     use super::*;
     use std::sync::atomic::AtomicU64;
 
+    fn mat(color: [f32; 3], roughness: f32) -> Material {
+        Material {
+            color,
+            roughness,
+            alpha: crate::lipp::chiang::DEFAULT_ALPHA,
+        }
+    }
+
     #[test]
     fn the_stand_in_lobe_mirrors_the_view_and_widens_with_roughness() {
         let t = [0.0, 1.0, 0.0];
@@ -115,18 +110,12 @@ mod tests {
         let n = view_facing_normal(t, v);
         assert!((dot(n, [0.0, 0.0, 1.0]) - 1.0).abs() < 1e-6);
         let dark = [0.02, 0.015, 0.01];
-        let lobe = specular_lobe(t, v, n, dark, 0.3);
+        let lobe = specular_lobe(t, v, n, &mat(dark, 0.3));
         // The lobe sits on the specular cone (sin θ_l = −sin θ_o) shifted by
         // the A-weighted mean of R's +2α and TRT's −4α; dark hair: nearly R's.
         let sin_o = dot(t, v);
         let shift = dot(lobe.direction, t) + sin_o;
-        let (f, trt) = reflected_albedo(
-            sin_o,
-            &Material {
-                color: dark,
-                roughness: 0.3,
-            },
-        );
+        let (f, trt) = reflected_albedo(sin_o, &mat(dark, 0.3));
         let a_trt = trt.iter().sum::<f32>() / 3.0;
         assert!((lobe.weight.iter().sum::<f32>() / 3.0 - (f + a_trt)).abs() < 1e-6);
         let alpha_c = 2f32.to_radians();
@@ -150,13 +139,13 @@ mod tests {
             "{lobe:?}"
         );
         // Blond hair: TRT adds weight (more in red), shifts the lobe towards −4α, widens it.
-        let blond = specular_lobe(t, v, n, [0.8, 0.6, 0.35], 0.3);
+        let blond = specular_lobe(t, v, n, &mat([0.8, 0.6, 0.35], 0.3));
         assert!(blond.weight[0] > blond.weight[2] && blond.weight[2] > lobe.weight[2]);
         assert!(dot(blond.direction, t) < dot(lobe.direction, t));
         assert!(blond.alpha > lobe.alpha);
         // Rougher hair, wider lobe; capped at α = 1.
-        let rough = specular_lobe(t, v, n, dark, 0.6);
-        assert!(rough.alpha > lobe.alpha && specular_lobe(t, v, n, dark, 1.0).alpha <= 1.0);
+        let rough = specular_lobe(t, v, n, &mat(dark, 0.6));
+        assert!(rough.alpha > lobe.alpha && specular_lobe(t, v, n, &mat(dark, 1.0)).alpha <= 1.0);
     }
 
     #[test]
@@ -166,8 +155,8 @@ mod tests {
         let w = Words::new(&a, &oob);
         let (t, v) = ([1.0, 0.0, 0.0], normalize([0.5, 0.2, 1.0]));
         let n = view_facing_normal(t, v);
-        let lobe = specular_lobe(t, v, n, [0.5, 0.4, 0.3], 0.35);
-        let s = specular(&w, t, v, n, [0.5, 0.4, 0.3], 0.35);
+        let lobe = specular_lobe(t, v, n, &mat([0.5, 0.4, 0.3], 0.35));
+        let s = specular(&w, t, v, n, &mat([0.5, 0.4, 0.3], 0.35));
         for k in 0..3 {
             assert!((s[k] - c[k] * lobe.weight[k]).abs() < 1e-6, "{s:?}");
         }
