@@ -11,6 +11,9 @@ pub struct TriMesh {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
     pub transform: Transform,
+    /// Linear RGB albedo per vertex (painted skin, lips, eyes), or empty:
+    /// then the opaque pass's `albedo` parameter shades the whole mesh.
+    pub colors: Vec<Vec3>,
 }
 
 /// The closest point on a mesh to a query point.
@@ -279,6 +282,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
             triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
             transform: Transform::IDENTITY,
+            colors: Vec::new(),
         }
     }
 

@@ -86,7 +86,28 @@ pub struct TriangleData {
     pub c: [f32; 4],
     /// Index of the mesh in the scene.
     pub mesh: u32,
-    pub _pad: [u32; 3],
+    /// Each corner's albedo (see [`pack_albedo`]); 0 = the pass's albedo.
+    pub albedo: [u32; 3],
+}
+
+/// A linear albedo as 8-bit square roots (a gamma of 2, so dark tones keep
+/// their precision), alpha 255 marking it set. WGSL decodes with
+/// `unpack4x8unorm` and squares: the same numbers on every backend.
+pub fn pack_albedo(c: [f32; 3]) -> u32 {
+    let q = |x: f32| (x.clamp(0.0, 1.0).sqrt() * 255.0).round() as u32;
+    q(c[0]) | q(c[1]) << 8 | q(c[2]) << 16 | 255 << 24
+}
+
+/// [`pack_albedo`] inverted; `None` for 0 (not set).
+pub fn unpack_albedo(w: u32) -> Option<[f32; 3]> {
+    if w == 0 {
+        return None;
+    }
+    let c = |k: u32| {
+        let x = ((w >> (8 * k)) & 0xFF) as f32 / 255.0;
+        x * x
+    };
+    Some([c(0), c(1), c(2)])
 }
 
 /// Words of a `Pod` value, for uploads.

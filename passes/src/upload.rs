@@ -125,12 +125,18 @@ fn pack_triangles(scene: &Scene) -> (Vec<TriangleData>, Vec<u32>) {
                 let v = normals.get(tri[k] as usize).copied().unwrap_or(Vec3::Y);
                 f32::from_bits(pack_unit_vector((normal_matrix * v).normalize_or(Vec3::Y)))
             };
+            let albedo = |k: usize| {
+                m.mesh
+                    .colors
+                    .get(tri[k] as usize)
+                    .map_or(0, |c| crate::layout::pack_albedo(c.to_array()))
+            };
             triangles.push(TriangleData {
                 a: [a.x, a.y, a.z, n(0)],
                 b: [b.x, b.y, b.z, n(1)],
                 c: [c.x, c.y, c.z, n(2)],
                 mesh: i as u32,
-                _pad: [0; 3],
+                albedo: [albedo(0), albedo(1), albedo(2)],
             });
         }
     }

@@ -66,7 +66,8 @@ struct TriangleData {
     b: vec4<f32>,
     c: vec4<f32>,
     mesh: u32,
-    _pad: array<u32, 3>,
+    // Each corner's albedo: 8-bit square roots of linear RGB, alpha 255; 0 = unset.
+    albedo: array<u32, 3>,
 }
 
 // `lod_models`: the LOD decision per model (kulikov::ModelLod, 8 words).

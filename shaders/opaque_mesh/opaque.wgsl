@@ -18,6 +18,8 @@
 struct OpaqueParams {
     // rgb: albedo; a: ambient.
     albedo_ambient: vec4<f32>,
+    // Diffuse wrap per channel (xyz).
+    wrap: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> params: OpaqueParams;
@@ -36,6 +38,7 @@ struct VertexOut {
     @location(1) normal: vec3<f32>,
     // Geometric normal, the fallback when the corner normals cancel out.
     @location(2) @interpolate(flat) face: vec3<f32>,
+    @location(3) albedo: vec3<f32>,
 }
 
 // assets/src/octahedral.rs: unpack_unit_vector (two snorm16, x low, y high;
@@ -76,6 +79,10 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
     let w_c = (frame.view_proj * vec4<f32>(t.c.xyz, 1.0)).w;
     let p = corner(t, vertex % 3u);
     var out: VertexOut;
+    // Each corner's painted albedo (8-bit square roots) or the pass's albedo.
+    let packed = t.albedo[vertex % 3u];
+    let e = unpack4x8unorm(packed).xyz;
+    out.albedo = select(params.albedo_ambient.rgb, e * e, packed != 0u);
     out.world = p.xyz;
     out.normal = unpack_unit_vector(bitcast<u32>(p.w));
     let f = cross(t.b.xyz - t.a.xyz, t.c.xyz - t.a.xyz);
@@ -123,9 +130,12 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         if i < 3u {
             visible = f32((mask >> (8u * i)) & 0xFFu) / 255.0;
         }
-        irradiance += l.radiance.rgb * (max(dot(n, to_light), 0.0) * falloff * visible);
+        // Green 2004's wrap lighting, per channel (opaque::shade).
+        let w = params.wrap.xyz;
+        let wrapped = max((vec3<f32>(dot(n, to_light)) + w) / (vec3<f32>(1.0) + w), vec3<f32>(0.0));
+        irradiance += l.radiance.rgb * wrapped * (falloff * visible);
     }
-    let albedo = params.albedo_ambient.rgb;
+    let albedo = in.albedo;
     let ambient = params.albedo_ambient.a * (f32(mask >> 24u) / 255.0);
     let color = albedo * (irradiance / PI + vec3<f32>(ambient));
     return vec4<f32>(color, 1.0);

@@ -28,6 +28,9 @@ pub struct HeadParams {
     pub resolution: u32,
     /// Add a neck base, shoulders and upper chest for hair to fall onto.
     pub shoulders: bool,
+    /// Linear albedo painted on the scalp under the hair, as games paint a
+    /// hair cap so the skin between strands reads as hair (none: bare skin).
+    pub scalp: Option<[f32; 3]>,
 }
 
 impl Default for HeadParams {
@@ -35,6 +38,7 @@ impl Default for HeadParams {
         HeadParams {
             resolution: 192,
             shoulders: true,
+            scalp: Some([0.07, 0.045, 0.032]),
         }
     }
 }
@@ -88,6 +92,13 @@ impl HeadParams {
             0.008,
         );
         d = d.min(sphere(q - EYE_CENTRE, EYE_RADIUS));
+        // Eyelids: shells over the eyeball above and below an almond opening.
+        let shell = sphere(q - EYE_CENTRE, EYE_RADIUS + 0.0016);
+        let opening = 0.0028 + 0.0015 * (1.0 - ((q.x - EYE_CENTRE.x) / 0.012).powi(2)).max(0.0);
+        let upper =
+            shell.max(EYE_CENTRE.y + opening - q.y + 0.002 * (q.z - EYE_CENTRE.z) / EYE_RADIUS);
+        let lower = shell.max(q.y - (EYE_CENTRE.y - opening - 0.0015));
+        d = smin(d, upper.min(lower), 0.002);
         // Nose: bridge, tip and wings.
         let mut nose = capsule(p, v(0.0, 0.014, 0.089), v(0.0, -0.026, 0.108), 0.0075);
         nose = smin(nose, sphere(p - v(0.0, -0.03, 0.104), 0.0115), 0.008);
@@ -142,7 +153,62 @@ impl HeadParams {
         let (min, max) = self.bounds();
         let cell = (max.y - min.y) / self.resolution.clamp(16, 1024) as f32;
         let pad = Vec3::splat(2.0 * cell);
-        mesh_sdf(|p| self.sdf(p), min - pad, max + pad, cell)
+        let mut mesh = mesh_sdf(|p| self.sdf(p), min - pad, max + pad, cell);
+        mesh.colors = mesh.positions.iter().map(|&p| self.albedo(p)).collect();
+        mesh
+    }
+}
+
+/// Linear albedo of light skin (measured skin reflectance is about sRGB
+/// (224, 172, 150)), lips, and the eyes' sclera, iris and pupil.
+const SKIN: Vec3 = Vec3::new(0.62, 0.4, 0.31);
+const LIPS: Vec3 = Vec3::new(0.45, 0.19, 0.17);
+const SCLERA: Vec3 = Vec3::new(0.6, 0.55, 0.52);
+const IRIS: Vec3 = Vec3::new(0.11, 0.065, 0.035);
+const PUPIL: Vec3 = Vec3::new(0.01, 0.01, 0.01);
+
+/// The head's painted albedo at surface point `p`.
+fn paint(p: Vec3) -> Vec3 {
+    let q = v(p.x.abs(), p.y, p.z);
+    let e = q - EYE_CENTRE;
+    if e.length() < EYE_RADIUS + 0.001 {
+        // Looking straight ahead: the iris is a cap about +z.
+        let c = e.normalize_or(Vec3::Z).z;
+        return if c > 11f32.to_radians().cos() {
+            PUPIL
+        } else if c > 27f32.to_radians().cos() {
+            IRIS
+        } else {
+            SCLERA
+        };
+    }
+    let lips = ellipsoid(p - v(0.0, -0.055, 0.09), v(0.024, 0.0075, 0.012)).min(ellipsoid(
+        p - v(0.0, -0.067, 0.087),
+        v(0.021, 0.0085, 0.012),
+    ));
+    let t = (1.0 - lips / 0.004).clamp(0.0, 1.0);
+    // A little more blood in the cheeks.
+    let cheek = (1.0 - (q - v(0.045, -0.03, 0.07)).length() / 0.03).clamp(0.0, 1.0);
+    let skin = SKIN + v(0.03, -0.02, -0.015) * cheek;
+    skin.lerp(LIPS, t * t * (3.0 - 2.0 * t))
+}
+
+impl HeadParams {
+    /// The painted albedo at surface point `p`: skin, lips and eyes, and
+    /// the scalp's cap faded in over a few millimetres of the hairline.
+    pub fn albedo(&self, p: Vec3) -> Vec3 {
+        let skin = paint(p);
+        let Some(cap) = self.scalp else { return skin };
+        let inside = |d: Vec3| super::surface::Region::Scalp.contains(p + d);
+        let taps = [
+            Vec3::ZERO,
+            Vec3::X * 0.004,
+            -Vec3::X * 0.004,
+            Vec3::Y * 0.004,
+            -Vec3::Y * 0.004,
+        ];
+        let w = taps.iter().filter(|&&d| inside(d)).count() as f32 / taps.len() as f32;
+        skin.lerp(Vec3::from(cap), w)
     }
 }
 

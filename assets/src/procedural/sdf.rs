@@ -111,6 +111,7 @@ pub fn mesh_sdf(sdf: impl Fn(Vec3) -> f32 + Sync, min: Vec3, max: Vec3, cell: f3
             .map(|t| [t[0], t[1], t[2]])
             .collect(),
         transform: Transform::IDENTITY,
+        colors: Vec::new(),
     };
     if mesh.signed_volume() < 0.0 {
         mesh.triangles.iter_mut().for_each(|t| t.swap(1, 2));

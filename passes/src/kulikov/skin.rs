@@ -175,7 +175,7 @@ mod tests {
             b: [1.0, 0.0, 0.0, 0.0],
             c: [0.0, 0.0, -1.0, 0.0],
             mesh: 0,
-            _pad: [0; 3],
+            albedo: [0; 3],
         };
         let words = crate::layout::words_of(&[tri]);
         let atoms: Vec<_> = words

@@ -140,7 +140,7 @@ pub(crate) mod testing {
             b: [b.x, b.y, b.z, n],
             c: [c.x, c.y, c.z, n],
             mesh: 0,
-            _pad: [0; 3],
+            albedo: [0; 3],
         }
     }
 
@@ -158,7 +158,7 @@ pub(crate) mod testing {
                     b: [b.x, b.y, b.z, n[1]],
                     c: [c.x, c.y, c.z, n[2]],
                     mesh: 0,
-                    _pad: [0; 3],
+                    albedo: [0; 3],
                 }
             })
             .collect()

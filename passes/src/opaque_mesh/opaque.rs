@@ -10,8 +10,12 @@
 //! our meshes do not have, would tie; the GPU resolves those by primitive
 //! order, the simulator by whichever lane stores last.)
 //!
-//! Shading is Lambert with the scene's lights plus a small ambient term, in
-//! linear RGB (the CLI converts to sRGB when saving): the opaque head the
+//! Shading is diffuse with the scene's lights plus a small ambient term, in
+//! linear RGB (the CLI tone-maps when saving), with Green's wrap lighting
+//! per channel (GPU Gems, 2004, ch. 16, "Real-Time Approximations to
+//! Subsurface Scattering": `max((n·l + w) / (1 + w), 0)`; a wider wrap in
+//! red is skin's cheap subsurface look) and each corner's painted albedo
+//! interpolated, or the pass's `albedo` for unpainted meshes: the opaque head the
 //! Kulikov issue composes its coverage visualisation over. Each light's
 //! irradiance and the ambient term are scaled by the pixel's `skin_shadow`
 //! mask word (bytes 0–2: lights 0–2, byte 3: ambient; see
@@ -31,7 +35,7 @@ use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
 use crate::kulikov::skin_shadow::{ambient_visibility, light_visibility};
-use crate::layout::{LightData, read};
+use crate::layout::{LightData, read, unpack_albedo};
 use crate::params::{Invalid, PassParams, non_negative};
 use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use glam::Vec3;
@@ -91,14 +95,17 @@ pub struct OpaqueParams {
     pub albedo: [f32; 3],
     /// Fraction of the albedo added everywhere, standing in for sky light.
     pub ambient: f32,
+    /// Diffuse wrap per channel (0 = Lambert).
+    pub wrap: [f32; 3],
 }
 
 impl Default for OpaqueParams {
     fn default() -> Self {
         Self {
             background: [0.02, 0.02, 0.025],
-            albedo: [0.75, 0.55, 0.45],
+            albedo: [0.62, 0.4, 0.31],
             ambient: 0.05,
+            wrap: [0.3, 0.12, 0.1],
         }
     }
 }
@@ -106,6 +113,12 @@ impl Default for OpaqueParams {
 impl PassParams for OpaqueParams {
     fn validate(&self) -> Result<(), Invalid> {
         non_negative("ambient", self.ambient)?;
+        if !self.wrap.iter().all(|w| (0.0..=1.0).contains(w)) {
+            return Err(Invalid::new(
+                "wrap",
+                format!("expected three numbers in 0..=1, got {:?}", self.wrap),
+            ));
+        }
         for (key, rgb) in [("background", self.background), ("albedo", self.albedo)] {
             if !rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
                 return Err(Invalid::new(
@@ -123,6 +136,8 @@ crate::gpu_block! {
     pub struct OpaqueGpu {
         /// rgb: albedo; a: ambient.
         albedo_ambient: [f32; 4],
+        /// xyz: wrap per channel.
+        wrap: [f32; 4],
     }
 }
 
@@ -131,14 +146,16 @@ impl OpaqueParams {
     /// (`background` is the colour attachment's clear value.)
     pub fn uniform(&self) -> OpaqueGpu {
         let [r, g, b] = self.albedo;
+        let [wr, wg, wb] = self.wrap;
         OpaqueGpu {
             albedo_ambient: [r, g, b, self.ambient],
+            wrap: [wr, wg, wb, 0.0],
         }
     }
 }
 
 /// Linear RGB reflected towards the camera from a point `p` with unit
-/// normal `n`: Lambert (BRDF albedo/π) over every light, whose radiance is
+/// normal `n`: wrapped diffuse (albedo/π) over every light, whose radiance is
 /// taken as irradiance at normal incidence (at 1 m for point lights, which
 /// fall off with the inverse square), plus `ambient` × albedo; lights and
 /// ambient scaled by the `shadow` mask word.
@@ -148,6 +165,7 @@ pub fn shade(
     lights: &[LightData],
     albedo: Vec3,
     ambient: f32,
+    wrap: Vec3,
     shadow: u32,
 ) -> Vec3 {
     let mut irradiance = Vec3::ZERO;
@@ -164,7 +182,8 @@ pub fn shade(
         };
         let radiance = Vec3::new(l.radiance[0], l.radiance[1], l.radiance[2]);
         let visible = light_visibility(shadow, i);
-        irradiance += radiance * (n.dot(to_light).max(0.0) * falloff * visible);
+        let wrapped = ((Vec3::splat(n.dot(to_light)) + wrap) / (Vec3::ONE + wrap)).max(Vec3::ZERO);
+        irradiance += radiance * wrapped * (falloff * visible);
     }
     let ambient = ambient * ambient_visibility(shadow);
     albedo * (irradiance * std::f32::consts::FRAC_1_PI + Vec3::splat(ambient))
@@ -216,11 +235,15 @@ impl CpuKernel for OpaqueKernel {
         let lights = Self::lights(ctx, &view);
         let (depth, out) = (ctx.words("scene.depth"), ctx.words("output"));
         let mask = ctx.words("skin_shadow");
-        let albedo = Vec3::from(self.params.albedo);
+        let default_albedo = Vec3::from(self.params.albedo);
+        let wrap = Vec3::from(self.params.wrap);
         let mut local = CounterValues::default();
         view.for_each_triangle(group, |tri, setup| {
             let p = corners(tri);
             let n = corner_normals(tri);
+            let albedo = tri
+                .albedo
+                .map(|w| unpack_albedo(w).map_or(default_albedo, Vec3::from));
             let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Z);
             setup.rasterize(|f| {
                 let i = view.texel(f.x, f.y);
@@ -232,7 +255,16 @@ impl CpuKernel for OpaqueKernel {
                 let pos = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
                 let normal = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or(face);
                 let shadow = mask.load(i);
-                let c = shade(pos, normal, &lights, albedo, self.params.ambient, shadow);
+                let albedo = albedo[0] * b[0] + albedo[1] * b[1] + albedo[2] * b[2];
+                let c = shade(
+                    pos,
+                    normal,
+                    &lights,
+                    albedo,
+                    self.params.ambient,
+                    wrap,
+                    shadow,
+                );
                 let [w0, w1] = pack([c.x, c.y, c.z, 1.0]);
                 out.store(2 * i, w0);
                 out.store(2 * i + 1, w1);
