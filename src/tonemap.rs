@@ -141,7 +141,7 @@ mod tests {
             let g = t.display([0.18; 3], 0.0)[0];
             assert!((0.3..0.6).contains(&g), "{t:?}: 18% grey at {g}");
         }
-        assert_eq!(Tonemap::None.display([4.0; 3], 0.0), [1.0; 3]);
+        assert_eq!(Tonemap::None.display8([4.0; 3], 0.0), [255; 3]);
         // Exposure is a power of two on the input.
         let a = Tonemap::None.display([0.1; 3], 1.0);
         let b = Tonemap::None.display([0.2; 3], 0.0);

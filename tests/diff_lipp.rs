@@ -59,7 +59,7 @@ fn small_scene(tag: &str, beard: bool) -> PathBuf {
         )
     } else {
         (
-            "Orbit(target: (0.0, 1.5, 0.0), distance: 2.5, yaw_deg: 25.0, pitch_deg: 5.0, fov_deg: 40.0)",
+            "Orbit(target: (0.0, 1.5, 0.0), distance: 1.5, yaw_deg: 25.0, pitch_deg: 5.0, fov_deg: 40.0)",
             "",
         )
     };

@@ -168,10 +168,16 @@ fn motion_vectors_agree_on_wgpu() {
     assert!(same_zeros as f64 >= 0.999 * c.len() as f64);
 }
 
-/// Frame `C`: the near view moved 5 cm sideways.
+/// Frame `C`: the near view moved 5 cm sideways, looking the same way (a
+/// pure translation, so every pixel moves, not only those off the target's
+/// depth).
 fn third_frame() -> Upload {
     let mut scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
-    look_from(&mut scene, [0.05, 1.65, 0.9]);
+    scene.desc.camera = Camera::LookAt {
+        position: [0.05, 1.65, 0.9],
+        target: [0.05, 1.6, 0.0],
+        fov_deg: 35.0,
+    };
     upload(&scene, W, H)
 }
 

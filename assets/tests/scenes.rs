@@ -68,10 +68,10 @@ fn showcase_has_hair_brows_beard_and_three_lights() {
     let s = Scene::load(&scenes_dir().join("showcase.ron")).unwrap();
     assert_eq!(s.desc.lights.len(), 3);
     let names: Vec<&str> = s.grooms.iter().map(|g| g.name.as_str()).collect();
-    assert_eq!(names, ["hair", "eyebrows", "beard"]);
-    assert!(!s.grooms[0].facial_hair && s.grooms[1].facial_hair && s.grooms[2].facial_hair);
+    assert_eq!(names, ["hair", "eyebrows", "eyelashes", "beard"]);
+    assert!(!s.grooms[0].facial_hair && s.grooms[1..].iter().all(|g| g.facial_hair));
     let c = s.counts();
-    assert_eq!(c.strands, 60_000 + 1_500 + 24_000);
+    assert_eq!(c.strands, 60_000 + 1_500 + 360 + 24_000);
 }
 
 #[test]
@@ -84,7 +84,29 @@ fn crowd_has_twelve_characters_at_varied_distances() {
         .map(|m| -m.transform.translation[2])
         .collect();
     z.sort_by(f32::total_cmp);
-    assert!(z[0] < 2.0 && z[11] > 30.0, "{z:?}");
+    assert!(z[0] < 1.0 && z[11] > 20.0, "{z:?}");
+    // All twelve in frame at 16:9: each head's crown, chin and sides project
+    // inside the view.
+    let (eye, target, fov) = s.camera.eye_target_fov();
+    let view = glam::Mat4::look_at_rh(eye.into(), target.into(), glam::Vec3::Y);
+    let proj = glam::Mat4::perspective_rh(fov.to_radians(), 16.0 / 9.0, 0.05, 100.0);
+    for m in &s.meshes {
+        let c = glam::Vec3::from(m.transform.translation);
+        for d in [
+            [0.0, 0.12, 0.0],
+            [0.0, -0.11, 0.0],
+            [0.09, 0.0, 0.0],
+            [-0.09, 0.0, 0.0],
+        ] {
+            let p = proj * view * (c + glam::Vec3::from(d)).extend(1.0);
+            let ndc = p.truncate() / p.w;
+            assert!(
+                p.w > 0.0 && ndc.x.abs() < 0.98 && ndc.y.abs() < 0.98,
+                "{}: {ndc}",
+                m.name
+            );
+        }
+    }
 }
 
 #[test]

@@ -52,7 +52,13 @@ impl HairMesh {
                 axis = Some(a1);
                 let a2 = t.cross(a1);
                 let h = half * (1.0 - 0.4 * i as f32 / (pts.len() - 1) as f32);
-                let c = pts[i];
+                // Guides lie on the skin: lift the bundle's centre so its
+                // cross-section rests on the head instead of half inside it.
+                let c = if i == 0 {
+                    pts[i]
+                } else {
+                    surface.push_out(pts[i], h + 0.001)
+                };
                 let q = [
                     c - a1 * h - a2 * h,
                     c + a1 * h - a2 * h,
