@@ -103,7 +103,8 @@ render() { # scene graph png
 
 page=$out/README.md
 ((scenes_only)) && page=/dev/null
-((extras_only)) && styles=()
+# Re-rendering the extras replaces the page's earlier extras section.
+((extras_only)) && { styles=(); sed -i '/^## Real grooms/,$d' "$page"; }
 ((extras_only)) || {
   echo "# Gallery"
   echo

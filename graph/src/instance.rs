@@ -131,16 +131,21 @@ impl Plan {
 
 fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, String> {
     let overflow = || "size overflows 64 bits".to_string();
+    // Optional content (no head mesh, no hair mesh) keeps one placeholder
+    // element (see `Quantity::may_be_empty`); anything else at zero is an error below.
+    let elements = |quantity: Quantity| {
+        let n = q.count(quantity);
+        if quantity.may_be_empty() { n.max(1) } else { n }
+    };
     let size = match decl {
         ResourceDecl::Buffer { size, .. } => {
             let bytes = match *size {
                 BufferSize::Bytes(b) => b,
                 BufferSize::PerElement(quantity, per) => {
-                    q.count(quantity).checked_mul(per).ok_or_else(overflow)?
+                    elements(quantity).checked_mul(per).ok_or_else(overflow)?
                 }
-                BufferSize::Bits(quantity) => q.count(quantity).div_ceil(32) * 4,
-                BufferSize::PerElementPlus(quantity, per, extra) => q
-                    .count(quantity)
+                BufferSize::Bits(quantity) => elements(quantity).div_ceil(32) * 4,
+                BufferSize::PerElementPlus(quantity, per, extra) => elements(quantity)
                     .checked_mul(per)
                     .and_then(|b| b.checked_add(extra))
                     .ok_or_else(overflow)?,

@@ -113,6 +113,19 @@ pub enum Quantity {
     Tiles(u32),
 }
 
+impl Quantity {
+    /// Scene content a scene may lack: meshes (a groom with no head),
+    /// hair meshes, lights. Buffers sized by these hold at least one element
+    /// so their bindings stay valid; passes count from the quantities, never
+    /// from a buffer's length, so the placeholder is never read as content.
+    pub fn may_be_empty(self) -> bool {
+        matches!(
+            self,
+            Quantity::Triangles | Quantity::Bundles | Quantity::Lights
+        )
+    }
+}
+
 /// How many bytes a buffer holds.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
 pub enum BufferSize {

@@ -388,6 +388,29 @@ fn zero_sized_resource_is_reported_at_instantiation() {
 }
 
 #[test]
+fn optional_scene_content_may_be_absent() {
+    // No head mesh: a triangle buffer keeps one placeholder element.
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "triangles", size: PerElement(Triangles, 64), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "b", kind: "test.consume", reads: ["triangles"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let plan = compile_str("no_mesh.ron", src, &registry(), 1).unwrap();
+    let q = Quantities {
+        triangles: 0,
+        ..Quantities::example()
+    };
+    let instance = plan.instantiate(&q).unwrap();
+    assert_eq!(instance.sizes[0].bytes, 64);
+}
+
+#[test]
 fn several_errors_are_reported_together() {
     let src = r#"Graph(
     name: "g",

@@ -66,6 +66,20 @@ fn default_seed() -> u64 {
     1
 }
 
+impl HairMeshParams {
+    /// What a groom that declares no hair mesh is fitted with: a bundle per
+    /// 128 strands (Lipp's 127k-strand groom has 1,024), 16 to 1,024 of
+    /// them, and 8 layers.
+    pub fn fitted_default(strands: usize) -> HairMeshParams {
+        HairMeshParams {
+            bundles: (strands / 128).clamp(16, 1024) as u32,
+            layers: 8,
+            style: StrandStyle::default(),
+            seed: default_seed(),
+        }
+    }
+}
+
 impl HairMesh {
     pub fn bundle_count(&self) -> usize {
         self.bundles.len()

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::{GroomDesc, GroomSource, LodSettings, Material, MeshSource, SceneDesc};
 use crate::error::AssetError;
 use crate::groom::Groom;
-use crate::hairmesh::HairMesh;
+use crate::hairmesh::{HairMesh, HairMeshParams};
 use crate::loaders::envmap::{self, EnvMap};
 use crate::loaders::{self, LoadOptions};
 use crate::mesh::TriMesh;
@@ -298,8 +298,13 @@ fn load_groom(
     if let (Some(p), None) = (parent, &skinning) {
         skinning = Some(skinning::bake(&meshes[p].mesh, &groom.roots()));
     }
-    if let (None, Some(hm)) = (&hair_mesh, &g.hair_mesh) {
-        hair_mesh = Some(HairMesh::fit(&groom, hm));
+    if hair_mesh.is_none() {
+        // Lipp's pipelines draw hair meshes: fit one to every groom that
+        // declares none, so every pipeline can render every scene.
+        let params = g
+            .hair_mesh
+            .unwrap_or_else(|| HairMeshParams::fitted_default(groom.strand_count()));
+        hair_mesh = Some(HairMesh::fit(&groom, &params));
     }
     // Kulikov: a stable randomized strand order, so LOD draws a prefix.
     if g.lod.enabled {
