@@ -344,7 +344,7 @@ impl Report {
         let mut o = String::new();
         for label in shipped {
             // A pipeline whose every cell was skipped has no passes to show.
-            if let Ok(md) = strandgraph::tables::bench::pass_table(&json, &label) {
+            if let Ok(md) = strandgraph::tables::bench::pass_table(&json, &label, &[]) {
                 let _ = write!(o, "\n{md}");
             }
         }

@@ -156,15 +156,18 @@ fn roofline_line(json: &Value, backend: &str) -> String {
 }
 
 /// One variant's per-pass medians on the file's first backend, a column
-/// per view.
-pub fn pass_table(json: &Value, variant: &str) -> Result<String, String> {
+/// per view (only `only`'s views when it names any).
+pub fn pass_table(json: &Value, variant: &str, only: &[String]) -> Result<String, String> {
     let mut md = String::new();
     if let Some((backend, device)) = devices(json)?.into_iter().next() {
         let mine: Vec<&Value> = cells(json, &backend)
             .filter(|c| label(c) == variant && c.get("skipped").is_none())
+            .filter(|c| only.is_empty() || only.contains(&view_of(c)))
             .collect();
         if mine.is_empty() {
-            return Err(format!("no measured cell of `{variant}` on {backend}"));
+            return Err(format!(
+                "no measured cell of `{variant}` on {backend} in {only:?}"
+            ));
         }
         let views = distinct(mine.iter().copied(), view_of);
         let passes = passes_of(mine.iter().copied());
@@ -294,8 +297,12 @@ mod tests {
 
     #[test]
     fn pass_table_lists_one_variants_passes() {
-        let md = pass_table(&sample(), "K: all").unwrap();
+        let md = pass_table(&sample(), "K: all", &[]).unwrap();
         assert!(md.contains("| raster | `k.raster` | 1.250 |"), "{md}");
-        assert!(pass_table(&sample(), "L: all").is_err());
+        assert!(pass_table(&sample(), "L: all", &[]).is_err());
+        // Named views only; a view with no cell is an error, not an empty table.
+        let close = pass_table(&sample(), "K: all", &["close".to_string()]).unwrap();
+        assert!(close.contains("| pass | kind | close |"), "{close}");
+        assert!(pass_table(&sample(), "K: all", &["far".to_string()]).is_err());
     }
 }

@@ -15,8 +15,9 @@
 //! it, `tests/readme_tables.rs`). Generators:
 //! - `agree FILE.json...`: per-pass agreement ([`crate::agree::summary`]);
 //! - `bench FILE.json`: frame medians per pipeline variant and view;
-//! - `bench-passes FILE.json VARIANT`: one variant's per-pass medians per
-//!   view (`_` in VARIANT stands for a space: `Kulikov:_all_optimisations`);
+//! - `bench-passes FILE.json VARIANT [VIEW...]`: one variant's per-pass
+//!   medians per view, or only the views named (`_` in VARIANT stands for a
+//!   space: `Kulikov:_all_optimisations`);
 //! - `bench-delta BEFORE.json AFTER.json VARIANT VIEW`: one cell's per-pass
 //!   medians in two runs of the same device, and the change.
 
@@ -103,8 +104,8 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
         [kind, file] if kind == "bench" => {
             bench::frame_table(&read(file)?).map_err(|e| format!("{file}: {e}"))
         }
-        [kind, file, variant] if kind == "bench-passes" => {
-            bench::pass_table(&read(file)?, &variant.replace('_', " "))
+        [kind, file, variant, views @ ..] if kind == "bench-passes" => {
+            bench::pass_table(&read(file)?, &variant.replace('_', " "), views)
                 .map_err(|e| format!("{file}: {e}"))
         }
         [kind, before, after, variant, view] if kind == "bench-delta" => bench::delta_table(
@@ -114,7 +115,7 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
             view,
         ),
         _ => Err(format!(
-            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-passes FILE.json VARIANT, bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
+            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-passes FILE.json VARIANT [VIEW...], bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
             command.join(" ")
         )),
     }
