@@ -104,7 +104,7 @@ render() { # scene graph png
 page=$out/README.md
 ((scenes_only)) && page=/dev/null
 # Re-rendering the extras replaces the page's earlier extras section.
-((extras_only)) && { styles=(); sed -i '/^## Real grooms/,$d' "$page"; }
+((extras_only)) && { styles=(); sed -i -e '/^## Real grooms/,$d' -e '${/^$/d}' "$page"; }
 ((extras_only)) || {
   echo "# Gallery"
   echo

@@ -390,7 +390,16 @@ mod tests {
         assert_eq!(c.vertices, 500 * 8 + 200 * 4);
         assert_eq!(c.segments, 500 * 7 + 200 * 3);
         assert_eq!((c.models, c.lights, c.width, c.height), (2, 2, 640, 360));
-        assert!(c.bundles > 0 && c.bundles <= 20);
+        // The beard's declared hair mesh (at most 20 bundles) and the one
+        // fitted to the hair, which declares none (16 for 500 strands).
+        let bundles = |g: usize| {
+            s.grooms[g]
+                .hair_mesh
+                .as_ref()
+                .map_or(0, |m| m.bundle_count())
+        };
+        assert!((1..=16).contains(&bundles(0)) && (1..=20).contains(&bundles(1)));
+        assert_eq!(c.bundles as usize, bundles(0) + bundles(1));
         assert_eq!(s.graph, d.join("graphs/kulikov.ron"));
         assert!(s.grooms[1].facial_hair);
         assert_eq!(s.grooms[0].skinning.as_ref().map(Vec::len), Some(500));
