@@ -10,6 +10,7 @@ use rand_pcg::Pcg64Mcg;
 
 use super::styles::{Comb, Gather, Resolved};
 use super::surface::Surface;
+use crate::groom::arc_length_samples;
 
 /// Points a guide is grown with, whatever the groom's point count: enough for
 /// collisions with the head to be resolved smoothly.
@@ -53,9 +54,10 @@ impl Path {
     }
     /// `n` points evenly spaced along the path.
     pub fn resampled(&self, n: usize) -> Vec<Vec3> {
-        let len = self.length();
-        (0..n)
-            .map(|i| self.sample(len * i as f32 / (n - 1).max(1) as f32).0)
+        let p = &self.points;
+        arc_length_samples(p, n)
+            .into_iter()
+            .map(|(i, t)| p[i].lerp(p[(i + 1).min(p.len() - 1)], t))
             .collect()
     }
     /// The path cut where it first goes below `height` (unchanged if it never does).

@@ -94,17 +94,9 @@ pub struct Material {
 /// pbrt-v4's and Chiang 2016's default scale tilt, 2°.
 pub const DEFAULT_ALPHA: f32 = 2.0 * std::f32::consts::PI / 180.0;
 
-/// Chiang 2016 Eq. 9 inverted: absorption from a desired colour.
-pub fn sigma_a(color: [f32; 3], beta_n: f32) -> [f32; 3] {
-    let b = beta_n;
-    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b.powi(3)
-        + 5.574 * b.powi(4)
-        + 0.245 * b.powi(5);
-    color.map(|c| {
-        let l = c.clamp(1e-4, 1.0).ln() / d;
-        l * l
-    })
-}
+/// Chiang 2016 Eq. 9 inverted: absorption from a desired colour (the scene
+/// material's colour came from absorption through the same equation).
+pub use strandgraph_assets::hair_color::sigma_a_from_color as sigma_a;
 
 fn logistic(x: f32, s: f32) -> f32 {
     let e = (-x.abs() / s).exp();
