@@ -41,7 +41,8 @@ use strandgraph_graph::registry::ParamProblem;
 pub static PASSES: &[&dyn PassDef] = &[
     // Shared by every pipeline.
     &common::clear::CLEAR,
-    &opaque_mesh::depth_prepass::DEPTH_PREPASS,
+    &opaque_mesh::visibility::VISIBILITY,
+    &opaque_mesh::depth_resolve::DEPTH_RESOLVE,
     &opaque_mesh::opaque::OPAQUE,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
     &kulikov::lod::LOD,

@@ -42,8 +42,9 @@ fn capabilities_of(file: &str) -> Capabilities {
         // CPU kernel does (`budget as f64 / total as f64`).
         "kulikov/lod.wgsl" => BASE | Capabilities::FLOAT64,
         // atomic<u64> with atomicMin whose result is unused (docs/architecture.md, "Shaders").
-        // Lipp §3.1.2: 64-bit atomicMin into the G-buffer, result unused.
-        "bench/atomic_min64.wgsl" | "lipp/raster.wgsl" => {
+        // Lipp §3.1.2: 64-bit atomicMin into the G-buffer, result unused;
+        // the opaque meshes' visibility buffer likewise.
+        "bench/atomic_min64.wgsl" | "lipp/raster.wgsl" | "opaque_mesh/visibility.wgsl" => {
             BASE | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
         }
         _ => BASE,

@@ -41,7 +41,7 @@ struct ComposeParams {
 @group(0) @binding(7) var<storage, read> vertex_lighting: array<vec2<u32>>;
 @group(0) @binding(8) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> groom_vertices: array<vec4<f32>>;
-@group(0) @binding(10) var scene_depth: texture_depth_2d;
+@group(0) @binding(10) var scene_depth: texture_2d<f32>;
 @group(0) @binding(11) var output: texture_storage_2d<rgba16float, read_write>;
 @group(0) @binding(12) var hair_depth: texture_storage_2d<r32float, write>;
 
@@ -267,7 +267,7 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     }
     let x = i % params.width;
     let y = i / params.width;
-    let scene_z = textureLoad(scene_depth, vec2<u32>(x, y), 0);
+    let scene_z = textureLoad(scene_depth, vec2<u32>(x, y), 0).x;
     var z = scene_z;
     var color = textureLoad(output, vec2<u32>(x, y));
     var touched = false;

@@ -10,7 +10,7 @@ struct DepthDownsampleParams {
 }
 
 @group(0) @binding(0) var<uniform> params: DepthDownsampleParams;
-@group(0) @binding(1) var scene_depth: texture_depth_2d;
+@group(0) @binding(1) var scene_depth: texture_2d<f32>;
 @group(0) @binding(2) var hiz: texture_storage_2d<r32float, write>;
 
 @compute @workgroup_size(64)
@@ -28,7 +28,7 @@ fn downsample(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
     var far = 0.0;
     for (var y = by; y < min(by + HIZ_FACTOR, h); y++) {
         for (var x = bx; x < min(bx + HIZ_FACTOR, w); x++) {
-            far = max(far, textureLoad(scene_depth, vec2<u32>(x, y), 0));
+            far = max(far, textureLoad(scene_depth, vec2<u32>(x, y), 0).x);
         }
     }
     textureStore(hiz, vec2<u32>(i % hw, i / hw), vec4<f32>(far, 0.0, 0.0, 1.0));

@@ -56,7 +56,7 @@ struct RasterParams {
 @group(0) @binding(6) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> groom_vertices: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read> atlas_tiles: array<ModelTiles>;
-@group(0) @binding(9) var scene_depth: texture_depth_2d;
+@group(0) @binding(9) var scene_depth: texture_2d<f32>;
 // LAYERS layers of arrayLength / LAYERS texels each.
 @group(0) @binding(10) var<storage, read_write> vis_atlas: array<atomic<u32>>;
 @group(0) @binding(11) var<storage, read_write> coverage_atlas: array<atomic<u32>>;
@@ -159,7 +159,7 @@ fn pixel_request(s: Segment, x: i32, y: i32, coverage: f32) -> Request {
 }
 
 fn depth_passes(pos: u32, view_depth: f32) -> bool {
-    let z = textureLoad(scene_depth, vec2<u32>(pos & 0xFFFFu, pos >> 16u), 0);
+    let z = textureLoad(scene_depth, vec2<u32>(pos & 0xFFFFu, pos >> 16u), 0).x;
     return !(view_depth >= linear_depth(z, frame.near, frame.far));
 }
 

@@ -24,7 +24,7 @@ struct SkinShadowParams {
 @group(0) @binding(2) var<storage, read> models: array<ModelData>;
 @group(0) @binding(3) var<storage, read> lights: array<LightData>;
 @group(0) @binding(4) var<storage, read> density_grid: array<u32>;
-@group(0) @binding(5) var scene_depth: texture_depth_2d;
+@group(0) @binding(5) var scene_depth: texture_2d<f32>;
 @group(0) @binding(6) var<storage, read_write> skin_shadow: array<u32>;
 
 const GROUP: u32 = 64u;
@@ -42,7 +42,7 @@ fn world_at(x: i32, y: i32) -> Hit {
     if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
         return out;
     }
-    let z = textureLoad(scene_depth, vec2<i32>(x, y), 0);
+    let z = textureLoad(scene_depth, vec2<i32>(x, y), 0).x;
     if !(z < 1.0) {
         return out;
     }

@@ -38,7 +38,7 @@ struct RasterParams {
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
-@group(0) @binding(6) var scene_depth: texture_depth_2d;
+@group(0) @binding(6) var scene_depth: texture_2d<f32>;
 // Earlier grooms' depth (f32 bits), written by their filter passes.
 @group(0) @binding(7) var<storage, read> hair_depth: array<u32>;
 @group(0) @binding(8) var<storage, read_write> gbuffer: array<atomic<u64>>;
@@ -68,7 +68,7 @@ fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, uv: vec2<f32
         return;
     }
     let z = a.z + (b.z - a.z) * t;
-    if !(z >= 0.0 && z < 1.0) || z >= textureLoad(scene_depth, vec2<i32>(x, y), 0) {
+    if !(z >= 0.0 && z < 1.0) || z >= textureLoad(scene_depth, vec2<i32>(x, y), 0).x {
         return;
     }
     let pixel = u32(y) * params.width + u32(x);

@@ -1,25 +1,30 @@
-// scene.opaque: shade opaque meshes where they won the depth prepass.
+// scene.opaque: shade opaque meshes from their visibility buffer, once per
+// pixel. Port of passes/src/opaque_mesh/opaque.rs.
 //
-// A raster pipeline; the CPU kernel is passes/src/opaque_mesh/opaque.rs.
-// Pipeline state the backend sets: topology TriangleList, FrontFace::Ccw,
-// CullMode::Back; depth attachment `scene.depth` loaded (not cleared), compare
-// Equal, writes off; colour attachment 0 `output` (Rgba16Float) cleared to
-// params.background, alpha 1. Draw 3 × triangles vertices, no vertex buffers.
+// Each lane takes one pixel, fetches the triangle scene.visibility kept
+// there, sets it up again with the same integer rasterizer
+// (shaders/opaque_mesh/setup.wgsl) and interpolates the corners
+// perspective-correctly from the exact edge functions at the pixel centre.
 //
-// Bindings (group 0), in the order of the pass's bindings less its attachments,
-// every record a storage buffer: 0 = frame, 1 = mesh.triangles, 2 = lights,
-// 3 = skin_shadow (one mask word per pixel, kulikov/skin_shadow.wgsl).
-// Parameters are the uniform block at binding 0 (OpaqueParams::uniform).
+// Bindings (group 0): 0 = parameters, 1 = frame, 2 = mesh.triangles,
+// 3 = lights, 4 = skin_shadow (one mask word per pixel,
+// kulikov/skin_shadow.wgsl), 5 = scene.visibility (word pairs, low word
+// first), 6 = output (Rgba16Float storage image).
 //
 #import strandgraph::layout::{FrameData, TriangleData, LightData}
+#import strandgraph::clip::transform
+#import strandgraph::opaque_setup::{setup_triangle, edges, barycentrics}
 
-// passes/src/opaque_mesh/opaque.rs: OpaqueParams. `background` is the colour
-// attachment's clear value, not a shader input.
+// passes/src/opaque_mesh/opaque.rs: OpaqueParams::uniform.
 struct OpaqueParams {
     // rgb: albedo; a: ambient.
     albedo_ambient: vec4<f32>,
     // Diffuse wrap per channel (xyz).
     wrap: vec4<f32>,
+    // rgb: where no mesh is drawn.
+    background: vec4<f32>,
+    width: u32,
+    height: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: OpaqueParams;
@@ -27,19 +32,11 @@ struct OpaqueParams {
 @group(0) @binding(2) var<storage, read> mesh_triangles: array<TriangleData>;
 @group(0) @binding(3) var<storage, read> lights: array<LightData>;
 @group(0) @binding(4) var<storage, read> skin_shadow: array<u32>;
+@group(0) @binding(5) var<storage, read> scene_visibility: array<vec2<u32>>;
+@group(0) @binding(6) var output: texture_storage_2d<rgba16float, write>;
 
-
-const PI: f32 = 3.14159265358979;
-
-struct VertexOut {
-    // Invariant: must match scene.depth_prepass bit for bit (depth Equal).
-    @invariant @builtin(position) position: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    // Geometric normal, the fallback when the corner normals cancel out.
-    @location(2) @interpolate(flat) face: vec3<f32>,
-    @location(3) albedo: vec3<f32>,
-}
+// 1/π, multiplied as the CPU kernel does (std::f32::consts::FRAC_1_PI).
+const FRAC_1_PI: f32 = 0.318309886183791;
 
 // assets/src/octahedral.rs: unpack_unit_vector (two snorm16, x low, y high;
 // Cigolle et al. 2014). unpack2x16snorm clamps at -1 like unsnorm16.
@@ -62,54 +59,47 @@ fn unpack_unit_vector(bits: u32) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
-fn corner(t: TriangleData, k: u32) -> vec4<f32> {
-    if k == 1u {
-        return t.b;
-    } else if k == 2u {
-        return t.c;
-    }
-    return t.a;
-}
-
-@vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> VertexOut {
-    let t = mesh_triangles[vertex / 3u];
-    let w_a = (frame.view_proj * vec4<f32>(t.a.xyz, 1.0)).w;
-    let w_b = (frame.view_proj * vec4<f32>(t.b.xyz, 1.0)).w;
-    let w_c = (frame.view_proj * vec4<f32>(t.c.xyz, 1.0)).w;
-    let p = corner(t, vertex % 3u);
-    var out: VertexOut;
-    // Each corner's painted albedo (8-bit square roots) or the pass's albedo.
-    let packed = t.albedo[vertex % 3u];
+// Each corner's painted albedo (8-bit square roots) or the pass's albedo.
+fn corner_albedo(packed: u32) -> vec3<f32> {
     let e = unpack4x8unorm(packed).xyz;
-    out.albedo = select(params.albedo_ambient.rgb, e * e, packed != 0u);
-    out.world = p.xyz;
-    out.normal = unpack_unit_vector(bitcast<u32>(p.w));
-    let f = cross(t.b.xyz - t.a.xyz, t.c.xyz - t.a.xyz);
-    out.face = select(vec3<f32>(0.0, 0.0, 1.0), normalize(f), dot(f, f) > 0.0);
-    // The same near-plane drop as depth_prepass.wgsl and the CPU kernels.
-    if min(w_a, min(w_b, w_c)) <= frame.near {
-        out.position = vec4<f32>(0.0, 0.0, 0.0, 1.0);
-        return out;
-    }
-    out.position = frame.view_proj * vec4<f32>(p.xyz, 1.0);
-    return out;
+    return select(params.albedo_ambient.rgb, e * e, packed != 0u);
 }
 
 // Lambert (BRDF albedo/π) over every light plus ambient × albedo, scaled by
 // the pixel's shadow mask (bytes 0-2: lights 0-2, byte 3: ambient), as
-// `shade` in passes/src/opaque_mesh/opaque.rs. Linear RGB.
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    // Perspective-correct interpolation (the default) of the corner normals.
-    var n = in.face;
-    if dot(in.normal, in.normal) > 0.0 {
-        n = normalize(in.normal);
+// `shade` in passes/src/opaque_mesh/opaque.rs. Linear RGB; false when the
+// triangle does not set up.
+fn shade_pixel(t: u32, x: u32, y: u32, mask: u32, color: ptr<function, vec3<f32>>) -> bool {
+    if t >= arrayLength(&mesh_triangles) {
+        return false;
     }
+    let tri = mesh_triangles[t];
+    let m = frame.view_proj;
+    let s = setup_triangle(
+        transform(m, vec4<f32>(tri.a.xyz, 1.0)),
+        transform(m, vec4<f32>(tri.b.xyz, 1.0)),
+        transform(m, vec4<f32>(tri.c.xyz, 1.0)),
+        frame.near,
+        params.width,
+        params.height,
+    );
+    if !s.valid {
+        return false;
+    }
+    let b = barycentrics(s, edges(s, x, y));
+    let world = tri.a.xyz * b.x + tri.b.xyz * b.y + tri.c.xyz * b.z;
+    let f = cross(tri.b.xyz - tri.a.xyz, tri.c.xyz - tri.a.xyz);
+    let face = select(vec3<f32>(0.0, 0.0, 1.0), normalize(f), dot(f, f) > 0.0);
+    let normal = unpack_unit_vector(bitcast<u32>(tri.a.w)) * b.x
+        + unpack_unit_vector(bitcast<u32>(tri.b.w)) * b.y
+        + unpack_unit_vector(bitcast<u32>(tri.c.w)) * b.z;
+    var n = face;
+    if dot(normal, normal) > 0.0 {
+        n = normalize(normal);
+    }
+    let albedo = corner_albedo(tri.albedo[0]) * b.x + corner_albedo(tri.albedo[1]) * b.y
+        + corner_albedo(tri.albedo[2]) * b.z;
     let count = min(frame.light_count, arrayLength(&lights));
-    // The fragment's pixel: position.xy is its centre (x + 0.5, y + 0.5).
-    let pixel = vec2<u32>(in.position.xy);
-    let mask = skin_shadow[pixel.y * u32(frame.screen.x) + pixel.x];
     var irradiance = vec3<f32>(0.0);
     for (var i = 0u; i < count; i += 1u) {
         let l = lights[i];
@@ -119,10 +109,10 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
             let d = l.position_or_direction.xyz;
             to_light = select(vec3<f32>(0.0), -normalize(d), dot(d, d) > 0.0);
         } else {
-            let d = l.position_or_direction.xyz - in.world;
+            let d = l.position_or_direction.xyz - world;
             // Clamped at 1 cm, as in the CPU kernel.
             let d2 = max(dot(d, d), 1e-4);
-            to_light = d * inverseSqrt(d2);
+            to_light = d / sqrt(d2);
             falloff = 1.0 / d2;
         }
         // kulikov::skin_shadow::light_visibility: lights past the third are lit.
@@ -135,8 +125,26 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         let wrapped = max((vec3<f32>(dot(n, to_light)) + w) / (vec3<f32>(1.0) + w), vec3<f32>(0.0));
         irradiance += l.radiance.rgb * wrapped * (falloff * visible);
     }
-    let albedo = in.albedo;
     let ambient = params.albedo_ambient.a * (f32(mask >> 24u) / 255.0);
-    let color = albedo * (irradiance / PI + vec3<f32>(ambient));
-    return vec4<f32>(color, 1.0);
+    *color = albedo * (irradiance * FRAC_1_PI + vec3<f32>(ambient));
+    return true;
+}
+
+@compute @workgroup_size(256)
+fn opaque(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= params.width * params.height {
+        return;
+    }
+    let x = i % params.width;
+    let y = i / params.width;
+    let v = scene_visibility[i];
+    var color = params.background.rgb;
+    if !(v.x == 0xFFFFFFFFu && v.y == 0xFFFFFFFFu) {
+        var lit: vec3<f32>;
+        if shade_pixel(v.x, x, y, skin_shadow[i], &lit) {
+            color = lit;
+        }
+    }
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(color, 1.0));
 }

@@ -55,12 +55,9 @@ pub fn own_input(kind: &str, binding: &str) -> Option<(&'static str, &'static st
         .map(|o| (o.2, o.3))
 }
 
-static OWN_INPUTS: &[(&str, &str, &str, &str)] = &[(
-    "scene.opaque",
-    "scene.depth",
-    "scene.depth_prepass",
-    "a depth-equal test passes only against depth from the same rasterizer: each backend shades over its own prepass depth",
-)];
+// None today: the opaque head's shading pass used to need its own backend's
+// prepass depth (a depth-equal test); it now reads the visibility buffer.
+static OWN_INPUTS: &[(&str, &str, &str, &str)] = &[];
 
 /// Which GPU backends an exception covers.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -89,23 +86,12 @@ struct Exception {
 // README says so: the bound is what CI enforces, not what every GPU meets.
 static EXCEPTIONS: &[Exception] = &[
     Exception {
-        kind: "scene.depth_prepass",
-        binding: "scene.depth",
-        on: On::Every,
-        rule: Rule::F32 {
-            ulps: 128,
-            abs: 1e-6,
-        },
-        outliers: 0.0,
-        why: "the hardware rasterizer interpolates depth with its own plane equations; the CPU evaluates barycentrics in f32 (lavapipe ≤ 68 ULP, H100 ≤ 54)",
-    },
-    Exception {
         kind: "scene.opaque",
         binding: "output",
         on: On::Every,
         rule: Rule::F16 { ulps: 2 },
         outliers: 0.005,
-        why: "shading inputs are varyings the hardware interpolates (normals, positions): a few specular texels move more than 2 half-ULPs (lavapipe 0.27% of words, H100 0.003%)",
+        why: "perspective-correct barycentrics divide by a varying sum and normalise the interpolated normal (Vulkan allows OpFDiv 2.5 ULP, inverseSqrt 2 ULP): a few texels move more than 2 half-ULPs",
     },
     Exception {
         kind: "kulikov.compose",

@@ -16,6 +16,7 @@
 //! Addresses and values come from a hash of the invocation's global id, so
 //! every backend performs the same sequence of operations.
 
+pub mod hardware_rules;
 mod raster;
 mod roofline;
 

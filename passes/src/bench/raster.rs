@@ -11,10 +11,10 @@
 //! is the same whatever order triangles are drawn in, on every backend.
 
 use super::roofline::pcg;
+use crate::bench::hardware_rules::Setup;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx};
-use crate::opaque_mesh::raster::Setup;
 use crate::params::{Invalid, PassParams, in_range};
 use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use strandgraph_graph::Quantities;

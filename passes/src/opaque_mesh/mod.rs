@@ -1,22 +1,26 @@
-//! Opaque scene geometry (heads, bodies): a depth prepass and a forward
-//! shading pass, the kinds `scene.depth_prepass` and `scene.opaque` (named
-//! for what graphs see: the scene's opaque meshes, as opposed to hair). The Kulikov pipeline composes its hair coverage over this
-//! opaque head, and culls and depth-tests hair against `scene.depth`.
+//! Opaque scene geometry (heads, bodies), the kinds graphs see as
+//! `scene.*` (the scene's opaque meshes, as opposed to hair):
 //!
-//! Both passes run one lane per triangle on the CPU simulator and share the
-//! fixed-point rasterizer in [`raster`], so the opaque pass's depth-equal test
-//! sees exactly the bits the prepass wrote. On the GPU backends they are real
-//! raster pipelines (`shaders/opaque_mesh/*.wgsl`), which apply the same rules.
+//! - `scene.visibility` rasterizes every triangle once, in a compute shader,
+//!   into a 64-bit visibility buffer (depth and triangle index per pixel);
+//! - `scene.depth_resolve` turns it into `scene.depth`, the depth image the
+//!   hair pipelines cull and depth-test against;
+//! - `scene.opaque` shades each covered pixel's triangle once.
+//!
+//! All three run the same integer rasterizer ([`setup`]) on every backend
+//! (`shaders/opaque_mesh/*.wgsl` mirror the CPU kernels).
 
-pub mod depth_prepass;
+pub mod depth_resolve;
 pub mod opaque;
-pub mod raster;
+pub mod setup;
+pub mod visibility;
 
 use crate::contract::Dispatch;
 use crate::kernel::{Ctx, Words};
+use crate::kulikov::transform;
 use crate::layout::{FrameData, TriangleData, read};
-use glam::{Mat4, Vec3, Vec4};
-use raster::Setup;
+use glam::{Vec3, Vec4};
+use setup::Setup;
 use strandgraph_assets::octahedral::unpack_unit_vector;
 use strandgraph_graph::schema::Quantity;
 
@@ -25,6 +29,18 @@ pub const GROUP: u32 = 64;
 
 /// Words per `TriangleData` record.
 const TRIANGLE_WORDS: usize = std::mem::size_of::<TriangleData>() / 4;
+
+/// Lanes per workgroup of the per-pixel passes: 256 keeps a 4K screen
+/// under the 65,535 workgroups Vulkan guarantees in one dimension.
+pub const PIXEL_GROUP: u32 = 256;
+
+/// One workgroup per [`PIXEL_GROUP`] pixels.
+const fn pixel_dispatch() -> Dispatch {
+    Dispatch::PerElement {
+        quantity: Quantity::Pixels,
+        per_group: PIXEL_GROUP,
+    }
+}
 
 const fn dispatch() -> Dispatch {
     Dispatch::PerElement {
@@ -50,7 +66,6 @@ pub fn corner_normals(t: &TriangleData) -> [Vec3; 3] {
 /// What both kernels decode once per workgroup.
 struct View<'a> {
     frame: FrameData,
-    view_proj: Mat4,
     width: u32,
     height: u32,
     triangles: Words<'a>,
@@ -64,7 +79,6 @@ impl<'a> View<'a> {
         let triangles = ctx.words("mesh.triangles");
         let stored = (triangles.len() / TRIANGLE_WORDS) as u64;
         Self {
-            view_proj: Mat4::from_cols_array(&frame.view_proj),
             frame,
             width: ctx.quantities.width,
             height: ctx.quantities.height,
@@ -73,16 +87,29 @@ impl<'a> View<'a> {
         }
     }
 
-    /// Calls `f` with each of this workgroup's triangles that survives setup.
-    fn for_each_triangle(&self, group: u32, mut f: impl FnMut(&TriangleData, &Setup)) {
+    /// Calls `f` with the index and setup of each of this workgroup's
+    /// triangles that survives setup.
+    fn for_each_triangle(&self, group: u32, mut f: impl FnMut(u32, &Setup)) {
         let first = group.saturating_mul(GROUP);
         for t in first..first.saturating_add(GROUP).min(self.count) {
-            let tri: TriangleData = read(&self.triangles, t as usize);
-            let clip = corners(&tri).map(|p| self.view_proj * Vec4::from((p, 1.0)));
-            if let Some(s) = Setup::from_clip(clip, self.frame.near, self.width, self.height) {
-                f(&tri, &s);
+            if let Some(s) = self.setup(&self.triangle(t)) {
+                f(t, &s);
             }
         }
+    }
+
+    /// Triangle `t` (a zeroed record past the bound buffer, as robust access reads).
+    fn triangle(&self, t: u32) -> TriangleData {
+        read(&self.triangles, t as usize)
+    }
+
+    /// The rasterizer's setup of `tri` for this view. The product sums in
+    /// column order, as the WGSL `transform` does, so every backend snaps
+    /// the same positions.
+    fn setup(&self, tri: &TriangleData) -> Option<Setup> {
+        let clip = corners(tri)
+            .map(|p| Vec4::from(transform(&self.frame.view_proj, [p.x, p.y, p.z, 1.0])));
+        Setup::from_clip(clip, self.frame.near, self.width, self.height)
     }
 
     /// Row-major texel index.
@@ -91,20 +118,10 @@ impl<'a> View<'a> {
     }
 }
 
-/// Fills every word of `words` with `value` (a render pass's clear load op).
-fn clear(words: &Words<'_>, value: u32) {
-    use rayon::prelude::*;
-    (0..words.len())
-        .into_par_iter()
-        .with_min_len(1 << 14)
-        .for_each(|i| words.store(i, value));
-}
-
 #[cfg(test)]
 pub(crate) mod testing {
-    //! Scenes built by hand for the tests of both passes.
+    //! Scenes built by hand for the tests of the three passes.
 
-    use super::GROUP;
     use crate::contract::PassDef;
     use crate::kernel::harness::Harness;
     use crate::layout::{FrameData, LightData, TriangleData, words_of};
@@ -173,7 +190,8 @@ pub(crate) mod testing {
         }
     }
 
-    /// A harness with every binding of both passes.
+    /// A harness with every binding of the three passes, the visibility
+    /// buffer cleared to empty.
     pub fn harness(mut frame: FrameData, tris: &[TriangleData], lights: &[LightData]) -> Harness {
         let (w, h) = (frame.screen[0] as u32, frame.screen[1] as u32);
         frame.light_count = lights.len() as u32;
@@ -188,15 +206,32 @@ pub(crate) mod testing {
             .buffer("mesh.triangles", words_of(tris))
             .buffer("lights", words_of(lights))
             .buffer("skin_shadow", vec![u32::MAX; (w * h) as usize])
+            .buffer("scene.visibility", vec![u32::MAX; (2 * w * h) as usize])
             .buffer("scene.depth", vec![0; (w * h) as usize])
             .buffer("output", vec![0; (2 * w * h) as usize]);
         hs
     }
 
-    /// Runs one pass with default parameters over every triangle.
+    /// Runs one pass with default parameters.
     pub fn run(hs: &Harness, def: &dyn PassDef) {
-        let kernel = def.cpu_kernel(&ron::Value::Unit).expect("default params");
-        let groups = hs.quantities.triangles.div_ceil(u64::from(GROUP)) as u32;
-        hs.run(kernel.as_ref(), groups, def.workgroup_size());
+        run_with(hs, def, &ron::Value::Unit);
+    }
+
+    /// Runs one pass with `params`, over the workgroups its dispatch asks for.
+    pub fn run_with(hs: &Harness, def: &dyn PassDef, params: &ron::Value) {
+        let kernel = def.cpu_kernel(params).expect("valid params");
+        let groups = def
+            .dispatch()
+            .direct_groups(&hs.quantities, 0)
+            .expect("a direct dispatch");
+        hs.run(kernel.as_ref(), groups as u32, def.workgroup_size());
+    }
+
+    /// Visibility, depth resolve and shading: what a graph runs, in order.
+    pub fn render(hs: &Harness) {
+        use super::{depth_resolve::DEPTH_RESOLVE, opaque::OPAQUE, visibility::VISIBILITY};
+        for def in [&VISIBILITY as &dyn PassDef, &DEPTH_RESOLVE, &OPAQUE] {
+            run(hs, def);
+        }
     }
 }

@@ -1,22 +1,19 @@
-//! `scene.opaque`: shade opaque meshes into `output` where they won the
-//! depth prepass.
+//! `scene.opaque`: shade opaque meshes into `output`, once per pixel, from
+//! the visibility buffer `scene.visibility` wrote.
 //!
-//! Each lane rasterizes one triangle exactly as `scene.depth_prepass` did
-//! (same [`Setup`](super::raster::Setup), same bits) and shades the pixels
-//! whose interpolated depth *equals* the stored depth: a depth-equal pass
-//! after a prepass, the usual way to shade each pixel once. The top-left rule
-//! gives every pixel centre to one triangle of a closed mesh, so the image
-//! does not depend on triangle or workgroup order. (Coplanar duplicates, which
-//! our meshes do not have, would tie; the GPU resolves those by primitive
-//! order, the simulator by whichever lane stores last.)
+//! Each lane takes one pixel, fetches the triangle that won it, sets it up
+//! again with the same integer rasterizer ([`Setup`](super::setup::Setup)),
+//! and interpolates its corners perspective-correctly from the exact edge
+//! functions at the pixel centre: deferred shading from a visibility buffer
+//! (Burns and Hunt, "The Visibility Buffer: A Cache-Friendly Approach to
+//! Deferred Shading", JCGT 2013). Pixels no triangle covers get `background`.
 //!
 //! Shading is diffuse with the scene's lights plus a small ambient term, in
 //! linear RGB (the CLI tone-maps when saving), with Green's wrap lighting
 //! per channel (GPU Gems, 2004, ch. 16, "Real-Time Approximations to
 //! Subsurface Scattering": `max((n·l + w) / (1 + w), 0)`; a wider wrap in
 //! red is skin's cheap subsurface look) and each corner's painted albedo
-//! interpolated, or the pass's `albedo` for unpainted meshes: the opaque head the
-//! Kulikov issue composes its coverage visualisation over. Each light's
+//! interpolated, or the pass's `albedo` for unpainted meshes. Each light's
 //! irradiance and the ambient term are scaled by the pixel's `skin_shadow`
 //! mask word (bytes 0–2: lights 0–2, byte 3: ambient; see
 //! `kulikov::skin_shadow`), written by `kulikov.skin_shadow` from the hair
@@ -24,72 +21,43 @@
 //!
 //! `output` is `Rgba16Float`: 2 words per texel, row-major,
 //! word 0 = r | g << 16, word 1 = b | a << 16 (IEEE half floats).
-//!
-//! On the GPU backends this is a raster pipeline (`shaders/opaque_mesh/opaque.wgsl`):
-//! colour attachment cleared to `background`, depth attachment `scene.depth`
-//! loaded with compare `Equal` and writes off, `FrontFace::Ccw`,
-//! `CullMode::Back`; [`OpaqueParams::uniform`] fills its parameter block.
 
-use super::{GROUP, View, corner_normals, corners, dispatch};
+use super::visibility::unpack;
+use super::{PIXEL_GROUP, View, corner_normals, corners, pixel_dispatch};
 use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
 use crate::kulikov::skin_shadow::{ambient_visibility, light_visibility};
 use crate::layout::{LightData, read, unpack_albedo};
 use crate::params::{Invalid, PassParams, non_negative};
-use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
 use glam::Vec3;
 use half::f16;
-use strandgraph_graph::Quantities;
 
 pub static OPAQUE: PassKind<OpaqueParams, OpaqueGpu> = PassKind {
     kind: "scene.opaque",
-    summary: "shade opaque meshes, including hair shadows on skin",
-    source: "Kulikov 2025, 'Hair shadows on skin'",
+    summary: "shade opaque meshes from their visibility buffer, including hair shadows on skin",
+    source: "Kulikov 2025, 'Hair shadows on skin'; Burns and Hunt 2013 (visibility buffer)",
     bindings: Some(&[
         Binding::read("frame"),
         Binding::read("mesh.triangles"),
         Binding::read("lights"),
         Binding::read("skin_shadow"),
-        Binding::read("scene.depth"),
+        Binding::read("scene.visibility"),
         Binding::write("output"),
     ]),
-    workgroup_size: GROUP,
-    dispatch: dispatch(),
-    shader: Shader {
-        file: "opaque_mesh/opaque.wgsl",
-        entry: "vs_main",
-        fragment: Some("fs_main"),
-    },
+    workgroup_size: PIXEL_GROUP,
+    dispatch: pixel_dispatch(),
+    shader: Shader::compute("opaque_mesh/opaque.wgsl", "opaque"),
     kernel: |p| Box::new(OpaqueKernel { params: *p }),
-    gpu: |p, _| p.uniform(),
-    raster: Some(draw),
+    gpu: |p, q| p.uniform(q.width, q.height),
+    raster: None,
 };
-
-/// Shades where the prepass's depth is equal (the kernel's `==` test),
-/// over the background the prologue clears to.
-fn draw(p: &OpaqueParams, q: &Quantities) -> RasterState {
-    let [r, g, b] = p.background;
-    RasterState {
-        vertices: q.triangles * 3,
-        cull_back_faces: true,
-        color_load: ColorLoad::Clear([r, g, b, 1.0]),
-        depth_load: DepthLoad::Load,
-        draws: vec![Draw {
-            fragment: "fs_main",
-            blend: Blend::Replace,
-            color_writes: true,
-            depth_compare: Compare::Equal,
-            depth_write: false,
-        }],
-    }
-}
 
 /// The pass's parameters, with their defaults.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct OpaqueParams {
-    /// Linear RGB where no mesh is drawn (the colour attachment's clear value).
+    /// Linear RGB where no mesh is drawn.
     pub background: [f32; 3],
     /// Linear RGB diffuse albedo (default: a skin tone).
     pub albedo: [f32; 3],
@@ -138,18 +106,27 @@ crate::gpu_block! {
         albedo_ambient: [f32; 4],
         /// xyz: wrap per channel.
         wrap: [f32; 4],
+        /// rgb: where no mesh is drawn; a: 1.
+        background: [f32; 4],
+        width: u32,
+        height: u32,
+        _pad: [u32; 2],
     }
 }
 
 impl OpaqueParams {
-    /// The WGSL `OpaqueParams` block at binding 0: albedo rgb, ambient.
-    /// (`background` is the colour attachment's clear value.)
-    pub fn uniform(&self) -> OpaqueGpu {
+    /// The WGSL `OpaqueParams` block at binding 0, for a `width` × `height` screen.
+    pub fn uniform(&self, width: u32, height: u32) -> OpaqueGpu {
         let [r, g, b] = self.albedo;
         let [wr, wg, wb] = self.wrap;
+        let [br, bg, bb] = self.background;
         OpaqueGpu {
             albedo_ambient: [r, g, b, self.ambient],
             wrap: [wr, wg, wb, 0.0],
+            background: [br, bg, bb, 1.0],
+            width,
+            height,
+            _pad: [0; 2],
         }
     }
 }
@@ -208,69 +185,65 @@ impl OpaqueKernel {
             .min(stored);
         (0..n as usize).map(|i| read(&w, i)).collect()
     }
+
+    /// Linear RGB of pixel (x, y), covered by triangle `t`; `None` when the
+    /// triangle does not set up (a visibility word from another frame).
+    fn shade_pixel(
+        &self,
+        view: &View<'_>,
+        lights: &[LightData],
+        t: u32,
+        (x, y): (u32, u32),
+        shadow: u32,
+    ) -> Option<Vec3> {
+        if t >= view.count {
+            return None;
+        }
+        let tri = view.triangle(t);
+        let setup = view.setup(&tri)?;
+        let b = setup.barycentrics(setup.edges(x, y));
+        let (p, n) = (corners(&tri), corner_normals(&tri));
+        let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Z);
+        let default_albedo = Vec3::from(self.params.albedo);
+        let albedo = tri
+            .albedo
+            .map(|w| unpack_albedo(w).map_or(default_albedo, Vec3::from));
+        let lerp = |v: [Vec3; 3]| v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+        Some(shade(
+            lerp(p),
+            lerp(n).normalize_or(face),
+            lights,
+            lerp(albedo),
+            self.params.ambient,
+            Vec3::from(self.params.wrap),
+            shadow,
+        ))
+    }
 }
 
 impl CpuKernel for OpaqueKernel {
-    fn prologue(&self, ctx: &Ctx<'_>) {
-        let [r, g, b] = self.params.background;
-        let texel = pack([r, g, b, 1.0]);
-        let out = ctx.words("output");
-        // Interleaved words: clear pairs, so no texel is half background.
-        use rayon::prelude::*;
-        (0..out.len() / 2)
-            .into_par_iter()
-            .with_min_len(1 << 14)
-            .for_each(|i| {
-                out.store(2 * i, texel[0]);
-                out.store(2 * i + 1, texel[1]);
-            });
-        // An odd trailing word (never for a well-sized image) still gets cleared.
-        if out.len() % 2 == 1 {
-            out.store(out.len() - 1, texel[0]);
-        }
-    }
-
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let view = View::load(ctx);
         let lights = Self::lights(ctx, &view);
-        let (depth, out) = (ctx.words("scene.depth"), ctx.words("output"));
+        let (vis, out) = (ctx.words("scene.visibility"), ctx.words("output"));
         let mask = ctx.words("skin_shadow");
-        let default_albedo = Vec3::from(self.params.albedo);
-        let wrap = Vec3::from(self.params.wrap);
+        let background = Vec3::from(self.params.background);
+        let pixels = view.width as usize * view.height as usize;
+        let first = group as usize * PIXEL_GROUP as usize;
         let mut local = CounterValues::default();
-        view.for_each_triangle(group, |tri, setup| {
-            let p = corners(tri);
-            let n = corner_normals(tri);
-            let albedo = tri
-                .albedo
-                .map(|w| unpack_albedo(w).map_or(default_albedo, Vec3::from));
-            let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Z);
-            setup.rasterize(|f| {
-                let i = view.texel(f.x, f.y);
-                // Depth-equal test against the prepass: same rasterizer, same bits.
-                if depth.load(i) != f.depth.to_bits() {
-                    return;
-                }
-                let b = setup.perspective(f.screen);
-                let pos = p[0] * b[0] + p[1] * b[1] + p[2] * b[2];
-                let normal = (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or(face);
-                let shadow = mask.load(i);
-                let albedo = albedo[0] * b[0] + albedo[1] * b[1] + albedo[2] * b[2];
-                let c = shade(
-                    pos,
-                    normal,
-                    &lights,
-                    albedo,
-                    self.params.ambient,
-                    wrap,
-                    shadow,
-                );
-                let [w0, w1] = pack([c.x, c.y, c.z, 1.0]);
-                out.store(2 * i, w0);
-                out.store(2 * i + 1, w1);
-                local.pixels_written += 1;
-            });
-        });
+        for i in first..(first + PIXEL_GROUP as usize).min(pixels) {
+            let xy = (
+                (i % view.width as usize) as u32,
+                (i / view.width as usize) as u32,
+            );
+            let c = unpack(vis.load_u64(i))
+                .and_then(|(t, _)| self.shade_pixel(&view, &lights, t, xy, mask.load(i)))
+                .unwrap_or(background);
+            let [w0, w1] = pack([c.x, c.y, c.z, 1.0]);
+            out.store(2 * i, w0);
+            out.store(2 * i + 1, w1);
+            local.pixels_written += 1;
+        }
         if ctx.instrument {
             ctx.counters.add(&local);
         }
@@ -279,8 +252,7 @@ impl CpuKernel for OpaqueKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::depth_prepass::DEPTH_PREPASS;
-    use super::super::testing::{frame, harness, head, run, sun, triangle};
+    use super::super::testing::{frame, harness, head, render as run_all, sun, triangle};
     use super::*;
 
     fn unpack(words: &[u32], i: usize) -> [f32; 4] {
@@ -320,7 +292,7 @@ mod tests {
     fn uniform_block_carries_albedo_and_ambient() {
         let p = OpaqueParams::default();
         assert_eq!(
-            p.uniform().albedo_ambient,
+            p.uniform(4, 4).albedo_ambient,
             [p.albedo[0], p.albedo[1], p.albedo[2], p.ambient]
         );
         let wgsl = include_str!("../../../shaders/opaque_mesh/opaque.wgsl");
@@ -348,8 +320,7 @@ mod tests {
             Vec3::X,
         );
         let hs = harness(f, &[far, near], &[light]);
-        run(&hs, &DEPTH_PREPASS);
-        run(&hs, &OPAQUE);
+        run_all(&hs);
         assert_eq!(hs.out_of_bounds(), 0);
         let out = hs.read("output");
         let p = OpaqueParams::default();
@@ -361,9 +332,9 @@ mod tests {
         assert!((corner[2] - p.background[2]).abs() < 1e-3, "{corner:?}");
     }
 
-    /// Prepass then opaque from 1 m in front of the origin, under a sun and a
-    /// point light; returns depth, output, out-of-bounds accesses and the
-    /// milliseconds both passes took.
+    /// Visibility, depth and shading from 1 m in front of the origin, under a
+    /// sun and a point light; returns depth, output, out-of-bounds accesses
+    /// and the milliseconds the three passes took.
     fn render(
         tris: &[crate::layout::TriangleData],
         w: u32,
@@ -377,8 +348,7 @@ mod tests {
         }];
         let hs = harness(f, tris, &lights);
         let start = std::time::Instant::now();
-        run(&hs, &DEPTH_PREPASS);
-        run(&hs, &OPAQUE);
+        run_all(&hs);
         let ms = start.elapsed().as_secs_f64() * 1e3;
         (
             hs.read("scene.depth"),
@@ -432,7 +402,7 @@ mod tests {
         assert_eq!(oob, 0);
         let covered = depth.iter().filter(|&&d| d != 1.0f32.to_bits()).count();
         println!(
-            "head: {} triangles, {covered} pixels at 1920x1080, prepass + opaque {ms:.1} ms",
+            "head: {} triangles, {covered} pixels at 1920x1080, visibility + depth + opaque {ms:.1} ms",
             tris.len()
         );
         assert!(covered > 100_000);

@@ -1,9 +1,7 @@
-//! Triangle rasterization shared by `scene.depth_prepass` and `scene.opaque`.
-//!
-//! The CPU kernels must make the same coverage decisions as the GPU
-//! backends' hardware rasterizers, and the opaque pass must reproduce the
-//! prepass's depth bit for bit (it shades where depth is *equal*). So the
-//! rules here are the ones D3D11 and Vulkan specify for hardware:
+//! Triangle rasterization as hardware does it, for the CPU kernel of
+//! `bench.raster` (the graphics roofline), which must make the same coverage
+//! decisions as the GPU backends' hardware rasterizers. The rules are the
+//! ones D3D11 and Vulkan specify for hardware:
 //!
 //! - corners snap to a fixed-point grid of 1/256 pixel (8 sub-pixel bits, the
 //!   usual `VkPhysicalDeviceLimits::subPixelPrecisionBits`; D3D11 functional
