@@ -17,6 +17,8 @@ struct SkinShadowParams {
     ao_distance: f32,
     absorption: f32,
     ao_absorption: f32,
+    // Ours: march only the grids a ray from the workgroup's pixels can reach.
+    tile_cull: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: SkinShadowParams;
@@ -30,6 +32,79 @@ struct SkinShadowParams {
 const GROUP: u32 = 64u;
 const MASK_LIGHTS: u32 = 3u;
 const LIT: u32 = 0xFFFFFFFFu;
+
+// skin_shadow/tile.rs: the workgroup's world box (order-preserving bits)
+// and which models' grids its rays can reach.
+const MARGIN: f32 = 1e-3;
+const MASKED_MODELS: u32 = 256u;
+var<workgroup> box_lo: array<atomic<u32>, 3>;
+var<workgroup> box_hi: array<atomic<u32>, 3>;
+var<workgroup> reached: array<atomic<u32>, 8>;
+
+fn ordered(f: f32) -> u32 {
+    let b = bitcast<u32>(f);
+    return select(b | 0x80000000u, ~b, (b >> 31u) == 1u);
+}
+
+fn unordered(u: u32) -> f32 {
+    return select(bitcast<f32>(~u), bitcast<f32>(u & 0x7FFFFFFFu), (u >> 31u) == 1u);
+}
+
+fn overlap(alo: vec3<f32>, ahi: vec3<f32>, blo: vec3<f32>, bhi: vec3<f32>) -> bool {
+    return all(alo <= bhi) && all(blo <= ahi);
+}
+
+// tile::slab: does p + t dir, t >= 0, meet [lo, hi]?
+fn slab(p: vec3<f32>, dir: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    var enter = 0.0;
+    var exit = F32_MAX;
+    for (var a = 0u; a < 3u; a++) {
+        if abs(dir[a]) > 1e-8 {
+            let t0 = (lo[a] - p[a]) / dir[a];
+            let t1 = (hi[a] - p[a]) / dir[a];
+            enter = max(enter, min(t0, t1));
+            exit = min(exit, max(t0, t1));
+        } else if p[a] < lo[a] || p[a] > hi[a] {
+            return false;
+        }
+    }
+    return enter <= exit;
+}
+
+// tile::TileBox::reaches.
+fn tile_reaches(m: u32, tlo: vec3<f32>, thi: vec3<f32>, light_count: u32) -> bool {
+    let md = models[m];
+    var gmax = vec3<f32>(0.0);
+    for (var a = 0u; a < 3u; a++) {
+        gmax[a] = md.bounds_min[a] + max(md.bounds_max[a] - md.bounds_min[a], 1e-6);
+    }
+    let lo = md.bounds_min.xyz - vec3<f32>(MARGIN);
+    let hi = gmax + vec3<f32>(MARGIN);
+    if params.ao_steps > 0u {
+        let d = vec3<f32>(params.ao_distance);
+        if overlap(tlo, thi, lo - d, hi + d) {
+            return true;
+        }
+    }
+    for (var l = 0u; l < light_count; l++) {
+        let light = lights[l].position_or_direction;
+        if light.w == 0.0 {
+            let d = light.xyz;
+            let dir = select(vec3<f32>(0.0), -normalize(d), length(d) > 0.0);
+            let h = (thi - tlo) * 0.5;
+            if slab((tlo + thi) * 0.5, dir, lo - h, hi + h) {
+                return true;
+            }
+        } else if overlap(min(tlo, light.xyz), max(thi, light.xyz), lo, hi) {
+            return true;
+        }
+    }
+    return false;
+}
+
+fn is_reached(m: u32) -> bool {
+    return m >= MASKED_MODELS || (atomicLoad(&reached[m / 32u]) & (1u << (m % 32u))) != 0u;
+}
 
 struct Hit {
     hit: bool,
@@ -162,7 +237,9 @@ fn crossed(m: u32, p: vec3<f32>, dir: vec3<f32>, max_t: f32, steps: u32) -> f32 
 fn march(p: vec3<f32>, dir: vec3<f32>, max_t: f32, steps: u32) -> f32 {
     var sum = 0.0;
     for (var m = 0u; m < frame.model_count; m++) {
-        sum += crossed(m, p, dir, max_t, steps);
+        if is_reached(m) {
+            sum += crossed(m, p, dir, max_t, steps);
+        }
     }
     return sum;
 }
@@ -174,20 +251,53 @@ fn unorm8(v: f32) -> u32 {
 
 @compute @workgroup_size(64)
 fn march_skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    if lane < 3u {
+        atomicStore(&box_lo[lane], 0xFFFFFFFFu);
+        atomicStore(&box_hi[lane], 0u);
+    }
+    if lane < 8u {
+        atomicStore(&reached[lane], select(0u, 0xFFFFFFFFu, params.tile_cull == 0u));
+    }
+    workgroupBarrier();
     let i = wg.x * GROUP + lane;
+    let x = i32(i % params.width);
+    let y = i32(i / params.width);
+    var here = Hit(false, vec3<f32>(0.0));
+    if i < params.width * params.height {
+        here = world_at(x, y);
+    }
+    if here.hit {
+        for (var a = 0u; a < 3u; a++) {
+            atomicMin(&box_lo[a], ordered(here.world[a]));
+            atomicMax(&box_hi[a], ordered(here.world[a]));
+        }
+    }
+    workgroupBarrier();
+    let count = min(min(frame.light_count, arrayLength(&lights)), MASK_LIGHTS);
+    // An empty box (no surface pixel) keeps lo > hi: nothing to mark.
+    if params.tile_cull != 0u && atomicLoad(&box_lo[0]) <= atomicLoad(&box_hi[0]) {
+        var tlo = vec3<f32>(0.0);
+        var thi = vec3<f32>(0.0);
+        for (var a = 0u; a < 3u; a++) {
+            tlo[a] = unordered(atomicLoad(&box_lo[a]));
+            thi[a] = unordered(atomicLoad(&box_hi[a]));
+        }
+        for (var m = lane; m < min(frame.model_count, MASKED_MODELS); m += GROUP) {
+            if tile_reaches(m, tlo, thi, count) {
+                atomicOr(&reached[m / 32u], 1u << (m % 32u));
+            }
+        }
+    }
+    workgroupBarrier();
     if i >= params.width * params.height {
         return;
     }
-    let x = i32(i % params.width);
-    let y = i32(i / params.width);
-    let here = world_at(x, y);
     if !here.hit {
         skin_shadow[i] = LIT;
         return;
     }
     let p = here.world;
     var mask = LIT;
-    let count = min(min(frame.light_count, arrayLength(&lights)), MASK_LIGHTS);
     for (var l = 0u; l < count; l++) {
         let light = lights[l];
         var dir: vec3<f32>;

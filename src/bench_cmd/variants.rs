@@ -85,6 +85,26 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    // Ours: large head triangles rasterized by the whole workgroup
+    // (passes/src/opaque_mesh/visibility.rs).
+    Variant {
+        pipeline: "Kulikov",
+        name: "no cooperative large triangles",
+        graph: KULIKOV,
+        overrides: &["visibility.cooperative_above=0"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    // Ours: each skin-shadow workgroup marches only the density grids its
+    // rays can reach (passes/src/kulikov/skin_shadow/tile.rs).
+    Variant {
+        pipeline: "Kulikov",
+        name: "no skin-shadow tile cull",
+        graph: KULIKOV,
+        overrides: &["skin_shadow.tile_cull=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
     // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`

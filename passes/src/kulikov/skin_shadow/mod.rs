@@ -20,6 +20,8 @@
 //! the smaller depth step, so silhouettes do not bend it); the game has the
 //! G-buffer normal, we have a depth prepass only.
 
+mod tile;
+
 use super::Scene;
 use super::density::{AREA_UNIT, GRID_WORDS, Grid, MAX_RESOLUTION, check_resolution};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
@@ -76,6 +78,9 @@ pub struct SkinShadowParams {
     pub absorption: f32,
     /// The same for ambient occlusion.
     pub ao_absorption: f32,
+    /// Ours: each workgroup marches only the grids a ray from its pixels
+    /// can reach ([`tile`]); the mask is the same either way.
+    pub tile_cull: bool,
 }
 
 impl Default for SkinShadowParams {
@@ -87,6 +92,7 @@ impl Default for SkinShadowParams {
             ao_distance: 0.05,
             absorption: 1.0,
             ao_absorption: 1.0,
+            tile_cull: true,
         }
     }
 }
@@ -113,6 +119,7 @@ crate::gpu_block! {
         ao_distance: f32,
         absorption: f32,
         ao_absorption: f32,
+        tile_cull: u32,
     }
 }
 
@@ -128,6 +135,7 @@ impl SkinShadowParams {
             ao_distance: self.ao_distance,
             absorption: self.absorption,
             ao_absorption: self.ao_absorption,
+            tile_cull: crate::contract::flag(self.tile_cull),
         }
     }
 }
@@ -297,21 +305,35 @@ impl CpuKernel for SkinShadowParams {
             .iter()
             .map(|m| Grid::of(m, self.resolution))
             .collect();
-        // Strands crossed along a ray, over every model's grid.
+        // The workgroup's pixels and their world positions.
+        let pixels: Vec<(u32, Option<Vec3>)> = (group * GROUP..(group + 1) * GROUP)
+            .take_while(|&i| i < px.width * px.height)
+            .map(|i| {
+                (
+                    i,
+                    px.world(i64::from(i % px.width), i64::from(i / px.width)),
+                )
+            })
+            .collect();
+        let ao = (self.ao_steps > 0).then_some(self.ao_distance);
+        let reached: Vec<bool> = match tile::TileBox::of(pixels.iter().filter_map(|p| p.1)) {
+            Some(b) if self.tile_cull => (0..grids.len())
+                .map(|m| m >= tile::MASKED_MODELS || b.reaches(&grids[m], &lights, ao))
+                .collect(),
+            _ => vec![true; grids.len()],
+        };
+        // Strands crossed along a ray, over every model's grid the tile reaches.
         let march = |p: Vec3, dir: Vec3, max_t: f32, steps: u32| -> f32 {
             grids
                 .iter()
                 .enumerate()
+                .filter(|&(m, _)| reached[m])
                 .map(|(m, g)| crossed(&grid, m as u32 * GRID_WORDS, g, p, dir, max_t, steps))
                 .sum()
         };
-        for lane in 0..GROUP {
-            let i = group * GROUP + lane;
-            if i >= px.width * px.height {
-                break;
-            }
+        for (i, world) in pixels {
             let (x, y) = (i64::from(i % px.width), i64::from(i / px.width));
-            let Some(p) = px.world(x, y) else {
+            let Some(p) = world else {
                 out.store(i as usize, LIT);
                 continue;
             };
@@ -444,6 +466,20 @@ mod tests {
         let under = ambient_visibility(mask[16 * 32 + 16]);
         assert!(under < 0.9, "{under}");
         assert_eq!(ambient_visibility(mask[0]), 1.0);
+    }
+
+    #[test]
+    fn tile_culling_changes_no_bit() {
+        for light in [Vec3::NEG_Y, Vec3::new(-1.0, -1.0, 0.3), Vec3::Y] {
+            let hs = floor_view(48, 40, light, 2000);
+            let on = run(&hs, "{\"ao_distance\": 0.5}");
+            let off = run(&hs, "{\"ao_distance\": 0.5, \"tile_cull\": false}");
+            assert!(on == off, "light {light}");
+            assert!(
+                on.iter().any(|&m| m != LIT),
+                "light {light}: nothing shadowed"
+            );
+        }
     }
 
     #[test]
