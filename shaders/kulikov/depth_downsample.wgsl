@@ -1,5 +1,6 @@
 // kulikov.depth_downsample: the farthest scene depth of each 16x16 block.
-// Port of passes/src/kulikov/depth_downsample.rs.
+// Port of passes/src/kulikov/depth_downsample.rs: one workgroup per block,
+// one lane per texel, the maximum an atomicMax on the depth bits.
 
 #import strandgraph::kulikov::HIZ_FACTOR
 
@@ -13,23 +14,27 @@ struct DepthDownsampleParams {
 @group(0) @binding(1) var scene_depth: texture_2d<f32>;
 @group(0) @binding(2) var hiz: texture_storage_2d<r32float, write>;
 
-@compute @workgroup_size(64)
+var<workgroup> farthest: atomic<u32>;
+
+@compute @workgroup_size(256)
 fn downsample(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let w = params.width;
-    let h = params.height;
-    let hw = (w + HIZ_FACTOR - 1u) / HIZ_FACTOR;
-    let hh = (h + HIZ_FACTOR - 1u) / HIZ_FACTOR;
-    let i = wg.x * 64u + lane;
-    if i >= hw * hh {
-        return;
+    if lane == 0u {
+        atomicStore(&farthest, 0u);
     }
-    let bx = i % hw * HIZ_FACTOR;
-    let by = i / hw * HIZ_FACTOR;
-    var far = 0.0;
-    for (var y = by; y < min(by + HIZ_FACTOR, h); y++) {
-        for (var x = bx; x < min(bx + HIZ_FACTOR, w); x++) {
-            far = max(far, textureLoad(scene_depth, vec2<u32>(x, y), 0).x);
-        }
+    workgroupBarrier();
+    let hw = (params.width + HIZ_FACTOR - 1u) / HIZ_FACTOR;
+    let bx = wg.x % hw * HIZ_FACTOR;
+    let by = wg.x / hw * HIZ_FACTOR;
+    let x = bx + lane % HIZ_FACTOR;
+    let y = by + lane / HIZ_FACTOR;
+    if x < params.width && y < params.height {
+        // Depths are in [0, 1]; clearing the sign keeps a -0.0 from winning.
+        let bits = bitcast<u32>(textureLoad(scene_depth, vec2<u32>(x, y), 0).x) & 0x7FFFFFFFu;
+        atomicMax(&farthest, bits);
     }
-    textureStore(hiz, vec2<u32>(i % hw, i / hw), vec4<f32>(far, 0.0, 0.0, 1.0));
+    workgroupBarrier();
+    if lane == 0u {
+        let far = bitcast<f32>(atomicLoad(&farthest));
+        textureStore(hiz, vec2<u32>(wg.x % hw, wg.x / hw), vec4<f32>(far, 0.0, 0.0, 1.0));
+    }
 }

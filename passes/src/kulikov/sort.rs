@@ -60,7 +60,8 @@ pub static SORT_SCAN: PassKind<NoParams, SortGpu> = PassKind {
         Binding::write("sort_offsets"),
         Binding::write("raster_args"),
     ]),
-    workgroup_size: 1,
+    // One workgroup: lanes scan runs of bins in parallel (shaders/kulikov/sort.wgsl).
+    workgroup_size: 256,
     dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("kulikov/sort.wgsl", "scan"),
     kernel: |_| Box::new(ScanKernel),
