@@ -89,7 +89,7 @@ pub fn to_linear(
     Rgba32FImage::from_raw(width, height, data)
 }
 
-/// A `D32Float` depth image (NDC depth of `perspective_rh`, cleared to 1)
+/// A depth image of f32 NDC depth (`perspective_rh`; 1 where nothing was drawn)
 /// as linear view depth in metres, in all three channels (the `image`
 /// crate writes EXR as RGB or RGBA); the far plane where nothing was drawn.
 pub fn depth_to_view(
