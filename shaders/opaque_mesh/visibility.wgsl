@@ -2,8 +2,9 @@
 // buffer, rasterized in compute. Port of passes/src/opaque_mesh/visibility.rs.
 //
 // One lane per triangle walks its clipped bounding box with exact integer
-// edge functions; boxes of more than `cooperative_above` pixels are queued
-// and walked by the whole workgroup, one pixel per lane. Each covered pixel
+// edge functions; with `cooperative_above` > 0 (off by default, see the
+// Rust side), larger boxes are queued and walked by the whole workgroup,
+// one pixel per lane. Each covered pixel
 // keeps (depth bits << 32 | triangle) with one atomicMin: the nearest
 // triangle, ties to the lower index, whatever the order.
 //

@@ -90,8 +90,8 @@ static EXCEPTIONS: &[Exception] = &[
         binding: "output",
         on: On::Every,
         rule: Rule::F16 { ulps: 2 },
-        outliers: 0.005,
-        why: "perspective-correct barycentrics divide by a varying sum and normalise the interpolated normal (Vulkan allows OpFDiv 2.5 ULP, inverseSqrt 2 ULP): a few texels move more than 2 half-ULPs",
+        outliers: 0.00001,
+        why: "perspective-correct barycentrics divide by a varying sum and the normal is normalised (Vulkan allows OpFDiv 2.5 ULP, inverseSqrt 2 ULP): lavapipe stays within 1 half-ULP; on the H100 at 1080p 10 of 4.1M words (crowd, wgpu) move further",
     },
     Exception {
         kind: "kulikov.compose",

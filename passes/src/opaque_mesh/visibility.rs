@@ -14,11 +14,17 @@
 //! prepass plus a depth-equal shading pass at 2.7 ms for the crowd's 560k
 //! triangles (benches/results/h100-hw-head.json). One lane per triangle
 //! walks its bounding box with exact integer edge functions
-//! ([`setup`](super::setup)); triangles whose box holds more than
-//! `cooperative_above` pixels are queued and rasterized by the whole
-//! workgroup, one pixel per lane, so a few large triangles do not stall 63
-//! idle lanes (ours, after the binning of large triangles in software
-//! rasterizers such as Nanite's).
+//! ([`setup`](super::setup)): 0.027 ms for the crowd, 0.037 ms for the close
+//! view (H100, `benches/results/h100.json`).
+//!
+//! `cooperative_above` (ours, after the binning of large triangles in
+//! software rasterizers such as Nanite's) queues triangles whose box holds
+//! more pixels than that and rasterizes them with the whole workgroup, one
+//! pixel per lane, so that one large triangle does not stall 63 idle lanes.
+//! It ships off: at 64 pixels it made the close view's pass 0.146 ms instead
+//! of 0.037 (every lane sets each queued triangle up again, one after
+//! another), and our heads have no triangle large enough to win it back. The
+//! bench row "cooperative large triangles" keeps measuring it.
 
 use super::{GROUP, View, dispatch};
 use crate::contract::{Binding, CpuKernel, Shader};
@@ -40,20 +46,12 @@ pub fn unpack(word: u64) -> Option<(u32, f32)> {
 }
 
 /// The pass's parameters, with their defaults.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct VisibilityParams {
     /// Triangles whose clipped bounding box holds more pixels than this are
     /// rasterized by the whole workgroup; 0 = every lane rasterizes its own.
     pub cooperative_above: u32,
-}
-
-impl Default for VisibilityParams {
-    fn default() -> Self {
-        Self {
-            cooperative_above: 64,
-        }
-    }
 }
 
 impl PassParams for VisibilityParams {
@@ -165,8 +163,8 @@ mod tests {
     fn params_default_parse_and_reject() {
         let p = VISIBILITY.params(&ron::Value::Unit).unwrap();
         assert_eq!(p, VisibilityParams::default());
-        let v: ron::Value = ron::from_str(r#"{"cooperative_above": 0}"#).unwrap();
-        assert_eq!(VISIBILITY.params(&v).unwrap().cooperative_above, 0);
+        let v: ron::Value = ron::from_str(r#"{"cooperative_above": 64}"#).unwrap();
+        assert_eq!(VISIBILITY.params(&v).unwrap().cooperative_above, 64);
         let v: ron::Value = ron::from_str(r#"{"cooperative": 3}"#).unwrap();
         let e = VISIBILITY.params(&v).unwrap_err();
         assert!(e.to_string().contains("scene.visibility"), "{e}");
