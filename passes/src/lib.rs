@@ -18,6 +18,8 @@ pub mod bind;
 pub mod common;
 pub mod contract;
 pub mod describe;
+#[cfg(test)]
+mod fill_rule_checks;
 pub mod kernel;
 pub mod kulikov;
 pub mod layout;

@@ -12,8 +12,7 @@
 // first), 6 = output (Rgba16Float storage image).
 //
 #import strandgraph::layout::{FrameData, TriangleData, LightData}
-#import strandgraph::clip::transform
-#import strandgraph::opaque_setup::{setup_triangle, edges, barycentrics}
+#import strandgraph::opaque_setup::{setup_world, edges, barycentrics}
 
 // passes/src/opaque_mesh/opaque.rs: OpaqueParams::uniform.
 struct OpaqueParams {
@@ -74,15 +73,7 @@ fn shade_pixel(t: u32, x: u32, y: u32, mask: u32, color: ptr<function, vec3<f32>
         return false;
     }
     let tri = mesh_triangles[t];
-    let m = frame.view_proj;
-    let s = setup_triangle(
-        transform(m, vec4<f32>(tri.a.xyz, 1.0)),
-        transform(m, vec4<f32>(tri.b.xyz, 1.0)),
-        transform(m, vec4<f32>(tri.c.xyz, 1.0)),
-        frame.near,
-        params.width,
-        params.height,
-    );
+    let s = setup_world(tri.a.xyz, tri.b.xyz, tri.c.xyz, frame.view_proj, frame.near, params.width, params.height);
     if !s.valid {
         return false;
     }

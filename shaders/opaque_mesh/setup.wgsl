@@ -8,6 +8,8 @@
 // positive.
 #define_import_path strandgraph::opaque_setup
 
+#import strandgraph::clip::transform
+
 const SUBPIXEL_BITS: u32 = 4u;
 const ONE: i32 = 16;
 const HALF: i32 = 8;
@@ -96,6 +98,19 @@ fn setup_triangle(clip_a: vec4<f32>, clip_b: vec4<f32>, clip_c: vec4<f32>, near_
     s.bounds = vec4<u32>(u32(x0), u32(y0), u32(x1), u32(y1));
     s.valid = true;
     return s;
+}
+
+// View::setup: world-space corners a, b, c through `view_proj` (summed in
+// column order, as the CPU's kulikov::transform), then setup_triangle.
+fn setup_world(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>, view_proj: mat4x4<f32>, near_plane: f32, width: u32, height: u32) -> Setup {
+    return setup_triangle(
+        transform(view_proj, vec4<f32>(a, 1.0)),
+        transform(view_proj, vec4<f32>(b, 1.0)),
+        transform(view_proj, vec4<f32>(c, 1.0)),
+        near_plane,
+        width,
+        height,
+    );
 }
 
 fn box_pixels(s: Setup) -> u32 {

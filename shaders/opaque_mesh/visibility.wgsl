@@ -12,8 +12,7 @@
 // 3 = scene.visibility (cleared to all-ones by common.clear).
 //
 #import strandgraph::layout::{FrameData, TriangleData}
-#import strandgraph::clip::transform
-#import strandgraph::opaque_setup::{Setup, setup_triangle, box_pixels, edges, step_x, covers, depth_at}
+#import strandgraph::opaque_setup::{Setup, setup_world, box_pixels, edges, step_x, covers, depth_at}
 
 struct VisibilityParams {
     triangles: u32,
@@ -36,15 +35,7 @@ var<workgroup> queued_total: u32;
 
 fn setup_of(t: u32) -> Setup {
     let tri = mesh_triangles[t];
-    let m = frame.view_proj;
-    return setup_triangle(
-        transform(m, vec4<f32>(tri.a.xyz, 1.0)),
-        transform(m, vec4<f32>(tri.b.xyz, 1.0)),
-        transform(m, vec4<f32>(tri.c.xyz, 1.0)),
-        frame.near,
-        params.width,
-        params.height,
-    );
+    return setup_world(tri.a.xyz, tri.b.xyz, tri.c.xyz, frame.view_proj, frame.near, params.width, params.height);
 }
 
 fn write(x: u32, y: u32, z: f32, t: u32) {

@@ -254,62 +254,12 @@ mod tests {
 
     #[test]
     fn covered_pixels_match_the_analytic_area() {
-        let mut seed = 0x2545_f491_u32;
-        for _ in 0..200 {
-            let tri = [0; 3].map(|_| [next(&mut seed) * 60.0 + 2.0, next(&mut seed) * 60.0 + 2.0]);
-            let cross = (tri[1][0] - tri[0][0]) * (tri[2][1] - tri[0][1])
-                - (tri[1][1] - tri[0][1]) * (tri[2][0] - tri[0][0]);
-            let d = |a: [f32; 2], b: [f32; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
-            let perimeter = d(tri[0], tri[1]) + d(tri[1], tri[2]) + d(tri[2], tri[0]);
-            let n = cover(tri, 64, 64).len() as f32;
-            let area = cross.abs() * 0.5;
-            assert!(
-                (n - area).abs() <= perimeter + 1.0,
-                "{tri:?}: {n} vs {area}"
-            );
-        }
-        // Legs along x = 0.5 (left edge, kept) and y = 0.5 (top edge, kept);
-        // centres on the hypotenuse, a right edge, are dropped.
-        let n = cover([[0.5, 0.5], [10.5, 0.5], [0.5, 10.5]], 16, 16).len();
-        assert_eq!(n, (1..=10).sum::<usize>());
+        crate::fill_rule_checks::covered_pixels_match_the_analytic_area(&cover);
     }
 
     #[test]
-    fn a_fan_covers_every_pixel_once() {
-        let (w, h) = (24u32, 24u32);
-        // Rim and hub on pixel centres: the worst case for the fill rule.
-        let hub = [12.5f32, 12.5];
-        let rim: [[f32; 2]; 8] = [
-            [2.5, 2.5],
-            [12.5, 0.5],
-            [22.5, 2.5],
-            [23.5, 12.5],
-            [22.5, 22.5],
-            [12.5, 23.5],
-            [2.5, 22.5],
-            [0.5, 12.5],
-        ];
-        let mut count = vec![0u32; (w * h) as usize];
-        for k in 0..8 {
-            for (x, y) in cover([hub, rim[k], rim[(k + 1) % 8]], w, h) {
-                count[(y * w + x) as usize] += 1;
-            }
-        }
-        let inside = |p: [f32; 2]| {
-            (0..8).all(|k| {
-                let (a, b) = (rim[k], rim[(k + 1) % 8]);
-                (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) > 0.0
-            })
-        };
-        for y in 0..h {
-            for x in 0..w {
-                let c = count[(y * w + x) as usize];
-                assert!(c <= 1, "pixel ({x}, {y}) covered {c} times");
-                if inside([x as f32 + 0.5, y as f32 + 0.5]) {
-                    assert_eq!(c, 1, "pixel ({x}, {y}) missed");
-                }
-            }
-        }
+    fn triangles_sharing_edges_cover_every_pixel_once() {
+        crate::fill_rule_checks::shared_edges_cover_every_pixel_once(&cover);
     }
 
     #[test]
