@@ -102,8 +102,12 @@ fn tile_reaches(m: u32, tlo: vec3<f32>, thi: vec3<f32>, light_count: u32) -> boo
     return false;
 }
 
+// The workgroup's mask, copied once per lane after it is complete: the
+// march tests it for every model of every ray.
+var<private> reached_bits: array<u32, 8>;
+
 fn is_reached(m: u32) -> bool {
-    return m >= MASKED_MODELS || (atomicLoad(&reached[m / 32u]) & (1u << (m % 32u))) != 0u;
+    return m >= MASKED_MODELS || (reached_bits[m / 32u] & (1u << (m % 32u))) != 0u;
 }
 
 struct Hit {
@@ -289,6 +293,9 @@ fn march_skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         }
     }
     workgroupBarrier();
+    for (var k = 0u; k < 8u; k++) {
+        reached_bits[k] = atomicLoad(&reached[k]);
+    }
     if i >= params.width * params.height {
         return;
     }

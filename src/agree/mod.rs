@@ -19,7 +19,6 @@ use crate::runner::{self, Backend, CpuOptions};
 use compare::{Outcome, compare};
 use miette::{IntoDiagnostic, Result};
 use serde::Serialize;
-use std::collections::HashMap;
 use strandgraph_cpu::{Captured, CpuBackend};
 use strandgraph_graph::Plan;
 use strandgraph_passes::Registry;
@@ -72,13 +71,12 @@ pub fn check_all(
     dump: Option<&std::path::Path>,
 ) -> Result<Vec<PassCheck>> {
     let mut checks = Vec::new();
-    let mut own = Own::default();
     for c in captured {
         let name = plan.pass_name(c.pass);
         if only.is_some_and(|o| !name.contains(o)) {
             continue;
         }
-        checks.extend(check_pass(plan, upload, c, gpus, dump, &mut own)?);
+        checks.extend(check_pass(plan, upload, c, gpus, dump)?);
     }
     Ok(checks)
 }
@@ -86,36 +84,25 @@ pub fn check_all(
 /// Runs one captured pass alone on the CPU and on each of `gpus`, and
 /// compares every output. With `dump`, the words of every output that
 /// fails are written there as `PASS.OUTPUT.BACKEND.u32` (little endian).
-/// `own` holds each backend's outputs of earlier passes, for the inputs
-/// [`rules::own_input`] lists, and receives this pass's.
 pub fn check_pass(
     plan: &Plan,
     upload: &Upload,
     captured: &Captured,
     gpus: &[Backend],
     dump: Option<&std::path::Path>,
-    own: &mut Own,
 ) -> Result<Vec<PassCheck>> {
     let pass = &plan.graph.passes[captured.pass];
     let alone = isolate::isolate(plan, captured.pass)?;
     let instance = alone.plan.instantiate(&upload.quantities)?;
-    let inputs_on = |backend: Backend| Upload {
-        resources: captured
-            .bindings
-            .iter()
-            .map(|(name, words)| {
-                let mine = rules::own_input(&pass.kind, name)
-                    .and_then(|(from, _)| own.get(&(backend, from.to_string(), name.clone())));
-                (name.clone(), mine.unwrap_or(words).clone())
-            })
-            .collect(),
+    let inputs = Upload {
+        resources: captured.bindings.iter().cloned().collect(),
         quantities: upload.quantities,
         ..Upload::default()
     };
     let outputs: Vec<&isolate::Port> = alone.ports.iter().filter(|p| p.mode.writes()).collect();
     let run = |backend: Backend| -> Result<Vec<Vec<u32>>> {
         let mut session = runner::open(backend, &alone.plan, &instance, CpuOptions::default())?;
-        session.run(&inputs_on(backend))?;
+        session.run(&inputs)?;
         outputs
             .iter()
             .map(|port| {
@@ -127,7 +114,6 @@ pub fn check_pass(
     };
     let cpu = run(Backend::Cpu)?;
     let mut checks = Vec::new();
-    let mut produced = vec![(Backend::Cpu, cpu.clone())];
     for &backend in gpus {
         let gpu = run(backend).map_err(|e| {
             e.wrap_err(format!(
@@ -160,19 +146,9 @@ pub fn check_pass(
             backend: backend.name(),
             outputs: checks_here,
         });
-        produced.push((backend, gpu));
-    }
-    for (backend, words) in produced {
-        for (port, w) in outputs.iter().zip(words) {
-            own.insert((backend, pass.kind.clone(), port.name.clone()), w);
-        }
     }
     Ok(checks)
 }
-
-/// Each backend's outputs of the passes checked so far, by (backend, pass
-/// kind, binding).
-pub type Own = HashMap<(Backend, String, String), Vec<u32>>;
 
 fn bytemuck_words(words: &[u32]) -> Vec<u8> {
     words.iter().flat_map(|w| w.to_le_bytes()).collect()

@@ -45,20 +45,6 @@ pub fn rule(kind: &str, binding: &str, decl: &ResourceDecl, backend: Backend) ->
     )
 }
 
-/// Inputs a backend must produce itself: the isolated pass is given this
-/// backend's own output of the named upstream pass kind instead of the
-/// CPU's words, and why.
-pub fn own_input(kind: &str, binding: &str) -> Option<(&'static str, &'static str)> {
-    OWN_INPUTS
-        .iter()
-        .find(|o| o.0 == kind && o.1 == binding)
-        .map(|o| (o.2, o.3))
-}
-
-// None today: the opaque head's shading pass used to need its own backend's
-// prepass depth (a depth-equal test); it now reads the visibility buffer.
-static OWN_INPUTS: &[(&str, &str, &str, &str)] = &[];
-
 /// Which GPU backends an exception covers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum On {

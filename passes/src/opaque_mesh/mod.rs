@@ -161,6 +161,24 @@ pub(crate) mod testing {
         }
     }
 
+    /// Two front-facing triangles seen from +z: a small one at z = 0.1
+    /// (normal +z) in front of a larger one at z = -0.1 (normal `far_normal`).
+    pub fn near_and_far(far_normal: Vec3) -> [TriangleData; 2] {
+        let near = triangle(
+            Vec3::new(-0.2, -0.2, 0.1),
+            Vec3::new(0.2, -0.2, 0.1),
+            Vec3::new(0.0, 0.2, 0.1),
+            Vec3::Z,
+        );
+        let far = triangle(
+            Vec3::new(-0.3, -0.3, -0.1),
+            Vec3::new(0.3, -0.3, -0.1),
+            Vec3::new(0.0, 0.3, -0.1),
+            far_normal,
+        );
+        [near, far]
+    }
+
     /// The procedural head's triangles, as `upload` packs them (identity transform).
     pub fn head() -> Vec<TriangleData> {
         let m = HeadParams::default().build();

@@ -252,7 +252,7 @@ impl CpuKernel for OpaqueKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testing::{frame, harness, head, render as run_all, sun, triangle};
+    use super::super::testing::{frame, harness, head, near_and_far, render as run_all, sun};
     use super::*;
 
     fn unpack(words: &[u32], i: usize) -> [f32; 4] {
@@ -307,18 +307,7 @@ mod tests {
         let f = frame(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 40.0, 32, 32);
         let light = sun(Vec3::new(0.0, 0.0, -1.0), 3.0);
         // The near triangle faces the light; the far one's normals face away.
-        let near = triangle(
-            Vec3::new(-0.2, -0.2, 0.1),
-            Vec3::new(0.2, -0.2, 0.1),
-            Vec3::new(0.0, 0.2, 0.1),
-            Vec3::Z,
-        );
-        let far = triangle(
-            Vec3::new(-0.3, -0.3, -0.1),
-            Vec3::new(0.3, -0.3, -0.1),
-            Vec3::new(0.0, 0.3, -0.1),
-            Vec3::X,
-        );
+        let [near, far] = near_and_far(Vec3::X);
         let hs = harness(f, &[far, near], &[light]);
         run_all(&hs);
         assert_eq!(hs.out_of_bounds(), 0);

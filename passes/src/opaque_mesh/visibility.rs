@@ -143,7 +143,7 @@ impl CpuKernel for VisibilityKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testing::{frame, harness, head, run, run_with, triangle};
+    use super::super::testing::{frame, harness, head, near_and_far, run, run_with, triangle};
     use super::*;
     use glam::Vec3;
 
@@ -173,19 +173,7 @@ mod tests {
     #[test]
     fn nearer_triangle_wins_whatever_the_order() {
         let f = frame(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 40.0, 32, 32);
-        // Counter-clockwise seen from +z (the camera): front faces.
-        let near = triangle(
-            Vec3::new(-0.2, -0.2, 0.1),
-            Vec3::new(0.2, -0.2, 0.1),
-            Vec3::new(0.0, 0.2, 0.1),
-            Vec3::Z,
-        );
-        let far = triangle(
-            Vec3::new(-0.3, -0.3, -0.1),
-            Vec3::new(0.3, -0.3, -0.1),
-            Vec3::new(0.0, 0.3, -0.1),
-            Vec3::Z,
-        );
+        let [near, far] = near_and_far(Vec3::Z);
         let mut results = Vec::new();
         for tris in [[near, far], [far, near]] {
             let hs = harness(f, &tris, &[]);
