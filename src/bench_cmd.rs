@@ -77,6 +77,10 @@ pub struct Args {
     /// Emulated subgroup width of the CPU backend (timed and counting runs).
     #[arg(long, default_value_t = 32)]
     pub subgroup: u32,
+    /// Override a pass parameter in every row, after the row's own
+    /// overrides, as PASS.PARAM=VALUE (repeatable); the report notes it.
+    #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
+    pub params: Vec<String>,
 }
 
 /// `rel` under the working directory, else under the checkout the binary
@@ -220,6 +224,9 @@ pub fn run(mut args: Args) -> Result<()> {
     };
     let t0 = Instant::now();
     let mut report = Report::new(&args, &scenes);
+    for spec in &args.params {
+        report.note(format!("--param {spec} on every row"));
+    }
     if args.quick {
         report.note(format!(
             "--quick: every kulikov.shade pass runs with {QUICK_SHADOW} (no offline bake)"
@@ -294,7 +301,7 @@ pub fn run(mut args: Args) -> Result<()> {
                 let atomics = match counts.get(&(r, s)) {
                     Some(&n) => n,
                     None => {
-                        let n = count_atomics(p, v, counting)?;
+                        let n = count_atomics(p, v, &args.params, counting)?;
                         counts.insert((r, s), n);
                         n
                     }
@@ -352,10 +359,11 @@ fn frames(
     Ok((passes, totals))
 }
 
-/// `v`'s plan for one prepared scene: the graph with the row's overrides.
-fn variant_plan(p: &Prepared, v: &Variant) -> Result<strandgraph_graph::Plan> {
+/// `v`'s plan for one prepared scene: the graph with the row's overrides,
+/// then `extra` (`--param`).
+fn variant_plan(p: &Prepared, v: &Variant, extra: &[String]) -> Result<strandgraph_graph::Plan> {
     let mut plan = p.plan.clone();
-    for spec in v.overrides {
+    for spec in v.overrides.iter().copied().chain(extra.iter().map(String::as_str)) {
         override_param(&mut plan, spec)?;
     }
     Ok(plan)
@@ -363,8 +371,13 @@ fn variant_plan(p: &Prepared, v: &Variant) -> Result<strandgraph_graph::Plan> {
 
 /// The raster passes' atomics in an instrumented CPU run of this
 /// configuration. GPUs expose no atomic counters, so GPU rows use this count.
-fn count_atomics(p: &Prepared, v: &Variant, counting: CpuOptions) -> Result<u64> {
-    let plan = variant_plan(p, v)?;
+fn count_atomics(
+    p: &Prepared,
+    v: &Variant,
+    extra: &[String],
+    counting: CpuOptions,
+) -> Result<u64> {
+    let plan = variant_plan(p, v, extra)?;
     let mut counter = runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
     Ok(counter
         .run(&p.upload)?
@@ -383,7 +396,7 @@ fn measure(
     cpu: CpuOptions,
     atomics: u64,
 ) -> Result<(String, Vec<String>, Stats)> {
-    let plan = variant_plan(p, v)?;
+    let plan = variant_plan(p, v, &args.params)?;
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);

@@ -66,6 +66,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &kulikov::motion::MOTION,
     // Lipp et al., deferred software rasterization of hair meshes.
     &lipp::lod::LOD,
+    &lipp::lod::scan::LOD_SCAN,
     &lipp::raster::RASTER,
     &lipp::dom::DOM_DEPTH,
     &lipp::dom::DOM_OPACITY,

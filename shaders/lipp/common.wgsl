@@ -83,18 +83,6 @@ fn depth_bits(z: f32) -> u32 {
     return min(u32(floor(clamp(z, 0.0, 1.0) * DEPTH_MAX)), 0xFFFFFEu);
 }
 
-// payload::pack as (low, high) words.
-fn pack_payload(depth: f32, tangent: vec3<f32>, uvw: vec3<f32>, ao: f32) -> vec2<u32> {
-    let e = oct_encode(tangent);
-    let hi = (depth_bits(depth) << 8u) | quantize(e.x * 0.5 + 0.5, 255.0);
-    let lo = (quantize(e.y * 0.5 + 0.5, 255.0) << 24u)
-        | (quantize(uvw.x, 63.0) << 18u)
-        | (quantize(uvw.y, 63.0) << 12u)
-        | (quantize(uvw.z, 63.0) << 6u)
-        | quantize(ao, 63.0);
-    return vec2<u32>(lo, hi);
-}
-
 // payload::unpack.
 struct Sample {
     depth: f32,

@@ -1,13 +1,17 @@
-// lipp.lod: Lipp §3.2, per-bundle LOD (Eq. 1-5), prefix sum of N_LOD and the
-// rasterizer's indirect dispatch arguments. Port of passes/src/lipp/lod.rs:
-// one workgroup of 256 threads, each owning a contiguous run of bundles; the
-// per-thread sums are scanned in workgroup memory (the deviation from the
-// paper's one-thread-per-bundle pass that lod.rs explains).
+// lipp.lod: Lipp §3.2, per-bundle LOD (Eq. 1-5), a thread per bundle, in
+// the camera's view or each light's deep opacity map. Port of
+// passes/src/lipp/lod/{mod,footprint}.rs; lipp.lod_scan (lod_scan.wgsl)
+// sums the counts.
 
-#import strandgraph::layout::FrameData
+// Bindings 1 (frame), 4 (models) and 5 (lights) are declared in dom.wgsl.
+#define FRAME_BINDING 1
+#define MODELS_BINDING 4
+#define LIGHTS_BINDING 5
+#import strandgraph::lipp_dom::{frame, models, lights, light_frame}
+#import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen}
-#import strandgraph::lipp::{unit, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, MAX_GROUPS_X, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
+#import strandgraph::lipp::{LightFrame, light_project, unit, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
 struct LodParams {
@@ -22,29 +26,56 @@ struct LodParams {
     bundles: u32,
     // Only this groom's bundles (the per-model block); ALL_MODELS: every groom.
     model: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // 1: measure in each light's map (lod::View::Light).
+    light_view: u32,
+    map_resolution: u32,
+    camera_bound: u32,
 }
 
 const ALL_MODELS: u32 = 0xffffffffu;
-
-// Whether bundle b belongs to the groom(s) this pass decides for.
-fn included(b: u32) -> bool {
-    return params.model == ALL_MODELS || hairmesh_bundles[b * BUNDLE_WORDS + 3u] == params.model;
-}
+// lod::LOD_GROUP.
+const LOD_GROUP: u32 = 64u;
+// dom::MAX_DOM_LIGHTS.
+const MAX_DOM_LIGHTS: u32 = 4u;
 
 @group(0) @binding(0) var<uniform> params: LodParams;
-@group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> hairmesh_bundles: array<u32>;
 @group(0) @binding(3) var<storage, read> hairmesh_layers: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read_write> bundle_lod: array<u32>;
-@group(0) @binding(5) var<storage, read_write> raster_args: array<u32>;
+@group(0) @binding(6) var<storage, read_write> lod_choices: array<u32>;
 
-const LOD_GROUP: u32 = 256u;
+// footprint::Footprint.
+struct Footprint {
+    lo: vec2<f32>,
+    hi: vec2<f32>,
+}
 
-var<workgroup> sums: array<u32, 256>;
-var<workgroup> full_sums: array<u32, 256>;
+fn empty_footprint() -> Footprint {
+    return Footprint(vec2<f32>(F32_MAX), vec2<f32>(F32_MIN));
+}
+
+fn corner(first_layer: u32, i: u32, k: u32) -> vec3<f32> {
+    return hairmesh_layers[(first_layer + i) * LAYER_VEC4S + 2u * k].xyz;
+}
+
+// lod::lod_value (Lipp Eq. 2).
+fn lod_value(fp: Footprint, height: f32, lambda: f32) -> f32 {
+    let dx = fp.hi.x - fp.lo.x;
+    let dy = fp.hi.y - fp.lo.y;
+    return clamp(sqrt(dx * dx + dy * dy) / height * lambda, 0.0, 1.0);
+}
+
+// footprint::light_map: Lipp Eq. 3 in light lf's map.
+fn light_map(lf: LightFrame, res: f32, first_layer: u32, layers: u32) -> Footprint {
+    var fp = empty_footprint();
+    for (var i = 0u; i < layers; i++) {
+        for (var k = 0u; k < 4u; k++) {
+            let q = light_project(lf, corner(first_layer, i, k));
+            let s = vec2<f32>(q.x * res, q.y * res);
+            fp = Footprint(min(fp.lo, s), max(fp.hi, s));
+        }
+    }
+    return fp;
+}
 
 // lod::snap_control_points (Lipp Eq. 5).
 fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
@@ -54,46 +85,61 @@ fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
     return min(p + 1u, c_max);
 }
 
-// lod::choose for bundle b: (N_LOD, C, culled flag).
+// lod::choose for bundle b: (N_LOD, C, flags).
 fn choose(b: u32) -> vec3<u32> {
-    if !included(b) {
+    let o = b * BUNDLE_WORDS;
+    if params.model != ALL_MODELS && hairmesh_bundles[o + 3u] != params.model {
         return vec3<u32>(0u, 3u, LOD_OTHER_GROOM);
     }
-    let o = b * BUNDLE_WORDS;
     let first_layer = hairmesh_bundles[o];
     let layers = clamp(hairmesh_bundles[o + 1u], 2u, MAX_LAYERS);
     let n = hairmesh_bundles[o + 2u];
     let seed = hairmesh_bundles[o + 8u];
     let w = frame.screen.x;
     let h = frame.screen.y;
-    // Lipp Eq. 3: AABB of the projected layer quads.
-    var lo = vec2<f32>(F32_MAX);
-    var hi = vec2<f32>(F32_MIN);
+    // footprint::screen (Lipp Eq. 3).
+    var fp = empty_footprint();
     var behind = false;
     for (var i = 0u; i < layers; i++) {
         for (var k = 0u; k < 4u; k++) {
-            let p = hairmesh_layers[(first_layer + i) * LAYER_VEC4S + 2u * k].xyz;
-            let c = transform(frame.view_proj, vec4<f32>(p, 1.0));
+            let c = transform(frame.view_proj, vec4<f32>(corner(first_layer, i, k), 1.0));
             if c.w <= frame.near {
                 behind = true;
                 continue;
             }
             let s = clip_to_screen(c, w, h);
-            lo = vec2<f32>(min(lo.x, s.x), min(lo.y, s.y));
-            hi = vec2<f32>(max(hi.x, s.x), max(hi.y, s.y));
+            fp = Footprint(min(fp.lo, s.xy), max(fp.hi, s.xy));
         }
     }
-    let any_in_front = lo.x <= hi.x;
-    let outside = !any_in_front || hi.x < 0.0 || lo.x > w || hi.y < 0.0 || lo.y > h;
-    let culled = params.frustum_cull != 0u && outside && !behind;
-    // Lipp Eq. 2.
-    // The groom's own strength multiplies the pass's (0: the groom has LOD off).
+    // The groom's own strength multiplies the pass's.
     let groom_lambda = bitcast<f32>(hairmesh_bundles[o + 9u]);
-    var l = 1.0;
-    if params.enabled != 0u && !behind && groom_lambda > 0.0 {
-        let dx = hi.x - lo.x;
-        let dy = hi.y - lo.y;
-        l = clamp(sqrt(dx * dx + dy * dy) / h * (params.lambda * groom_lambda), 0.0, 1.0);
+    let lambda = params.lambda * groom_lambda;
+    var camera_l = 1.0;
+    if !behind {
+        camera_l = lod_value(fp, h, lambda);
+    }
+    var culled = false;
+    var measured = camera_l;
+    if params.light_view == 0u {
+        let outside = !(fp.lo.x <= fp.hi.x) || fp.hi.x < 0.0 || fp.lo.x > w || fp.hi.y < 0.0 || fp.lo.y > h;
+        culled = params.frustum_cull != 0u && outside && !behind;
+    } else {
+        let res = f32(params.map_resolution);
+        let n_lights = min(min(frame.light_count, MAX_DOM_LIGHTS), arrayLength(&lights));
+        var l = 0.0;
+        for (var li = 0u; li < n_lights; li++) {
+            l = max(l, lod_value(light_map(light_frame(li), res, first_layer, layers), res, lambda));
+        }
+        if params.camera_bound != 0u {
+            l = min(l, camera_l);
+        }
+        measured = l;
+        culled = n_lights == 0u;
+    }
+    // 0: the groom has LOD off.
+    var l = measured;
+    if params.enabled == 0u || groom_lambda <= 0.0 {
+        l = 1.0;
     }
     let delta = select(0.0, unit(pcg(seed)), params.random_delta != 0u);
     // Lipp Eq. 1.
@@ -110,47 +156,16 @@ fn choose(b: u32) -> vec3<u32> {
     return vec3<u32>(strands, c, select(0u, LOD_CULLED, culled));
 }
 
-@compute @workgroup_size(256)
-fn lod(@builtin(local_invocation_index) lane: u32) {
-    let count = min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS);
-    let per = (count + LOD_GROUP - 1u) / LOD_GROUP;
-    let begin = min(lane * per, count);
-    let end = min(begin + per, count);
-    var sum = 0u;
-    var full = 0u;
-    for (var b = begin; b < end; b++) {
-        if included(b) {
-            full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
-        }
-        let d = choose(b);
-        bundle_lod[b * LOD_WORDS] = d.x;
-        bundle_lod[b * LOD_WORDS + 1u] = d.y;
-        bundle_lod[b * LOD_WORDS + 3u] = d.z;
-        sum += d.x;
+@compute @workgroup_size(64)
+fn lod(@builtin(global_invocation_id) id: vec3<u32>) {
+    let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), arrayLength(&lod_choices) / LOD_WORDS);
+    let b = id.x;
+    if b >= count {
+        return;
     }
-    sums[lane] = sum;
-    full_sums[lane] = full;
-    workgroupBarrier();
-    if lane == 0u {
-        var acc = 0u;
-        var acc_full = 0u;
-        for (var i = 0u; i < LOD_GROUP; i++) {
-            acc_full += full_sums[i];
-            let s = sums[i];
-            sums[i] = acc;
-            acc += s;
-        }
-        raster_args[0] = min(acc, MAX_GROUPS_X);
-        raster_args[1] = 1u;
-        raster_args[2] = 1u;
-        raster_args[3] = acc;
-        // β of Lipp Eq. 8 is word 3 / word 4.
-        raster_args[4] = acc_full;
-    }
-    workgroupBarrier();
-    var first = sums[lane];
-    for (var b = begin; b < end; b++) {
-        bundle_lod[b * LOD_WORDS + 2u] = first;
-        first += bundle_lod[b * LOD_WORDS];
-    }
+    let d = choose(b);
+    lod_choices[b * LOD_WORDS] = d.x;
+    lod_choices[b * LOD_WORDS + 1u] = d.y;
+    lod_choices[b * LOD_WORDS + 2u] = 0u;
+    lod_choices[b * LOD_WORDS + 3u] = d.z;
 }

@@ -14,7 +14,7 @@
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, pack_payload, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
@@ -32,7 +32,8 @@ struct RasterParams {
     // The groom drawn, in the per-model block; grooms after the first also
     // test hair_depth (Lipp §3.5).
     model_index: u32,
-    _pad0: u32,
+    // Ours: the tangent packed once per segment (raster::segment_payload).
+    segment_payload: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -62,8 +63,27 @@ fn project(cp: ControlPoint, tangent: vec3<f32>) -> End {
     return End(snap(s.x), snap(s.y), s.z, tangent, cp.w, cp.ao, true);
 }
 
-// Target::write.
-fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, uv: vec2<f32>) {
+// payload::pack's tangent bits: octahedral x (high word) and y (low word,
+// already shifted).
+fn tangent_bits(tangent: vec3<f32>) -> vec2<u32> {
+    let e = oct_encode(tangent);
+    return vec2<u32>(quantize(e.y * 0.5 + 0.5, 255.0) << 24u, quantize(e.x * 0.5 + 0.5, 255.0));
+}
+
+// Target::segment_bits: what every sample of segment (a, b) shares in
+// payload::pack's layout: the strand's u and v, and with segment_payload the
+// tangent at the segment's middle.
+fn segment_bits(a: End, b: End, uv: vec2<f32>) -> vec2<u32> {
+    var bits = vec2<u32>((quantize(uv.x, 63.0) << 18u) | (quantize(uv.y, 63.0) << 12u), 0u);
+    if params.segment_payload != 0u {
+        bits |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, 0.5)));
+    }
+    return bits;
+}
+
+// Target::write: payload::pack of the sample at t, from the segment's
+// shared bits.
+fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: vec2<u32>) {
     if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
         return;
     }
@@ -75,12 +95,12 @@ fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, uv: vec2<f32
     if params.model_index > 0u && z >= bitcast<f32>(hair_depth[pixel]) {
         return;
     }
-    let p = pack_payload(
-        z,
-        safe_normalize(lerp_vec(a.tangent, b.tangent, t)),
-        vec3<f32>(uv.x, uv.y, a.w + (b.w - a.w) * t),
-        a.ao + (b.ao - a.ao) * t,
-    );
+    var p = seg_bits;
+    if params.segment_payload == 0u {
+        p |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, t)));
+    }
+    p.x |= (quantize(a.w + (b.w - a.w) * t, 63.0) << 6u) | quantize(a.ao + (b.ao - a.ao) * t, 63.0);
+    p.y |= depth_bits(z) << 8u;
     let slot = layer * params.width * params.height + pixel;
     atomicMin(&gbuffer[slot], (u64(p.y) << 32u) | u64(p.x));
 }
@@ -90,7 +110,7 @@ fn pixel_of(x_major: bool, m: i32, n: i32) -> vec2<i32> {
 }
 
 // Target::segment: a DDA over the major axis, one column at a time.
-fn draw_segment(a: End, b: End, uv: vec2<f32>) {
+fn draw_segment(a: End, b: End, bits: vec2<u32>) {
     let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
     let ma = select(a.y, a.x, x_major);
     let na = select(a.x, a.y, x_major);
@@ -120,7 +140,7 @@ fn draw_segment(a: End, b: End, uv: vec2<f32>) {
             for (var row = r; row <= r + 1; row++) {
                 if abs((n - (f32(row) + 0.5)) * cosa) <= half {
                     let p = pixel_of(x_major, ci, row);
-                    write_sample(a, b, t, p.x, p.y, 0u, uv);
+                    write_sample(a, b, t, p.x, p.y, 0u, bits);
                 }
             }
         }
@@ -132,7 +152,7 @@ fn draw_segment(a: End, b: End, uv: vec2<f32>) {
             let tm = 0.5 * (t0 + t1);
             for (var row = r0; row <= r1; row++) {
                 let p = pixel_of(x_major, ci, row);
-                write_sample(a, b, tm, p.x, p.y, 1u, uv);
+                write_sample(a, b, tm, p.x, p.y, 1u, bits);
             }
         }
     }
@@ -159,7 +179,7 @@ fn sample_offset(n: u32, s: u32) -> vec2<f32> {
 
 // Target::segment_msaa: every sample within centre_diameter / 2 of the
 // segment, in every pixel the segment touches.
-fn draw_segment_msaa(a: End, b: End, uv: vec2<f32>) {
+fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>) {
     let n = params.msaa;
     let layers = min(n, arrayLength(&gbuffer) / max(params.width * params.height, 1u));
     let half = params.centre_diameter * 0.5;
@@ -189,7 +209,7 @@ fn draw_segment_msaa(a: End, b: End, uv: vec2<f32>) {
                 let ex = a.x + dx * t - px;
                 let ey = a.y + dy * t - py;
                 if ex * ex + ey * ey <= half * half {
-                    write_sample(a, b, t, p.x, p.y, s, uv);
+                    write_sample(a, b, t, p.x, p.y, s, bits);
                 }
             }
         }
@@ -200,10 +220,11 @@ fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2
     let pa = project(a, ta);
     let pb = project(b, tb);
     if pa.ok && pb.ok {
+        let bits = segment_bits(pa, pb, uv);
         if params.msaa > 1u {
-            draw_segment_msaa(pa, pb, uv);
+            draw_segment_msaa(pa, pb, bits);
         } else {
-            draw_segment(pa, pb, uv);
+            draw_segment(pa, pb, bits);
         }
     }
 }

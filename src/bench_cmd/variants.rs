@@ -147,6 +147,34 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Ours, each switched off in turn on the published configuration
+    // (passes/src/lipp/raster.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, per-sample payload",
+        graph: LIPP,
+        overrides: &["raster.segment_payload=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
+    // (passes/src/lipp/lod/mod.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, shadow LOD from the camera",
+        graph: LIPP,
+        overrides: &["shadow_lod.view=\"Camera\"", "shadow_lod.lambda=1.0"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, shadow LOD not camera-bound",
+        graph: LIPP,
+        overrides: &["shadow_lod.camera_bound=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 2",

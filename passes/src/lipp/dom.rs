@@ -203,15 +203,20 @@ impl LightFrame {
     }
 }
 
-/// Every light's view, for the lights the maps have room for.
-pub fn light_frames(ctx: &Ctx<'_>, res: u32, maps: usize) -> Vec<LightFrame> {
+/// The views of the lights with a deep opacity map: the first
+/// [`MAX_DOM_LIGHTS`] lights the `lights` buffer holds, and of those only as
+/// many as `room` = (texels per side, words of the maps) has maps for
+/// (`None`: no limit from the maps).
+pub fn light_frames(ctx: &Ctx<'_>, room: Option<(u32, usize)>) -> Vec<LightFrame> {
     let f = frame(ctx);
     let mw = ctx.words("models");
     let models: Vec<ModelData> = (0..f.model_count as usize).map(|m| read(&mw, m)).collect();
     let lw = ctx.words("lights");
-    let per = (res * res) as usize;
+    let held = lw.len() * 4 / std::mem::size_of::<LightData>();
+    let fit = room.map_or(usize::MAX, |(res, maps)| maps / ((res * res) as usize).max(1));
     let n = (f.light_count as usize)
-        .min(maps / per.max(1))
+        .min(held)
+        .min(fit)
         .min(MAX_DOM_LIGHTS);
     (0..n)
         .map(|l| LightFrame::new(&read::<LightData>(&lw, l), &models))
@@ -390,7 +395,7 @@ impl CpuKernel for DomKernel {
             Stage::Depth => depth,
             Stage::Opacity => ctx.words("dom_layers"),
         };
-        let lights = light_frames(ctx, res, depth.len());
+        let lights = light_frames(ctx, Some((res, depth.len())));
         if lights.is_empty() {
             return;
         }

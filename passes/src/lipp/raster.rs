@@ -68,6 +68,13 @@ pub struct RasterParams {
     /// The groom this pass draws, in the graph's per-model block; grooms
     /// after the first also test `hair_depth`.
     pub model_index: u32,
+    /// Ours: every sample of a segment stores the tangent at the segment's
+    /// middle, packed once per segment, instead of the tangent interpolated
+    /// to the sample and packed per sample. The octahedral tangent keeps 8
+    /// bits per axis, which a segment of a 127-point strand rarely spans;
+    /// measured on the H100 it takes most of the per-sample work and the
+    /// registers that held both end tangents through the walk.
+    pub segment_payload: bool,
 }
 
 impl Default for RasterParams {
@@ -79,6 +86,7 @@ impl Default for RasterParams {
             conservative_layer: true,
             msaa: 0,
             model_index: 0,
+            segment_payload: true,
         }
     }
 }
@@ -116,7 +124,7 @@ crate::gpu_block! {
         height: u32,
         msaa: u32,
         model_index: u32,
-        _pad0: u32,
+        segment_payload: u32,
         _pad1: u32,
         _pad2: u32,
     }
@@ -153,6 +161,7 @@ pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
         height: q.height,
         msaa: p.msaa,
         model_index: p.model_index,
+        segment_payload: flag(p.segment_payload),
         ..RasterGpu::default()
     },
     raster: None,
@@ -182,6 +191,9 @@ struct Target<'a> {
     gbuffer: Words<'a>,
     params: &'a RasterParams,
     uv: [f32; 2],
+    /// The tangent every sample of the current segment stores
+    /// (`segment_payload`); `None`: interpolated per sample.
+    segment_tangent: Option<[f32; 3]>,
     local: &'a mut CounterValues,
 }
 
@@ -226,7 +238,9 @@ impl Target<'_> {
         }
         let sample = Sample {
             depth: z,
-            tangent: normalize(mix(a.tangent, b.tangent, t)),
+            tangent: self
+                .segment_tangent
+                .unwrap_or_else(|| normalize(mix(a.tangent, b.tangent, t))),
             uvw: [self.uv[0], self.uv[1], a.w + (b.w - a.w) * t],
             ao: a.ao + (b.ao - a.ao) * t,
         };
@@ -265,6 +279,10 @@ impl Target<'_> {
 
     /// DDA over the segment's major axis, one pixel column (or row) at a time.
     fn segment(&mut self, a: &End, b: &End) {
+        self.segment_tangent = self
+            .params
+            .segment_payload
+            .then(|| normalize(mix(a.tangent, b.tangent, 0.5)));
         if self.params.msaa > 1 {
             let layers = self.gbuffer.len_u64() / (self.width * self.height).max(1) as usize;
             self.segment_msaa(a, b, self.params.msaa, layers);
@@ -354,6 +372,7 @@ impl CpuKernel for RasterKernel {
             gbuffer: ctx.words("gbuffer"),
             params: &self.0,
             uv: [0.0; 2],
+            segment_tangent: None,
             local: &mut local,
         };
         let stride = ctx.workgroups.max(1);

@@ -5,7 +5,7 @@ use super::*;
 use crate::contract::PassDef;
 use crate::kernel::harness::Harness;
 use crate::layout::words_of;
-use crate::lipp::lod::LOD;
+use crate::lipp::lod::{LOD, LOD_GROUP, scan::LOD_SCAN, scan::SCAN_GROUP};
 use crate::lipp::payload::{EMPTY, unpack};
 use bytemuck::Zeroable;
 use strandgraph_graph::Quantities;
@@ -71,6 +71,7 @@ fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
     h.buffer("frame", words_of(&[frame()]))
         .buffer("hairmesh.bundles", bundles)
         .buffer("hairmesh.layers", layers)
+        .buffer("lod_choices", vec![0; 8])
         .buffer("bundle_lod", vec![0; 8])
         .buffer("raster_args", vec![0; 8])
         .buffer("scene.depth", vec![1.0f32.to_bits(); (W * H) as usize])
@@ -78,7 +79,9 @@ fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
     let lod = LOD
         .cpu_kernel(&ron::from_str(r#"{"enabled": false}"#).unwrap())
         .unwrap();
-    h.run(lod.as_ref(), 1, 256);
+    h.run(lod.as_ref(), 1, LOD_GROUP);
+    let scan = LOD_SCAN.cpu_kernel(&ron::Value::Unit).unwrap();
+    h.run(scan.as_ref(), 1, SCAN_GROUP);
     let groups = h.read("raster_args")[0];
     let k = crate::PassDef::cpu_kernel(&RASTER, &ron::from_str(raster).unwrap()).unwrap();
     h.run(k.as_ref(), groups, RASTER_GROUP);

@@ -345,7 +345,7 @@ impl CpuKernel for ShadeKernel {
                 let depth = ctx.words("dom_depth");
                 let args = ctx.words("raster_args");
                 Dom {
-                    frames: light_frames(ctx, self.0.dom_resolution, depth.len()),
+                    frames: light_frames(ctx, Some((self.0.dom_resolution, depth.len()))),
                     depth,
                     layers: ctx.words("dom_layers"),
                     delta: if self.0.lod_depth_correction {

@@ -1,13 +1,14 @@
-//! `lipp.lod`: Lipp §3.2, the per-bundle level-of-detail prepass.
+//! `lipp.lod`: Lipp §3.2, the per-bundle level-of-detail prepass, one
+//! thread per bundle as the paper runs it ("computed via a dispatch of B
+//! threads, with one thread assigned to each bundle").
 //!
-//! For every bundle: the screen-space AABB of its projected layer quads
-//! (Lipp Eq. 3), the LOD value L (Eq. 2), the strand count N_LOD (Eq. 1, with
-//! a per-bundle random δ), and the control-point count C (Eq. 4-5, snapped to
-//! 2^k + 1). Bundles whose AABB lies outside the viewport are frustum-culled
-//! (N_LOD = 0). The counts are prefix-summed into each bundle's first strand
-//! and the total goes into the rasterizer's indirect dispatch arguments
-//! `raster_args` = (min(drawn, 65535), 1, 1, drawn, Σ N), whose last two
-//! words give `lipp.shade` the fraction β of Eq. 8.
+//! For every bundle: the footprint of its projected layer quads (Eq. 3,
+//! [`footprint`]), the LOD value L (Eq. 2), the strand count N_LOD (Eq. 1,
+//! with a per-bundle random δ), and the control-point count C (Eq. 4-5,
+//! snapped to 2^k + 1). Bundles whose footprint lies outside the viewport are
+//! frustum-culled (N_LOD = 0). The decisions go to `lod_choices`;
+//! `lipp.lod_scan` ([`scan`]) turns them into first strands and the
+//! rasterizer's indirect dispatch.
 //!
 //! λ of Eq. 2 is the pass's `lambda` times the groom's `lod.lambda` from the
 //! scene (Lipp Fig. 1 uses a different strength per style); a groom with
@@ -18,28 +19,48 @@
 //! and β counts only this groom's strands. Outside the block it decides for
 //! every groom at once (the deep opacity maps shadow with all of them).
 //!
-//! Deviation: the paper runs one thread per bundle and feeds N_LOD to a
-//! per-bundle indirect dispatch. Here the rasterizer is one flat indirect
-//! dispatch over all drawn strands (one workgroup per strand), so this pass
-//! also needs the exclusive prefix sum of N_LOD: it runs one workgroup of 256
-//! threads, each owning a contiguous run of bundles, and scans their sums in
-//! workgroup memory. The CPU kernel computes the same values sequentially.
+//! Shadow LOD (ours, `view: Light`): the paper does not say which strands
+//! its deep opacity maps receive. With `view: Camera` they would receive the
+//! camera's LOD: at close range nearly every strand at C_max points into a
+//! 512² map, and fewer as the camera backs away, so shadows would change with
+//! the camera. With `view: Light`, Eq. 2-5 run on each bundle's footprint in
+//! the light's map (R_y = the map's resolution), taking the largest over the
+//! lights; with `camera_bound` L is also at most the camera's, so a distant
+//! groom's shadows get no more detail than the groom itself. The maps
+//! compensate the removed strands' opacity (`lipp.dom_opacity`'s
+//! `density_compensation`).
 
+pub mod footprint;
+pub mod scan;
+
+use super::dom::{LightFrame, light_frames};
 use super::{
-    BUNDLE_WORDS, BundleLod, BundleRecord, Corner, LOD_CULLED, LOD_OTHER_GROOM, MAX_CONTROL_POINTS,
-    MAX_GROUPS_X, bundle_count, frame, pcg, transform, unit,
+    BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED, LOD_OTHER_GROOM, LOD_WORDS,
+    MAX_CONTROL_POINTS, bundle_count, frame, pcg, unit,
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::layout::FrameData;
-use crate::params::{Invalid, PassParams};
+use crate::params::{Invalid, PassParams, in_range};
+use footprint::Footprint;
+use strandgraph_graph::schema::Quantity;
 
-/// Threads of the single LOD workgroup (WGSL).
-pub const LOD_GROUP: u32 = 256;
+/// Threads per workgroup of the LOD pass (WGSL), one bundle each.
+pub const LOD_GROUP: u32 = 64;
 
 /// `LodParams.model` in WGSL when the pass decides for every groom.
 const ALL_MODELS: u32 = u32::MAX;
+
+crate::string_enum! {
+    /// Whose view Eq. 2-5 measure a bundle in.
+    pub enum View {
+        /// The camera's screen (Lipp §3.2).
+        Camera,
+        /// Each light's deep opacity map (ours; see the module documentation).
+        Light,
+    }
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -52,11 +73,19 @@ pub struct LodParams {
     pub random_delta: bool,
     /// C_max of Eq. 4-5 (3..=129).
     pub max_control_points: u32,
+    /// Camera view only: a light's map is fitted around every groom.
     pub frustum_cull: bool,
     /// §3.2.1 dynamic strand counts (Eq. 1); off, N_LOD = N.
     pub strand_lod: bool,
     /// §3.2.2 dynamic strand resolution (Eq. 4-5); off, C from L = 1.
     pub resolution_lod: bool,
+    /// The view a bundle's footprint is measured in.
+    pub view: View,
+    /// `view: Light`: texels per side of the deep opacity maps (R_y of Eq. 2
+    /// in the light's view; the dom passes' `resolution`).
+    pub map_resolution: u32,
+    /// `view: Light`: L at most the camera's L (ours).
+    pub camera_bound: bool,
     /// Only this groom's bundles (the per-model block sets `model_index`); `None`: all.
     #[serde(rename = "model_index", deserialize_with = "crate::params::some")]
     pub model: Option<u32>,
@@ -72,6 +101,9 @@ impl Default for LodParams {
             frustum_cull: true,
             strand_lod: true,
             resolution_lod: true,
+            view: View::Camera,
+            map_resolution: 512,
+            camera_bound: true,
             model: None,
         }
     }
@@ -96,7 +128,7 @@ impl PassParams for LodParams {
                 format!("{} is not a finite λ >= 0", self.lambda),
             ));
         }
-        Ok(())
+        in_range("map_resolution", self.map_resolution, 16..=4096)
     }
 }
 
@@ -114,25 +146,30 @@ crate::gpu_block! {
         bundles: u32,
         /// Only this groom's bundles; `ALL_MODELS`: every groom.
         model: u32,
-        _pad0: u32,
-        _pad1: u32,
-        _pad2: u32,
+        /// 1: `View::Light`.
+        light_view: u32,
+        map_resolution: u32,
+        camera_bound: u32,
     }
 }
 
 pub static LOD: PassKind<LodParams, LodGpu> = PassKind {
     kind: "lipp.lod",
-    summary: "per-bundle LOD: screen AABB (Eq. 3), L (Eq. 2), N_LOD (Eq. 1), control points (Eq. 4-5), indirect args",
+    summary: "per-bundle LOD, a thread per bundle: footprint (Eq. 3) in the camera's or a light's view, L (Eq. 2), N_LOD (Eq. 1), control points (Eq. 4-5)",
     source: "Lipp §3.2",
     bindings: Some(&[
         Binding::read("frame"),
         Binding::read("hairmesh.bundles"),
         Binding::read("hairmesh.layers"),
-        Binding::write("bundle_lod"),
-        Binding::write("raster_args"),
+        Binding::read("models"),
+        Binding::read("lights"),
+        Binding::write("lod_choices"),
     ]),
     workgroup_size: LOD_GROUP,
-    dispatch: Dispatch::Fixed(1),
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Bundles,
+        per_group: LOD_GROUP,
+    },
     shader: Shader::compute("lipp/lod.wgsl", "lod"),
     kernel: |p| Box::new(LodKernel(*p)),
     gpu: |p, q| LodGpu {
@@ -145,7 +182,9 @@ pub static LOD: PassKind<LodParams, LodGpu> = PassKind {
         resolution_lod: flag(p.resolution_lod),
         bundles: count(q.bundles),
         model: p.model.unwrap_or(ALL_MODELS),
-        ..LodGpu::default()
+        light_view: flag(p.view == View::Light),
+        map_resolution: p.map_resolution,
+        camera_bound: flag(p.camera_bound),
     },
     raster: None,
 };
@@ -170,39 +209,20 @@ pub fn lod_strands(l: f32, n: u32, delta: f32) -> u32 {
 }
 
 /// Lipp Eq. 2: L = clamp(|AABB_max − AABB_min| / R_y · λ, 0, 1).
-pub fn lod_value(aabb_min: [f32; 2], aabb_max: [f32; 2], height: f32, lambda: f32) -> f32 {
-    let (dx, dy) = (aabb_max[0] - aabb_min[0], aabb_max[1] - aabb_min[1]);
+pub fn lod_value(fp: &Footprint, height: f32, lambda: f32) -> f32 {
+    let (dx, dy) = (fp.hi[0] - fp.lo[0], fp.hi[1] - fp.lo[1]);
     ((dx * dx + dy * dy).sqrt() / height * lambda).clamp(0.0, 1.0)
 }
 
-/// Lipp Eq. 3: the screen AABB (pixels) of bundle `b`'s layer corners, and
-/// whether a corner lies behind the near plane.
-pub fn screen_aabb(
+/// The decision for one bundle (first_strand is filled in by the scan).
+/// `lights`: the maps' views, for `view: Light`.
+pub fn choose(
+    p: &LodParams,
     f: &FrameData,
     layers: &Words<'_>,
     b: &BundleRecord,
-) -> ([f32; 2], [f32; 2], bool) {
-    let (mut lo, mut hi) = ([f32::MAX; 2], [f32::MIN; 2]);
-    let mut behind = false;
-    for i in 0..b.layers() {
-        for k in 0..4 {
-            let c = Corner::load(layers, (b.first_layer + i) as usize, k);
-            let p = c.position;
-            let clip = transform(&f.view_proj, [p[0], p[1], p[2], 1.0]);
-            if clip[3] <= f.near {
-                behind = true;
-                continue;
-            }
-            let s = crate::kulikov::clip_to_screen(clip, f.screen[0], f.screen[1]);
-            lo = [lo[0].min(s[0]), lo[1].min(s[1])];
-            hi = [hi[0].max(s[0]), hi[1].max(s[1])];
-        }
-    }
-    (lo, hi, behind)
-}
-
-/// The decision for one bundle (first_strand is filled in by the scan).
-pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord) -> BundleLod {
+    lights: &[LightFrame],
+) -> BundleLod {
     if p.model.is_some_and(|m| m != b.model) {
         return BundleLod {
             strands: 0,
@@ -211,17 +231,39 @@ pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord
             flags: LOD_OTHER_GROOM,
         };
     }
-    let (lo, hi, behind) = screen_aabb(f, layers, b);
+    let (fp, behind) = footprint::screen(f, layers, b);
     let (w, h) = (f.screen[0], f.screen[1]);
-    let any_in_front = lo[0] <= hi[0];
-    let outside = !any_in_front || hi[0] < 0.0 || lo[0] > w || hi[1] < 0.0 || lo[1] > h;
-    // A corner behind the camera: the bundle may cover the screen; not culled, full detail.
-    let culled = p.frustum_cull && outside && !behind;
-    // The groom's own strength multiplies the pass's (0: the groom has LOD off).
-    let l = if !p.enabled || behind || b.lod_lambda <= 0.0 {
+    // The groom's own strength multiplies the pass's.
+    let lambda = p.lambda * b.lod_lambda;
+    // A corner behind the camera: the bundle may cover the screen; full detail.
+    let camera_l = if behind {
         1.0
     } else {
-        lod_value(lo, hi, h, p.lambda * b.lod_lambda)
+        lod_value(&fp, h, lambda)
+    };
+    let (culled, measured) = match p.view {
+        View::Camera => {
+            let outside =
+                !fp.is_some() || fp.hi[0] < 0.0 || fp.lo[0] > w || fp.hi[1] < 0.0 || fp.lo[1] > h;
+            // A corner behind the camera: not culled.
+            (p.frustum_cull && outside && !behind, camera_l)
+        }
+        View::Light => {
+            let res = p.map_resolution as f32;
+            let mut l = 0.0f32;
+            for lf in lights {
+                l = l.max(lod_value(&footprint::light_map(lf, res, layers, b), res, lambda));
+            }
+            let l = if p.camera_bound { l.min(camera_l) } else { l };
+            // No map to draw into: nothing to draw.
+            (lights.is_empty(), l)
+        }
+    };
+    // 0: the groom has LOD off.
+    let l = if !p.enabled || b.lod_lambda <= 0.0 {
+        1.0
+    } else {
+        measured
     };
     let delta = if p.random_delta {
         unit(pcg(b.seed))
@@ -251,32 +293,25 @@ pub fn choose(p: &LodParams, f: &FrameData, layers: &Words<'_>, b: &BundleRecord
 struct LodKernel(LodParams);
 
 impl CpuKernel for LodKernel {
-    fn run_workgroup(&self, _group: u32, ctx: &Ctx<'_>) {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
         let (bundles, layers, out) = (
             ctx.words("hairmesh.bundles"),
             ctx.words("hairmesh.layers"),
-            ctx.words("bundle_lod"),
+            ctx.words("lod_choices"),
         );
-        let count = bundle_count(ctx).min(bundles.len() / BUNDLE_WORDS);
-        let (mut total, mut full) = (0u32, 0u32);
-        for b in 0..count {
+        let lights = match self.0.view {
+            View::Camera => Vec::new(),
+            View::Light => light_frames(ctx, None),
+        };
+        let count = bundle_count(ctx)
+            .min(bundles.len() / BUNDLE_WORDS)
+            .min(out.len() / LOD_WORDS);
+        let first = group as usize * LOD_GROUP as usize;
+        for b in first..(first + LOD_GROUP as usize).min(count) {
             let rec = BundleRecord::load(&bundles, b);
-            if self.0.model.is_none_or(|m| m == rec.model) {
-                full = full.saturating_add(rec.strands);
-            }
-            let mut lod = choose(&self.0, &f, &layers, &rec);
-            lod.first_strand = total;
-            total = total.saturating_add(lod.strands);
-            lod.store(&out, b);
+            choose(&self.0, &f, &layers, &rec, &lights).store(&out, b);
         }
-        let args = ctx.words("raster_args");
-        args.store(0, total.min(MAX_GROUPS_X));
-        args.store(1, 1);
-        args.store(2, 1);
-        args.store(3, total);
-        // β of Lipp Eq. 8 is word 3 / word 4.
-        args.store(4, full);
     }
 }
 
@@ -315,14 +350,25 @@ mod tests {
 
     #[test]
     fn eq2_is_the_aabb_diagonal_over_the_height_times_lambda() {
-        let l = lod_value([0.0, 0.0], [30.0, 40.0], 1000.0, 2.0);
+        let fp = |hi: [f32; 2]| Footprint { lo: [0.0; 2], hi };
+        let l = lod_value(&fp([30.0, 40.0]), 1000.0, 2.0);
         assert!((l - 0.1).abs() < 1e-6);
-        assert_eq!(lod_value([0.0, 0.0], [3000.0, 4000.0], 1000.0, 1.0), 1.0);
+        assert_eq!(lod_value(&fp([3000.0, 4000.0]), 1000.0, 1.0), 1.0);
     }
 
     /// One bundle whose two layers span ±`half` NDC on a 1000×1000 screen
     /// (clip = world, w = 1), with N = 1000 strands.
     fn decide(p: &LodParams, lod_lambda: f32, model: u32, half: f32) -> BundleLod {
+        decide_lit(p, lod_lambda, model, half, &[])
+    }
+
+    fn decide_lit(
+        p: &LodParams,
+        lod_lambda: f32,
+        model: u32,
+        half: f32,
+        lights: &[LightFrame],
+    ) -> BundleLod {
         use std::sync::atomic::{AtomicU32, AtomicU64};
         let mut f: FrameData = bytemuck::Zeroable::zeroed();
         for i in 0..4 {
@@ -345,7 +391,7 @@ mod tests {
             lod_lambda,
             ..Default::default()
         };
-        choose(p, &f, &Words::new(&atoms, &oob), &b)
+        choose(p, &f, &Words::new(&atoms, &oob), &b, lights)
     }
 
     #[test]
@@ -368,6 +414,39 @@ mod tests {
             1000,
             "LOD off for the groom"
         );
+    }
+
+    #[test]
+    fn light_view_measures_the_footprint_in_each_lights_map() {
+        use crate::layout::{LightData, ModelData};
+        use bytemuck::Zeroable;
+        let mut m = ModelData::zeroed();
+        m.bounds_min = [-0.1, -0.1, -0.1, 0.0];
+        m.bounds_max = [0.1, 0.1, 0.1, 0.0];
+        let mut light = LightData::zeroed();
+        light.position_or_direction = [0.0, 0.0, -1.0, 0.0];
+        let lf = LightFrame::new(&light, &[m]);
+        let p = LodParams {
+            view: View::Light,
+            camera_bound: false,
+            random_delta: false,
+            ..LodParams::default()
+        };
+        // The 0.04 m quad in a map 0.204 m across (bounds padded by 1%):
+        // L = 0.04·√2 / 0.204 at any map resolution.
+        let expect = (0.04 * 2f32.sqrt() / 0.204 * 1000.0).ceil() as i64;
+        for res in [64, 512, 4096] {
+            let lit = decide_lit(&LodParams { map_resolution: res, ..p }, 1.0, 0, 0.02, &[lf]);
+            assert!((i64::from(lit.strands) - expect).abs() <= 1, "{res}: {lit:?}");
+        }
+        // Bound by the camera, where the quad is 20 px of 1000.
+        let camera = decide(&LodParams { random_delta: false, ..LodParams::default() }, 1.0, 0, 0.02);
+        let bound = decide_lit(&LodParams { camera_bound: true, ..p }, 1.0, 0, 0.02, &[lf]);
+        assert_eq!(bound, camera);
+        assert!(camera.strands * 5 < expect as u32);
+        // No light with a map: nothing to draw.
+        let dark = decide_lit(&p, 1.0, 0, 0.02, &[]);
+        assert_eq!((dark.strands, dark.flags), (0, LOD_CULLED));
     }
 
     #[test]

@@ -1,0 +1,126 @@
+//! `lipp.lod_scan`: the exclusive prefix sum of `lipp.lod`'s strand counts,
+//! and the rasterizer's indirect dispatch.
+//!
+//! Deviation: the paper feeds each bundle's N_LOD to a per-bundle indirect
+//! dispatch (Lipp §3.2). Here the rasterizer is one flat indirect dispatch
+//! over all drawn strands (a workgroup per strand), so each bundle needs its
+//! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
+//! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
+//! drawn, Σ N), whose last two words give `lipp.shade` the fraction β of
+//! Eq. 8 (Σ N over the bundles the decision was for: not another groom's).
+//! One workgroup of 256 threads, each owning a contiguous run of bundles,
+//! scans their sums in workgroup memory (shaders/lipp/lod_scan.wgsl); the
+//! CPU kernel computes the same values sequentially.
+
+use super::super::{
+    BUNDLE_WORDS, BundleLod, BundleRecord, LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
+};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
+use crate::kernel::Ctx;
+use crate::params::NoParams;
+
+/// Threads of the single scan workgroup (WGSL).
+pub const SCAN_GROUP: u32 = 256;
+
+crate::gpu_block! {
+    /// `ScanParams` in shaders/lipp/lod_scan.wgsl.
+    pub struct ScanGpu {
+        /// Scene quantity: bundles packed.
+        bundles: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
+    }
+}
+
+pub static LOD_SCAN: PassKind<NoParams, ScanGpu> = PassKind {
+    kind: "lipp.lod_scan",
+    summary: "prefix sum of the LOD's strand counts into first strands; the rasterizer's indirect dispatch and β of Eq. 8",
+    source: "Lipp §3.2",
+    bindings: Some(&[
+        Binding::read("hairmesh.bundles"),
+        Binding::read("lod_choices"),
+        Binding::write("bundle_lod"),
+        Binding::write("raster_args"),
+    ]),
+    workgroup_size: SCAN_GROUP,
+    dispatch: Dispatch::Fixed(1),
+    shader: Shader::compute("lipp/lod_scan.wgsl", "scan"),
+    kernel: |_| Box::new(ScanKernel),
+    gpu: |_, q| ScanGpu {
+        bundles: count(q.bundles),
+        ..ScanGpu::default()
+    },
+    raster: None,
+};
+
+struct ScanKernel;
+
+impl CpuKernel for ScanKernel {
+    fn run_workgroup(&self, _group: u32, ctx: &Ctx<'_>) {
+        let (bundles, choices, out) = (
+            ctx.words("hairmesh.bundles"),
+            ctx.words("lod_choices"),
+            ctx.words("bundle_lod"),
+        );
+        let count = bundle_count(ctx)
+            .min(bundles.len() / BUNDLE_WORDS)
+            .min(choices.len() / LOD_WORDS)
+            .min(out.len() / LOD_WORDS);
+        let (mut total, mut full) = (0u32, 0u32);
+        for b in 0..count {
+            let mut lod = BundleLod::load(&choices, b);
+            if lod.flags & LOD_OTHER_GROOM == 0 {
+                full = full.wrapping_add(BundleRecord::load(&bundles, b).strands);
+            }
+            lod.first_strand = total;
+            total = total.wrapping_add(lod.strands);
+            lod.store(&out, b);
+        }
+        let args = ctx.words("raster_args");
+        args.store(0, total.min(MAX_GROUPS_X));
+        args.store(1, 1);
+        args.store(2, 1);
+        args.store(3, total);
+        // β of Lipp Eq. 8 is word 3 / word 4.
+        args.store(4, full);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::harness::Harness;
+    use strandgraph_graph::Quantities;
+
+    /// Bundles drawing 10, 0 (culled), 0 (another groom's) and 5 strands of 20.
+    #[test]
+    fn first_strands_are_the_running_sum_and_beta_counts_only_this_groom() {
+        let counts = [(10, 0), (0, 1), (0, LOD_OTHER_GROOM), (5, 0)];
+        let mut bundles = Vec::new();
+        let mut choices = Vec::new();
+        for (n, flags) in counts {
+            let rec = BundleRecord {
+                strands: 20,
+                ..Default::default()
+            };
+            bundles.extend(rec.words());
+            choices.extend([n, 9, 123, flags]);
+        }
+        let mut h = Harness::new(Quantities {
+            bundles: 4,
+            ..Default::default()
+        });
+        h.buffer("hairmesh.bundles", bundles)
+            .buffer("lod_choices", choices)
+            .buffer("bundle_lod", vec![0; 16])
+            .buffer("raster_args", vec![0; 8]);
+        h.run(&ScanKernel, 1, SCAN_GROUP);
+        let lod = h.read("bundle_lod");
+        let firsts: Vec<u32> = lod.chunks(4).map(|w| w[2]).collect();
+        assert_eq!(firsts, [0, 10, 10, 10]);
+        assert!(lod.chunks(4).all(|w| w[1] == 9), "C copied");
+        assert_eq!(&h.read("raster_args")[..5], &[15, 1, 1, 15, 60]);
+    }
+}

@@ -1,0 +1,81 @@
+// lipp.lod_scan: the exclusive prefix sum of lipp.lod's strand counts into
+// bundle_lod's first strands, and the rasterizer's indirect dispatch. Port of
+// passes/src/lipp/lod/scan.rs: one workgroup of 256 lanes, each owning a
+// contiguous run of bundles; the lanes' sums are scanned in workgroup memory
+// (Hillis and Steele), then each lane writes its run.
+
+#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM}
+
+struct ScanParams {
+    // Scene quantity: bundles packed.
+    bundles: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: ScanParams;
+@group(0) @binding(1) var<storage, read> hairmesh_bundles: array<u32>;
+@group(0) @binding(2) var<storage, read> lod_choices: array<u32>;
+@group(0) @binding(3) var<storage, read_write> bundle_lod: array<u32>;
+@group(0) @binding(4) var<storage, read_write> raster_args: array<u32>;
+
+// scan::SCAN_GROUP.
+const SCAN_GROUP: u32 = 256u;
+
+var<workgroup> sums: array<u32, SCAN_GROUP>;
+var<workgroup> full_sums: array<u32, SCAN_GROUP>;
+
+@compute @workgroup_size(256)
+fn scan(@builtin(local_invocation_index) lane: u32) {
+    let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), min(arrayLength(&lod_choices), arrayLength(&bundle_lod)) / LOD_WORDS);
+    let per = (count + SCAN_GROUP - 1u) / SCAN_GROUP;
+    let begin = min(lane * per, count);
+    let end = min(begin + per, count);
+    var sum = 0u;
+    var full = 0u;
+    for (var b = begin; b < end; b++) {
+        sum += lod_choices[b * LOD_WORDS];
+        if (lod_choices[b * LOD_WORDS + 3u] & LOD_OTHER_GROOM) == 0u {
+            full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
+        }
+    }
+    sums[lane] = sum;
+    full_sums[lane] = full;
+    workgroupBarrier();
+    // Inclusive scans of the lanes' sums.
+    for (var d = 1u; d < SCAN_GROUP; d <<= 1u) {
+        var v = sums[lane];
+        var f = full_sums[lane];
+        if lane >= d {
+            v += sums[lane - d];
+            f += full_sums[lane - d];
+        }
+        workgroupBarrier();
+        sums[lane] = v;
+        full_sums[lane] = f;
+        workgroupBarrier();
+    }
+    var first = 0u;
+    if lane > 0u {
+        first = sums[lane - 1u];
+    }
+    for (var b = begin; b < end; b++) {
+        let o = b * LOD_WORDS;
+        let n = lod_choices[o];
+        bundle_lod[o] = n;
+        bundle_lod[o + 1u] = lod_choices[o + 1u];
+        bundle_lod[o + 2u] = first;
+        bundle_lod[o + 3u] = lod_choices[o + 3u];
+        first += n;
+    }
+    if lane == SCAN_GROUP - 1u {
+        let total = sums[SCAN_GROUP - 1u];
+        raster_args[0] = min(total, MAX_GROUPS_X);
+        raster_args[1] = 1u;
+        raster_args[2] = 1u;
+        raster_args[3] = total;
+        // β of Lipp Eq. 8 is word 3 / word 4.
+        raster_args[4] = full_sums[SCAN_GROUP - 1u];
+    }
+}
