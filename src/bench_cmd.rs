@@ -363,7 +363,12 @@ fn frames(
 /// then `extra` (`--param`).
 fn variant_plan(p: &Prepared, v: &Variant, extra: &[String]) -> Result<strandgraph_graph::Plan> {
     let mut plan = p.plan.clone();
-    for spec in v.overrides.iter().copied().chain(extra.iter().map(String::as_str)) {
+    for spec in v
+        .overrides
+        .iter()
+        .copied()
+        .chain(extra.iter().map(String::as_str))
+    {
         override_param(&mut plan, spec)?;
     }
     Ok(plan)
@@ -371,12 +376,7 @@ fn variant_plan(p: &Prepared, v: &Variant, extra: &[String]) -> Result<strandgra
 
 /// The raster passes' atomics in an instrumented CPU run of this
 /// configuration. GPUs expose no atomic counters, so GPU rows use this count.
-fn count_atomics(
-    p: &Prepared,
-    v: &Variant,
-    extra: &[String],
-    counting: CpuOptions,
-) -> Result<u64> {
+fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptions) -> Result<u64> {
     let plan = variant_plan(p, v, extra)?;
     let mut counter = runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
     Ok(counter

@@ -213,7 +213,9 @@ pub fn light_frames(ctx: &Ctx<'_>, room: Option<(u32, usize)>) -> Vec<LightFrame
     let models: Vec<ModelData> = (0..f.model_count as usize).map(|m| read(&mw, m)).collect();
     let lw = ctx.words("lights");
     let held = lw.len() * 4 / std::mem::size_of::<LightData>();
-    let fit = room.map_or(usize::MAX, |(res, maps)| maps / ((res * res) as usize).max(1));
+    let fit = room.map_or(usize::MAX, |(res, maps)| {
+        maps / ((res * res) as usize).max(1)
+    });
     let n = (f.light_count as usize)
         .min(held)
         .min(fit)

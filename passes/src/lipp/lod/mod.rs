@@ -252,7 +252,11 @@ pub fn choose(
             let res = p.map_resolution as f32;
             let mut l = 0.0f32;
             for lf in lights {
-                l = l.max(lod_value(&footprint::light_map(lf, res, layers, b), res, lambda));
+                l = l.max(lod_value(
+                    &footprint::light_map(lf, res, layers, b),
+                    res,
+                    lambda,
+                ));
             }
             let l = if p.camera_bound { l.min(camera_l) } else { l };
             // No map to draw into: nothing to draw.
@@ -436,12 +440,41 @@ mod tests {
         // L = 0.04·√2 / 0.204 at any map resolution.
         let expect = (0.04 * 2f32.sqrt() / 0.204 * 1000.0).ceil() as i64;
         for res in [64, 512, 4096] {
-            let lit = decide_lit(&LodParams { map_resolution: res, ..p }, 1.0, 0, 0.02, &[lf]);
-            assert!((i64::from(lit.strands) - expect).abs() <= 1, "{res}: {lit:?}");
+            let lit = decide_lit(
+                &LodParams {
+                    map_resolution: res,
+                    ..p
+                },
+                1.0,
+                0,
+                0.02,
+                &[lf],
+            );
+            assert!(
+                (i64::from(lit.strands) - expect).abs() <= 1,
+                "{res}: {lit:?}"
+            );
         }
         // Bound by the camera, where the quad is 20 px of 1000.
-        let camera = decide(&LodParams { random_delta: false, ..LodParams::default() }, 1.0, 0, 0.02);
-        let bound = decide_lit(&LodParams { camera_bound: true, ..p }, 1.0, 0, 0.02, &[lf]);
+        let camera = decide(
+            &LodParams {
+                random_delta: false,
+                ..LodParams::default()
+            },
+            1.0,
+            0,
+            0.02,
+        );
+        let bound = decide_lit(
+            &LodParams {
+                camera_bound: true,
+                ..p
+            },
+            1.0,
+            0,
+            0.02,
+            &[lf],
+        );
         assert_eq!(bound, camera);
         assert!(camera.strands * 5 < expect as u32);
         // No light with a map: nothing to draw.
