@@ -221,14 +221,74 @@ fn pass_one(st: Strand, l: Lanes) {
 }
 
 // A lane's strip of control points with final tangents, and the next lane's
-// first point and tangent (Code 1 lines 30-50).
+// first point and tangent (Code 1 lines 30-50). The points are fields, not
+// an array, and are read with constant indices only (`pick_*`): a
+// dynamically indexed array lives in local memory, which on the H100 put
+// 384 bytes per lane there (VK_KHR_pipeline_executable_properties).
 struct Strip {
-    cps: array<ControlPoint, 4>,
-    tangents: array<vec3<f32>, 4>,
+    point_a: ControlPoint,
+    point_b: ControlPoint,
+    point_c: ControlPoint,
+    point_d: ControlPoint,
+    tangent_a: vec3<f32>,
+    tangent_b: vec3<f32>,
+    tangent_c: vec3<f32>,
+    tangent_d: vec3<f32>,
     have: u32,
     next: ControlPoint,
     next_tangent: vec3<f32>,
     has_next: bool,
+}
+
+// Point k (< 4) of p0..p3.
+fn pick_cp(p0: ControlPoint, p1: ControlPoint, p2: ControlPoint, p3: ControlPoint, k: u32) -> ControlPoint {
+    switch k {
+        case 0u: {
+            return p0;
+        }
+        case 1u: {
+            return p1;
+        }
+        case 2u: {
+            return p2;
+        }
+        default: {
+            return p3;
+        }
+    }
+}
+
+fn pick_vec(t0: vec3<f32>, t1: vec3<f32>, t2: vec3<f32>, t3: vec3<f32>, k: u32) -> vec3<f32> {
+    switch k {
+        case 0u: {
+            return t0;
+        }
+        case 1u: {
+            return t1;
+        }
+        case 2u: {
+            return t2;
+        }
+        default: {
+            return t3;
+        }
+    }
+}
+
+// The tangent at the lane's point m (< have), from its neighbours: the
+// point before the strip (`before`), the strip's points, the point after it
+// (`after`).
+fn strip_tangent_at(first: u32, c: u32, m: u32, have: u32, p0: ControlPoint, p1: ControlPoint, p2: ControlPoint, p3: ControlPoint, before: vec3<f32>, after: vec3<f32>) -> vec3<f32> {
+    let here = pick_cp(p0, p1, p2, p3, m).pos;
+    var p = before;
+    if m > 0u {
+        p = pick_cp(p0, p1, p2, p3, m - 1u).pos;
+    }
+    var q = after;
+    if m + 1u < have {
+        q = pick_cp(p0, p1, p2, p3, m + 1u).pos;
+    }
+    return calc_tangent(first + m, c, p, here, q);
 }
 
 fn pass_two(st: Strand, l: Lanes) -> Strip {
@@ -238,12 +298,25 @@ fn pass_two(st: Strand, l: Lanes) -> Strip {
     let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
     let first = l.lane * strip;
     let have = min(select(0u, c - first, first < c), strip);
-    var cps: array<ControlPoint, 4>;
-    for (var m = 0u; m < have; m++) {
-        cps[m] = eval_cp(b, id, first + m, c, st.styling);
+    let none = ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
+    var p0 = none;
+    var p1 = none;
+    var p2 = none;
+    var p3 = none;
+    if have > 0u {
+        p0 = eval_cp(b, id, first, c, st.styling);
     }
-    let first_cp = cps[0];
-    let last_cp = cps[max(have, 1u) - 1u];
+    if have > 1u {
+        p1 = eval_cp(b, id, first + 1u, c, st.styling);
+    }
+    if have > 2u {
+        p2 = eval_cp(b, id, first + 2u, c, st.styling);
+    }
+    if have > 3u {
+        p3 = eval_cp(b, id, first + 3u, c, st.styling);
+    }
+    let first_cp = p0;
+    let last_cp = pick_cp(p0, p1, p2, p3, max(have, 1u) - 1u);
     let up_cp_pos = subgroupShuffleUp(last_cp.pos, 1u);
     let up_cp_w = subgroupShuffleUp(last_cp.w, 1u);
     let up_cp_ao = subgroupShuffleUp(last_cp.ao, 1u);
@@ -268,54 +341,59 @@ fn pass_two(st: Strand, l: Lanes) -> Strip {
             next = eval_cp(b, id, end, c, st.styling);
         }
     }
-    var tangents: array<vec3<f32>, 4>;
-    for (var m = 0u; m < have; m++) {
-        var p = cps[m].pos;
-        if m > 0u {
-            p = cps[m - 1u].pos;
-        } else if first > 0u {
-            p = prev.pos;
-        }
-        var q = cps[m].pos;
-        if m + 1u < have {
-            q = cps[m + 1u].pos;
-        } else if has_next {
-            q = next.pos;
-        }
-        tangents[m] = calc_tangent(first + m, c, p, cps[m].pos, q);
+    // The first point's predecessor is itself at the root, the last one's
+    // successor itself at the tip.
+    let before = select(p0.pos, prev.pos, first > 0u);
+    let after = select(last_cp.pos, next.pos, has_next);
+    var t0 = vec3<f32>(0.0);
+    var t1 = vec3<f32>(0.0);
+    var t2 = vec3<f32>(0.0);
+    var t3 = vec3<f32>(0.0);
+    if have > 0u {
+        t0 = strip_tangent_at(first, c, 0u, have, p0, p1, p2, p3, before, after);
+    }
+    if have > 1u {
+        t1 = strip_tangent_at(first, c, 1u, have, p0, p1, p2, p3, before, after);
+    }
+    if have > 2u {
+        t2 = strip_tangent_at(first, c, 2u, have, p0, p1, p2, p3, before, after);
+    }
+    if have > 3u {
+        t3 = strip_tangent_at(first, c, 3u, have, p0, p1, p2, p3, before, after);
     }
     // The next lane's first tangent (Code 1 line 46).
-    let down_t = subgroupShuffleDown(tangents[0], 1u);
+    let down_t = subgroupShuffleDown(t0, 1u);
     var tn = vec3<f32>(0.0);
     if has_next {
         if l.has_down {
             tn = down_t;
         } else {
-            var after = next.pos;
+            var after_next = next.pos;
             if end + 1u < c {
-                after = eval_cp(b, id, end + 1u, c, st.styling).pos;
+                after_next = eval_cp(b, id, end + 1u, c, st.styling).pos;
             }
-            tn = calc_tangent(end, c, cps[have - 1u].pos, next.pos, after);
+            tn = calc_tangent(end, c, last_cp.pos, next.pos, after_next);
         }
     }
-    return Strip(cps, tangents, have, next, tn, has_next);
+    return Strip(p0, p1, p2, p3, t0, t1, t2, t3, have, next, tn, has_next);
 }
 
-// Segment m of a strip: (a, ta, b, tb); valid for m + 1 < have, or the last with has_next.
-fn strip_segment_end(st: Strip, m: u32) -> ControlPoint {
-    if m + 1u < st.have {
-        return st.cps[m + 1u];
+// Point k (<= have) of the strip: its own, then the next lane's first.
+fn strip_point(st: Strip, k: u32) -> ControlPoint {
+    if k < st.have {
+        return pick_cp(st.point_a, st.point_b, st.point_c, st.point_d, k);
     }
     return st.next;
 }
 
-fn strip_segment_tangent(st: Strip, m: u32) -> vec3<f32> {
-    if m + 1u < st.have {
-        return st.tangents[m + 1u];
+fn strip_tangent(st: Strip, k: u32) -> vec3<f32> {
+    if k < st.have {
+        return pick_vec(st.tangent_a, st.tangent_b, st.tangent_c, st.tangent_d, k);
     }
     return st.next_tangent;
 }
 
+// Segment m of a strip runs from point m to point m + 1.
 fn strip_segments(st: Strip) -> u32 {
     return select(max(st.have, 1u) - 1u, st.have, st.has_next);
 }

@@ -10,7 +10,7 @@
 #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
 
 // Bindings 0 and 8.. are the DOM entries' own.
 
@@ -132,7 +132,7 @@ fn dom_depth_pass(
         for (var li = 0u; li < lights_n; li++) {
             let lf = light_frame(li);
             for (var m = 0u; m < strip_segments(strip); m++) {
-                dom_segment_depth(strip.cps[m], strip_segment_end(strip, m), li, lf);
+                dom_segment_depth(strip_point(strip, m), strip_point(strip, m + 1u), li, lf);
             }
         }
         workgroupBarrier();
@@ -161,7 +161,7 @@ fn dom_opacity_pass(
         for (var li = 0u; li < lights_n; li++) {
             let lf = light_frame(li);
             for (var m = 0u; m < strip_segments(strip); m++) {
-                dom_segment_opacity(strip.cps[m], strip_segment_end(strip, m), amount, li, lf);
+                dom_segment_opacity(strip_point(strip, m), strip_point(strip, m + 1u), amount, li, lf);
             }
         }
         workgroupBarrier();

@@ -49,6 +49,10 @@ const APRON_TEXELS: u32 = 576u; // (TILE + 2 MAX_RADIUS)^2
 // linear depth (w), and hit flags (bit 0 centre, bit 1 conservative).
 var<workgroup> tile_sample: array<vec4<f32>, APRON_TEXELS>;
 var<workgroup> tile_hits: array<u32, APRON_TEXELS>;
+// Whether a pixel of the tile has a centre or conservative hit: a tile
+// without one (most of a frame) loads nothing.
+var<workgroup> tile_busy: atomic<u32>;
+var<workgroup> tile_busy_uniform: u32;
 
 // The tile's top-left texel with its apron, and its row length.
 struct Tile {
@@ -211,17 +215,25 @@ fn filter_pixels(
     let y = (wg.x / tiles_x) * TILE + lane / TILE;
     let r = i32(params.radius);
     let t = Tile(i32(x - lane % TILE) - r, i32(y - lane / TILE) - r, i32(TILE) + 2 * r);
-    // Workgroup-uniform: params only.
-    if params.tiled != 0u && params.enabled != 0u && params.msaa <= 1u {
+    let inside = x < params.width && y < params.height;
+    let i = select(0u, y * params.width + x, inside);
+    let g = payload(0u, i);
+    let a = payload(1u, i);
+    if inside && (!is_empty(g) || !is_empty(a)) {
+        atomicStore(&tile_busy, 1u);
+    }
+    workgroupBarrier();
+    if lane == 0u {
+        tile_busy_uniform = atomicLoad(&tile_busy);
+    }
+    let busy = workgroupUniformLoad(&tile_busy_uniform) != 0u;
+    if busy && params.tiled != 0u && params.enabled != 0u && params.msaa <= 1u {
         fill_tile(t, lane);
     }
     workgroupBarrier();
-    if x >= params.width || y >= params.height {
+    if !inside {
         return;
     }
-    let i = y * params.width + x;
-    let g = payload(0u, i);
-    let a = payload(1u, i);
     let centre = !is_empty(g);
     let cons = !is_empty(a);
     let scene = textureLoad(output, vec2<u32>(x, y));

@@ -15,7 +15,7 @@
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_segment_end, strip_segment_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -248,7 +248,7 @@ fn raster(
         workgroupBarrier();
         let strip = pass_two(st, l);
         for (var m = 0u; m < strip_segments(strip); m++) {
-            draw(strip.cps[m], strip.tangents[m], strip_segment_end(strip, m), strip_segment_tangent(strip, m), st.uv);
+            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv);
         }
         // smLayer is rewritten by the next strand.
         workgroupBarrier();

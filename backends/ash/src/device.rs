@@ -56,6 +56,8 @@ pub(crate) struct Gpu {
     /// workgroup memory is the driver's job (as wgpu-hal does on 1.3),
     /// not a loop naga adds to every shader.
     pub zero_init_native: bool,
+    /// Pipeline statistics, when `STRANDGRAPH_PIPELINE_STATS` asks for them.
+    pub(crate) stats: Option<crate::stats::Stats>,
 }
 
 unsafe extern "system" fn on_message(
@@ -226,6 +228,7 @@ fn create_device(
     want: &Wanted,
     families: &[u32],
     messenger: Option<Messenger>,
+    stats: bool,
 ) -> Result<Arc<Device>, AshError> {
     let priority = [1.0f32];
     let queue_infos: Vec<vk::DeviceQueueCreateInfo<'_>> = families
@@ -243,12 +246,19 @@ fn create_device(
         .synchronization2(true)
         .dynamic_rendering(want.dynamic_rendering)
         .shader_zero_initialize_workgroup_memory(want.zero_init_workgroup_memory);
+    let mut want_stats = vk::PhysicalDevicePipelineExecutablePropertiesFeaturesKHR::default()
+        .pipeline_executable_info(true);
     let mut want2 = vk::PhysicalDeviceFeatures2::default()
         .features(want.core)
         .push_next(&mut want12)
         .push_next(&mut want13);
+    if stats {
+        want2 = want2.push_next(&mut want_stats);
+    }
+    let extensions = [ash::khr::pipeline_executable_properties::NAME.as_ptr()];
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_infos)
+        .enabled_extension_names(if stats { &extensions[..] } else { &[] })
         .push_next(&mut want2);
     // SAFETY: the create info chain lives on this stack frame.
     let raw = unsafe { instance.create_device(physical, &info, None) }.ctx("vkCreateDevice")?;
@@ -276,7 +286,8 @@ impl Gpu {
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let (graphics, compute) = queue_families(&families, backend.async_compute, &name)?;
         let used: Vec<u32> = std::iter::once(graphics).chain(compute).collect();
-        let device = create_device(&instance, physical, &want, &used, messenger)?;
+        let stats = crate::stats::wanted() && crate::stats::supported(&instance, physical);
+        let device = create_device(&instance, physical, &want, &used, messenger, stats)?;
         let queues = used
             .iter()
             .enumerate()
@@ -290,6 +301,7 @@ impl Gpu {
             .collect();
         // SAFETY: plain query.
         let memory_props = unsafe { instance.get_physical_device_memory_properties(physical) };
+        let stats = stats.then(|| crate::stats::Stats::new(&instance, &device));
         Ok(Gpu {
             device,
             instance,
@@ -303,6 +315,7 @@ impl Gpu {
             enabled: want.names,
             spirv_caps: want.spirv_caps,
             zero_init_native: want.zero_init_workgroup_memory,
+            stats,
         })
     }
 

@@ -69,6 +69,7 @@ mod readback;
 mod record;
 mod session;
 mod spirv;
+mod stats;
 mod submit;
 mod timing;
 

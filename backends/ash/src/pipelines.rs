@@ -213,13 +213,24 @@ fn compute_work(
         .stage(vk::ShaderStageFlags::COMPUTE)
         .module(module)
         .name(&entry);
+    let flags = if cx.gpu.stats.is_some() {
+        vk::PipelineCreateFlags::CAPTURE_STATISTICS_KHR
+    } else {
+        vk::PipelineCreateFlags::empty()
+    };
     let info = vk::ComputePipelineCreateInfo::default()
+        .flags(flags)
         .stage(stage)
         .layout(layout);
     // SAFETY: valid module and layout.
     let made = unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
     let pipeline = match made {
-        Ok(p) => d.own(p[0]),
+        Ok(p) => {
+            if let Some(stats) = &cx.gpu.stats {
+                stats.log(cx.plan.pass_name(prep.p), p[0]);
+            }
+            d.own(p[0])
+        }
         Err((_, e)) => {
             let what = format!(
                 "pass `{}`: vkCreateComputePipelines",
