@@ -2,8 +2,6 @@
 // bilateral reconnection filter with opacity reconstruction, blended over
 // `output`. Port of passes/src/lipp/filter.rs (see its deviations).
 // `output` is Rgba16Float, read and written: a read_write storage texture.
-// A workgroup filters an 8x8 tile; with `tiled` the taps read the tile and
-// its apron from workgroup memory (filter.rs, "Tiles").
 
 #import strandgraph::layout::FrameData
 #import strandgraph::clip::transform
@@ -28,8 +26,6 @@ struct FilterParams {
     msaa: u32,
     // Pixels at least this opaque write their hair depth (Lipp §3.5).
     depth_alpha: f32,
-    tiled: u32,
-    _pad0: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -39,34 +35,6 @@ struct FilterParams {
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, read_write>;
 // NDC depth (f32 bits) the next groom's rasterizer is tested against.
 @group(0) @binding(5) var<storage, read_write> hair_depth: array<u32>;
-
-// filter::{TILE, MAX_RADIUS}: the largest tile with its apron.
-const TILE: u32 = 8u;
-const MAX_RADIUS: u32 = 8u;
-const APRON_TEXELS: u32 = 576u; // (TILE + 2 MAX_RADIUS)^2
-
-// What a window reads of a neighbour: its centre hit's colour (xyz) and
-// linear depth (w), and hit flags (bit 0 centre, bit 1 conservative).
-var<workgroup> tile_sample: array<vec4<f32>, APRON_TEXELS>;
-var<workgroup> tile_hits: array<u32, APRON_TEXELS>;
-// Whether a pixel of the tile has a centre or conservative hit: a tile
-// without one (most of a frame) loads nothing.
-var<workgroup> tile_busy: atomic<u32>;
-var<workgroup> tile_busy_uniform: u32;
-
-// The tile's top-left texel with its apron, and its row length.
-struct Tile {
-    x0: i32,
-    y0: i32,
-    stride: i32,
-}
-
-struct Neighbour {
-    centre: bool,
-    cons: bool,
-    lin_depth: f32,
-    color: vec3<f32>,
-}
 
 fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
@@ -104,49 +72,8 @@ fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
     return n.xy;
 }
 
-// Neighbour q = (qx, qy) from global memory.
-fn load_neighbour(q: u32) -> Neighbour {
-    let gq = payload(0u, q);
-    let centre = !is_empty(gq);
-    var n = Neighbour(centre, !is_empty(payload(1u, q)), 0.0, vec3<f32>(0.0));
-    if centre {
-        n.lin_depth = lin(unpack_payload(gq).depth);
-        n.color = color(0u, q).xyz;
-    }
-    return n;
-}
-
-// Fills the tile: each lane loads texels of the tile and its apron.
-fn fill_tile(t: Tile, lane: u32) {
-    let texels = u32(t.stride * t.stride);
-    for (var k = lane; k < texels; k += TILE * TILE) {
-        let qx = t.x0 + i32(k % u32(t.stride));
-        let qy = t.y0 + i32(k / u32(t.stride));
-        var hits = 0u;
-        var texel = vec4<f32>(0.0);
-        if qx >= 0 && qy >= 0 && qx < i32(params.width) && qy < i32(params.height) {
-            let n = load_neighbour(u32(qy) * params.width + u32(qx));
-            hits = select(0u, 1u, n.centre) | select(0u, 2u, n.cons);
-            texel = vec4<f32>(n.color, n.lin_depth);
-        }
-        tile_sample[k] = texel;
-        tile_hits[k] = hits;
-    }
-}
-
-// Neighbour (qx, qy), inside the screen, from the tile or global memory.
-fn neighbour(t: Tile, qx: i32, qy: i32) -> Neighbour {
-    if params.tiled == 0u {
-        return load_neighbour(u32(qy) * params.width + u32(qx));
-    }
-    let k = (qy - t.y0) * t.stride + (qx - t.x0);
-    let s = tile_sample[k];
-    let hits = tile_hits[k];
-    return Neighbour((hits & 1u) != 0u, (hits & 2u) != 0u, s.w, s.xyz);
-}
-
 // filter::reconstruct: (filtered colour, alpha).
-fn reconstruct(t: Tile, x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
+fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
@@ -162,27 +89,30 @@ fn reconstruct(t: Tile, x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>
             if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
                 continue;
             }
-            let nq = neighbour(t, qx, qy);
+            let q = u32(qy) * params.width + u32(qx);
             let fx = f32(dx);
             let fy = f32(dy);
             let dpar = fx * tp.x + fy * tp.y;
             let ox = fx - dpar * tp.x;
             let oy = fy - dpar * tp.y;
             let dperp = sqrt(ox * ox + oy * oy);
+            let gq = payload(0u, q);
+            let aq = payload(1u, q);
             if dperp <= params.strip_width {
-                if nq.centre {
+                if !is_empty(gq) {
                     hc += 1.0;
-                } else if nq.cons {
+                } else if !is_empty(aq) {
                     hcons += 1.0;
                 }
             }
-            if !nq.centre {
+            if is_empty(gq) {
                 continue;
             }
-            if abs(nq.lin_depth - d_ref) > params.depth_threshold {
+            let zq = unpack_payload(gq).depth;
+            if abs(lin(zq) - d_ref) > params.depth_threshold {
                 continue;
             }
-            let cq = nq.color;
+            let cq = color(0u, q);
             let ws = exp(-(dpar * dpar) / (sp * sp) - dperp * dperp / (sq * sq));
             var wc = 1.0;
             if !promoted {
@@ -206,34 +136,15 @@ fn reconstruct(t: Tile, x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>
 }
 
 @compute @workgroup_size(64)
-fn filter_pixels(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    let tiles_x = max((params.width + TILE - 1u) / TILE, 1u);
-    let x = (wg.x % tiles_x) * TILE + lane % TILE;
-    let y = (wg.x / tiles_x) * TILE + lane / TILE;
-    let r = i32(params.radius);
-    let t = Tile(i32(x - lane % TILE) - r, i32(y - lane / TILE) - r, i32(TILE) + 2 * r);
-    let inside = x < params.width && y < params.height;
-    let i = select(0u, y * params.width + x, inside);
-    let g = payload(0u, i);
-    let a = payload(1u, i);
-    if inside && (!is_empty(g) || !is_empty(a)) {
-        atomicStore(&tile_busy, 1u);
-    }
-    workgroupBarrier();
-    if lane == 0u {
-        tile_busy_uniform = atomicLoad(&tile_busy);
-    }
-    let busy = workgroupUniformLoad(&tile_busy_uniform) != 0u;
-    if busy && params.tiled != 0u && params.enabled != 0u && params.msaa <= 1u {
-        fill_tile(t, lane);
-    }
-    workgroupBarrier();
-    if !inside {
+fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if i >= params.width * params.height {
         return;
     }
+    let x = i % params.width;
+    let y = i / params.width;
+    let g = payload(0u, i);
+    let a = payload(1u, i);
     let centre = !is_empty(g);
     let cons = !is_empty(a);
     let scene = textureLoad(output, vec2<u32>(x, y));
@@ -265,7 +176,7 @@ fn filter_pixels(
     } else if centre {
         let sg = unpack_payload(g);
         depth = sg.depth;
-        out = reconstruct(t, x, y, sg.depth, screen_tangent(x, y, sg), color(0u, i), false);
+        out = reconstruct(x, y, sg.depth, screen_tangent(x, y, sg), color(0u, i), false);
         var front = false;
         if cons && params.reconnect != 0u {
             let sa = unpack_payload(a);
@@ -274,14 +185,14 @@ fn filter_pixels(
         if front {
             // A flyaway in front of the centre hit: blended over it, opacity 1.
             let sa = unpack_payload(a);
-            let f = reconstruct(t, x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+            let f = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
             out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
             depth = sa.depth;
         }
     } else if cons && params.reconnect != 0u {
         // Promoted conservative-only pixel (§3.3.2).
         let sa = unpack_payload(a);
-        out = reconstruct(t, x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+        out = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
         depth = sa.depth;
     } else {
         return;

@@ -169,14 +169,6 @@ pub const VARIANTS: &[Variant] = &[
     },
     Variant {
         pipeline: "Lipp",
-        name: "SWR 1+F+L, filter untiled",
-        graph: LIPP,
-        overrides: &["filter.tiled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
         name: "SWR 1+F+L, shadow LOD not camera-bound",
         graph: LIPP,
         overrides: &["shadow_lod.camera_bound=false"],

@@ -30,14 +30,6 @@
 //! With `enabled: false` the centre layer is composited as is (SWR 1); with
 //! `msaa` N the N sample layers of the raster's MSAA reference mode are
 //! averaged, α = hits / N (SWR 2/4/8).
-//!
-//! Tiles: a workgroup filters an 8×8 tile of pixels (the paper's are 8×4).
-//! With `tiled` the WGSL first loads what every window reads of its
-//! neighbours (centre and conservative hit flags, the centre hit's linear
-//! depth and colour) for the tile and its apron of `radius` pixels into
-//! workgroup memory: (8 + 2r)² texels instead of 64 · (2r + 1)² global reads
-//! (324 instead of 7,744 at r = 5). Without it every tap reads global
-//! memory. The CPU kernel filters the same tile's pixels either way.
 
 use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::shade::world_position;
@@ -50,9 +42,7 @@ use crate::layout::FrameData;
 use crate::params::{Invalid, PassParams, in_range};
 use strandgraph_graph::schema::Quantity;
 
-/// A workgroup's tile is `TILE`×`TILE` pixels, one lane each.
-pub const TILE: u32 = 8;
-pub const FILTER_GROUP: u32 = TILE * TILE;
+pub const FILTER_GROUP: u32 = 64;
 pub const MAX_RADIUS: u32 = 8;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
@@ -74,8 +64,6 @@ pub struct FilterParams {
     /// Pixels at least this opaque write their hair depth to `hair_depth`,
     /// which the next groom's rasterizer tests against (Lipp §3.5).
     pub depth_alpha: f32,
-    /// Neighbours read from a tile in workgroup memory (see above).
-    pub tiled: bool,
 }
 
 impl Default for FilterParams {
@@ -93,7 +81,6 @@ impl Default for FilterParams {
             front_threshold: 0.01,
             msaa: 0,
             depth_alpha: 0.5,
-            tiled: true,
         }
     }
 }
@@ -138,8 +125,6 @@ crate::gpu_block! {
         height: u32,
         msaa: u32,
         depth_alpha: f32,
-        tiled: u32,
-        _pad0: u32,
     }
 }
 
@@ -156,8 +141,8 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
     ]),
     workgroup_size: FILTER_GROUP,
     dispatch: Dispatch::PerElement {
-        quantity: Quantity::Tiles(TILE),
-        per_group: 1,
+        quantity: Quantity::Pixels,
+        per_group: FILTER_GROUP,
     },
     shader: Shader::compute("lipp/filter.wgsl", "filter_pixels"),
     kernel: |p| Box::new(FilterKernel(*p)),
@@ -176,8 +161,6 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         height: q.height,
         msaa: p.msaa,
         depth_alpha: p.depth_alpha,
-        tiled: flag(p.tiled),
-        _pad0: 0,
     },
     raster: None,
 };
@@ -436,15 +419,11 @@ impl CpuKernel for FilterKernel {
             shaded,
         };
         let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
-        let tiles_x = w.div_ceil(TILE).max(1);
-        let (x0, y0) = ((group % tiles_x) * TILE, (group / tiles_x) * TILE);
-        let pixels =
-            (y0..(y0 + TILE).min(h)).flat_map(|y| (x0..(x0 + TILE).min(w)).map(move |x| (x, y)));
-        for (x, y) in pixels {
-            let Some(hair) = filter_pixel(&self.0, &v, x, y) else {
+        for i in group * FILTER_GROUP..((group + 1) * FILTER_GROUP).min(w * h) {
+            let Some(hair) = filter_pixel(&self.0, &v, i % w, i / w) else {
                 continue;
             };
-            let i = (y * w + x) as usize;
+            let i = i as usize;
             store_rgba16f(&out, i, hair.over(load_rgba16f(&out, i)));
             // Lipp §3.5: the depth later grooms are tested against.
             if hair.alpha >= self.0.depth_alpha {
