@@ -15,12 +15,15 @@
 //!    1/1024) to the layer its depth behind the first hit falls in; layers
 //!    are `layer_thickness` metres deep.
 //!
-//! Deviation: Lipp's Fig. 4 problem is a depth map built from more strands
-//! than are drawn. Here the maps are built from the drawn strands, each
-//! strand's opacity scaled by N / N_LOD of its bundle (`density_compensation`,
-//! stochastic simplification's "thicken the remaining ones"), so the optical
-//! depth is preserved in expectation; Eq. 8's shift stays available in
-//! `lipp.shade` (`lod_depth_correction`) for the ablation.
+//! Which strands: the paper builds its maps from "the full geometry set"
+//! (Fig. 4) and shifts the lookups of the strands the camera's LOD kept (Eq.
+//! 8, in `lipp.shade`). Here the maps receive the strands of their own LOD
+//! decision (`shadow_lod`: `lipp.lod` with `view: Light`, footprints in the
+//! map), each strand's opacity scaled by N / N_LOD of its bundle
+//! (`density_compensation`, stochastic simplification's "thicken the
+//! remaining ones"), so the optical depth of the whole groom is preserved in
+//! expectation and the maps stand for the full geometry set, as the paper's
+//! do, at a fraction of the strands.
 
 use super::assemble::{Assembly, assemble};
 use super::strand::ControlPoint;

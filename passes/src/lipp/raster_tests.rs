@@ -139,6 +139,35 @@ fn shuffles_naive_assembly_and_subgroup_width_give_identical_g_buffers() {
 }
 
 #[test]
+fn segment_payload_changes_only_the_tangent_bits() {
+    let (on, _) = harness("{}", 32);
+    let (off, _) = harness(r#"{"segment_payload": false}"#, 32);
+    let (a, b) = (payloads(&on), payloads(&off));
+    let (mut hits, mut changed, mut other_winner) = (0, 0, 0);
+    for (&x, &y) in a.iter().zip(&b) {
+        assert_eq!(x == EMPTY, y == EMPTY, "the same pixels are written");
+        if x == EMPTY {
+            continue;
+        }
+        hits += 1;
+        let (sx, sy) = (unpack(x), unpack(y));
+        // A depth tie between two strands can resolve to the other one.
+        if sx.depth != sy.depth || sx.uvw != sy.uvw || sx.ao != sy.ao {
+            other_winner += 1;
+            continue;
+        }
+        changed += usize::from(x != y);
+        // Quantised octahedral tangents a segment's turn apart.
+        assert!(
+            crate::lipp::dot(sx.tangent, sy.tangent) > 0.95,
+            "{sx:?} vs {sy:?}"
+        );
+    }
+    assert!(hits > 100 && changed > 0, "{hits} hits, {changed} changed");
+    assert!(other_winner * 100 <= hits, "{other_winner} of {hits}");
+}
+
+#[test]
 fn depth_test_against_the_scene_rejects_hidden_strands() {
     let (mut h, groups) = harness("{}", 32);
     h.buffer("scene.depth", vec![0.0f32.to_bits(); (W * H) as usize])

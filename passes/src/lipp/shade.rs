@@ -17,8 +17,14 @@
 //! Lights are directional and point lights, shadowed by the deep opacity
 //! maps of `lipp.dom_depth` / `lipp.dom_opacity` (`dom_shadows`), looked up
 //! Δ = −log β layers nearer the light (Lipp Eq. 8, `lod_depth_correction`;
-//! β = drawn / all strands over the whole groom, since a G-buffer pixel does
-//! not know its bundle). The head casts no shadow on the hair.
+//! β = drawn / all strands of the groom in the camera's view, from the
+//! groom's `raster_args`, since a G-buffer pixel does not know its bundle).
+//! The paper builds its maps from "the full geometry set" and shifts the
+//! lookups of the strands the camera's LOD kept; ours are built from the
+//! shadow LOD's strands with their opacity scaled up to stand for the whole
+//! groom (`lipp.dom_opacity`'s density compensation), so the shift is the
+//! paper's, for the camera's β. The head casts no shadow on the hair: the
+//! maps hold hair only (Yuksel and Keyser 2008), as in the paper.
 //!
 //! Probe lighting (Lipp §3.4, [`super::probe`]), times the hair mesh's baked
 //! AO: the diffuse part is `env.sh`'s irradiance (L2 SH, Ramamoorthi and
