@@ -34,8 +34,7 @@ struct RasterParams {
     model_index: u32,
     // Ours: the tangent packed once per segment (raster::segment_payload).
     segment_payload: u32,
-    // Ours: the strand's columns dealt out to all lanes (raster::flatten_columns).
-    flatten_columns: u32,
+    _pad1: u32,
     _pad2: u32,
 }
 
@@ -110,24 +109,8 @@ fn pixel_of(x_major: bool, m: i32, n: i32) -> vec2<i32> {
     return select(vec2<i32>(n, m), vec2<i32>(m, n), x_major);
 }
 
-// Target::segment's set-up: a DDA over the segment's major axis, one pixel
-// column at a time, over columns lo..=hi.
-struct Line {
-    a: End,
-    b: End,
-    bits: vec2<u32>,
-    x_major: bool,
-    ma: f32,
-    na: f32,
-    mb: f32,
-    dm: f32,
-    dn: f32,
-    cosa: f32,
-    lo: f32,
-    hi: f32,
-}
-
-fn line_of(a: End, b: End, bits: vec2<u32>) -> Line {
+// Target::segment: a DDA over the major axis, one column at a time.
+fn draw_segment(a: End, b: End, bits: vec2<u32>) {
     let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
     let ma = select(a.y, a.x, x_major);
     let na = select(a.x, a.y, x_major);
@@ -138,56 +121,40 @@ fn line_of(a: End, b: End, bits: vec2<u32>) -> Line {
     let limit = f32(select(params.height, params.width, x_major));
     let lo = floor(max(min(ma, mb), 0.0));
     let hi = floor(min(max(ma, mb), limit - 1.0));
+    if lo > hi && dm != 0.0 {
+        return;
+    }
+    let half = params.centre_diameter * 0.5;
     let len = sqrt(dm * dm + dn * dn);
     let cosa = select(1.0, abs(dm) / len, len > 0.0);
-    return Line(a, b, bits, x_major, ma, na, mb, dm, dn, cosa, lo, hi);
-}
-
-// The columns a line covers.
-fn line_columns(l: Line) -> u32 {
-    return select(0u, u32(l.hi - l.lo) + 1u, l.hi >= l.lo);
-}
-
-// Target::segment's body: column `col` of line l into both layers.
-fn draw_column(l: Line, col: f32) {
-    let half = params.centre_diameter * 0.5;
-    let ci = i32(col);
-    let t = column_params(l.ma, l.dm, col);
-    let t0 = t.x;
-    let t1 = t.y;
-    // Centre layer: the column centre within the segment (half-open, so
-    // shared ends are drawn once), rows whose centre is near the line.
-    let centre = col + 0.5;
-    if l.dm != 0.0 && centre >= min(l.ma, l.mb) && centre < max(l.ma, l.mb) {
-        let tc = (centre - l.ma) / l.dm;
-        let n = l.na + l.dn * tc;
-        let r = i32(floor(n - 0.5));
-        for (var row = r; row <= r + 1; row++) {
-            if abs((n - (f32(row) + 0.5)) * l.cosa) <= half {
-                let p = pixel_of(l.x_major, ci, row);
-                write_sample(l.a, l.b, tc, p.x, p.y, 0u, l.bits);
+    for (var col = lo; col <= hi; col += 1.0) {
+        let ci = i32(col);
+        let t = column_params(ma, dm, col);
+        let t0 = t.x;
+        let t1 = t.y;
+        let centre = col + 0.5;
+        if dm != 0.0 && centre >= min(ma, mb) && centre < max(ma, mb) {
+            let t = (centre - ma) / dm;
+            let n = na + dn * t;
+            let r = i32(floor(n - 0.5));
+            for (var row = r; row <= r + 1; row++) {
+                if abs((n - (f32(row) + 0.5)) * cosa) <= half {
+                    let p = pixel_of(x_major, ci, row);
+                    write_sample(a, b, t, p.x, p.y, 0u, bits);
+                }
             }
         }
-    }
-    // Conservative layer: every row the segment touches in the column.
-    if params.conservative_layer != 0u {
-        let n0 = l.na + l.dn * t0;
-        let n1 = l.na + l.dn * t1;
-        let r0 = i32(floor(min(n0, n1)));
-        let r1 = i32(floor(max(n0, n1)));
-        let tm = 0.5 * (t0 + t1);
-        for (var row = r0; row <= r1; row++) {
-            let p = pixel_of(l.x_major, ci, row);
-            write_sample(l.a, l.b, tm, p.x, p.y, 1u, l.bits);
+        if params.conservative_layer != 0u {
+            let n0 = na + dn * t0;
+            let n1 = na + dn * t1;
+            let r0 = i32(floor(min(n0, n1)));
+            let r1 = i32(floor(max(n0, n1)));
+            let tm = 0.5 * (t0 + t1);
+            for (var row = r0; row <= r1; row++) {
+                let p = pixel_of(x_major, ci, row);
+                write_sample(a, b, tm, p.x, p.y, 1u, bits);
+            }
         }
-    }
-}
-
-// Target::segment: each lane its own segments' columns.
-fn draw_segment(a: End, b: End, bits: vec2<u32>) {
-    let l = line_of(a, b, bits);
-    for (var col = l.lo; col <= l.hi; col += 1.0) {
-        draw_column(l, col);
     }
 }
 
@@ -263,105 +230,6 @@ fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2
 }
 
 
-// Column flattening (ours, raster::flatten_columns). A lane draws the
-// segments of its strip, and a strip's segments differ in length: the
-// subgroup waits for its longest strip. Flattened, the lanes project their
-// points into workgroup memory, count each segment's columns and scan the
-// counts; then lane j draws column jobs j, j + 32, ... of the whole strand,
-// each finding its segment by binary search. The writes are the same, so
-// the CPU kernel does not model it. Needs segment_payload (the segment's
-// payload bits are all a column needs besides the two ends).
-var<workgroup> flat_points: array<vec4<f32>, MAX_CONTROL_POINTS>;
-var<workgroup> flat_ao: array<f32, MAX_CONTROL_POINTS>;
-var<workgroup> flat_ok: array<u32, MAX_CONTROL_POINTS>;
-var<workgroup> flat_bits: array<vec2<u32>, MAX_CONTROL_POINTS>;
-// First column job of segment g; [segments] = all of them.
-var<workgroup> flat_first: array<u32, MAX_CONTROL_POINTS>;
-var<workgroup> flat_lane_columns: array<u32, RASTER_GROUP>;
-
-fn flat_end(k: u32) -> End {
-    let p = flat_points[k];
-    return End(p.x, p.y, p.z, vec3<f32>(0.0), p.w, flat_ao[k], flat_ok[k] != 0u);
-}
-
-fn flat_line(g: u32) -> Line {
-    return line_of(flat_end(g), flat_end(g + 1u), flat_bits[g]);
-}
-
-// The strand's segments, their columns dealt out to the lanes. Every lane
-// calls it (it holds workgroup barriers).
-fn draw_flattened(st: Strand, strip: Strip, lane: u32) {
-    let per_lane = (st.c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
-    let first = lane * per_lane;
-    // Each point by the lane holding it; the strand's last point is only
-    // the last lane's `next` when the lanes' strips end before it (C = 33,
-    // 65, 129).
-    var points = strip.have;
-    if lane == RASTER_GROUP - 1u && strip.has_next {
-        points += 1u;
-    }
-    for (var k = 0u; k < points; k++) {
-        let e = project(strip_point(strip, k), vec3<f32>(0.0));
-        flat_points[first + k] = vec4<f32>(e.x, e.y, e.z, e.w);
-        flat_ao[first + k] = e.ao;
-        flat_ok[first + k] = select(0u, 1u, e.ok);
-    }
-    workgroupBarrier();
-    // Each segment's columns, counted by the lane owning its first point.
-    let segments = strip_segments(strip);
-    var mine = 0u;
-    for (var m = 0u; m < segments; m++) {
-        let g = first + m;
-        var a = flat_end(g);
-        var b = flat_end(g + 1u);
-        a.tangent = strip_tangent(strip, m);
-        b.tangent = strip_tangent(strip, m + 1u);
-        let bits = segment_bits(a, b, st.uv);
-        flat_bits[g] = bits;
-        var n = 0u;
-        if a.ok && b.ok {
-            n = line_columns(line_of(a, b, bits));
-        }
-        flat_first[g] = n;
-        mine += n;
-    }
-    flat_lane_columns[lane] = mine;
-    workgroupBarrier();
-    var before = 0u;
-    var total = 0u;
-    for (var i = 0u; i < RASTER_GROUP; i++) {
-        let n = flat_lane_columns[i];
-        before += select(0u, n, i < lane);
-        total += n;
-    }
-    for (var m = 0u; m < segments; m++) {
-        let n = flat_first[first + m];
-        flat_first[first + m] = before;
-        before += n;
-    }
-    let all = st.c - 1u;
-    if lane == 0u {
-        flat_first[all] = total;
-    }
-    workgroupBarrier();
-    for (var j = lane; j < total; j += RASTER_GROUP) {
-        // The last segment whose first job is at most j.
-        var lo = 0u;
-        var hi = all;
-        while lo < hi {
-            let mid = (lo + hi) / 2u;
-            if flat_first[mid] <= j {
-                lo = mid + 1u;
-            } else {
-                hi = mid;
-            }
-        }
-        let g = lo - 1u;
-        let l = flat_line(g);
-        draw_column(l, l.lo + f32(j - flat_first[g]));
-    }
-}
-
 @compute @workgroup_size(32)
 fn raster(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -374,21 +242,15 @@ fn raster(
     let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
     let stride = max(groups.x, 1u);
-    // Workgroup-uniform: params only.
-    let flatten = params.flatten_columns != 0u && params.segment_payload != 0u && params.msaa <= 1u;
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, params.styling != 0u);
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
-        if flatten {
-            draw_flattened(st, strip, lane);
-        } else {
-            for (var m = 0u; m < strip_segments(strip); m++) {
-                draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv);
-            }
+        for (var m = 0u; m < strip_segments(strip); m++) {
+            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv);
         }
-        // smLayer and the flattened strand are rewritten by the next strand.
+        // smLayer is rewritten by the next strand.
         workgroupBarrier();
     }
 }

@@ -157,14 +157,6 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F+L, a lane per segment",
-        graph: LIPP,
-        overrides: &["raster.flatten_columns=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
     // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
     // (passes/src/lipp/lod/mod.rs).
     Variant {

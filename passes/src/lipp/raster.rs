@@ -75,13 +75,6 @@ pub struct RasterParams {
     /// measured on the H100 it takes most of the per-sample work and the
     /// registers that held both end tangents through the walk.
     pub segment_payload: bool,
-    /// Ours, WGSL only: a lane draws whole segments of its strip, and the
-    /// subgroup waits for its longest strip. Flattened, the strand's pixel
-    /// columns are dealt out to all lanes (shaders/lipp/raster.wgsl,
-    /// `draw_flattened`). The samples written are the same, so the CPU
-    /// kernel ignores it. Needs `segment_payload`; MSAA reference mode
-    /// draws per lane.
-    pub flatten_columns: bool,
 }
 
 impl Default for RasterParams {
@@ -94,7 +87,6 @@ impl Default for RasterParams {
             msaa: 0,
             model_index: 0,
             segment_payload: true,
-            flatten_columns: true,
         }
     }
 }
@@ -133,7 +125,7 @@ crate::gpu_block! {
         msaa: u32,
         model_index: u32,
         segment_payload: u32,
-        flatten_columns: u32,
+        _pad1: u32,
         _pad2: u32,
     }
 }
@@ -170,7 +162,6 @@ pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
         msaa: p.msaa,
         model_index: p.model_index,
         segment_payload: flag(p.segment_payload),
-        flatten_columns: flag(p.flatten_columns),
         ..RasterGpu::default()
     },
     raster: None,
