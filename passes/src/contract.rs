@@ -129,6 +129,17 @@ pub trait PassDef: Send + Sync {
     fn workgroup_size(&self) -> u32;
     fn dispatch(&self) -> Dispatch;
     fn shader(&self) -> Shader;
+    /// The entry point these parameters run: [`Shader::entry`], or one of
+    /// [`PassDef::entries`] where the kind compiles a switch into entry
+    /// points of its own ([`crate::params::PassParams::entry`]).
+    fn entry(&self, params: &ron::Value) -> Result<&'static str, ParamError> {
+        let _ = params;
+        Ok(self.shader().entry)
+    }
+    /// Every entry point [`PassDef::entry`] may return, the default first.
+    fn entries(&self) -> Vec<&'static str> {
+        vec![self.shader().entry]
+    }
     /// Checks parameters as a graph file or `--param` wrote them: unknown
     /// keys (including `model_index`, which only the per-model block sets),
     /// types and ranges. The error names the key.

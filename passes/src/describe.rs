@@ -104,6 +104,14 @@ impl<P: PassParams, G: GpuBlock> PassDef for PassKind<P, G> {
     fn shader(&self) -> Shader {
         self.shader
     }
+    fn entry(&self, value: &ron::Value) -> Result<&'static str, ParamError> {
+        Ok(self.params(value)?.entry(self.shader.entry))
+    }
+    fn entries(&self) -> Vec<&'static str> {
+        std::iter::once(self.shader.entry)
+            .chain(P::VARIANT_ENTRIES.iter().copied())
+            .collect()
+    }
     fn check_params(&self, value: &ron::Value) -> Result<(), ParamError> {
         params::check::<P>(value)
             .map(drop)

@@ -151,11 +151,13 @@ mod tests {
             let path = std::path::Path::new(wgsl).join(d.shader().file);
             let text = std::fs::read_to_string(&path)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            assert!(
-                text.contains(&format!("fn {}(", d.shader().entry)),
-                "{} lacks entry point",
-                path.display()
-            );
+            for entry in d.entries() {
+                assert!(
+                    text.contains(&format!("fn {entry}(")),
+                    "{} lacks entry point {entry}",
+                    path.display()
+                );
+            }
         }
     }
 

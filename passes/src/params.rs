@@ -38,6 +38,18 @@ pub trait PassParams: DeserializeOwned + Default + Send + Sync + 'static {
     fn validate(&self) -> Result<(), Invalid> {
         Ok(())
     }
+
+    /// Entry points besides the kind's [`crate::contract::Shader::entry`]
+    /// that [`PassParams::entry`] may choose.
+    const VARIANT_ENTRIES: &'static [&'static str] = &[];
+
+    /// The entry point for these parameters; `default` is the kind's. A
+    /// kind compiles a switch into an entry point of its own where a branch
+    /// would cost every variant: the registers a branch's other side holds
+    /// live are the kernel's, whichever side runs.
+    fn entry(&self, default: &'static str) -> &'static str {
+        default
+    }
 }
 
 /// No parameters: only an empty map (or none) is accepted.

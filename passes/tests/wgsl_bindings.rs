@@ -128,6 +128,19 @@ fn entry_points(module: &Module, def: &dyn PassDef) -> Result<Vec<&'static str>,
             entries.push(fragment);
         }
     }
+    // Entry points a switch selects (PassDef::entries): the same stage and
+    // workgroup size as the default one.
+    for variant in def.entries().into_iter().skip(1) {
+        let ep = find(module, variant)
+            .ok_or_else(|| format!("no entry point `{variant}` (PassDef::entries)"))?;
+        if ep.stage != entry.stage || ep.workgroup_size != entry.workgroup_size {
+            return Err(format!(
+                "`{variant}` is {:?} {:?}, `{}` is {:?} {:?}",
+                ep.stage, ep.workgroup_size, shader.entry, entry.stage, entry.workgroup_size
+            ));
+        }
+        entries.push(variant);
+    }
     Ok(entries)
 }
 

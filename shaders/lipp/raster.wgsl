@@ -32,7 +32,8 @@ struct RasterParams {
     // The groom drawn, in the per-model block; grooms after the first also
     // test hair_depth (Lipp §3.5).
     model_index: u32,
-    // Ours: the tangent packed once per segment (raster::segment_payload).
+    // Ours: the tangent packed once per segment (raster::segment_payload);
+    // it selects the entry point (`raster` or `raster_sample_payload`).
     segment_payload: u32,
     _pad1: u32,
     _pad2: u32,
@@ -71,11 +72,12 @@ fn tangent_bits(tangent: vec3<f32>) -> vec2<u32> {
 }
 
 // Target::segment_bits: what every sample of segment (a, b) shares in
-// payload::pack's layout: the strand's u and v, and with segment_payload the
-// tangent at the segment's middle.
-fn segment_bits(a: End, b: End, uv: vec2<f32>) -> vec2<u32> {
+// payload::pack's layout: the strand's u and v, and unless the tangent is
+// packed per sample, the tangent at the segment's middle. `per_sample` is a
+// constant of each entry point, so each compiles only its own side.
+fn segment_bits(a: End, b: End, uv: vec2<f32>, per_sample: bool) -> vec2<u32> {
     var bits = vec2<u32>((quantize(uv.x, 63.0) << 18u) | (quantize(uv.y, 63.0) << 12u), 0u);
-    if params.segment_payload != 0u {
+    if !per_sample {
         bits |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, 0.5)));
     }
     return bits;
@@ -83,7 +85,7 @@ fn segment_bits(a: End, b: End, uv: vec2<f32>) -> vec2<u32> {
 
 // Target::write: payload::pack of the sample at t, from the segment's
 // shared bits.
-fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: vec2<u32>) {
+fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: vec2<u32>, per_sample: bool) {
     if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
         return;
     }
@@ -96,7 +98,7 @@ fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: ve
         return;
     }
     var p = seg_bits;
-    if params.segment_payload == 0u {
+    if per_sample {
         p |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, t)));
     }
     p.x |= (quantize(a.w + (b.w - a.w) * t, 63.0) << 6u) | quantize(a.ao + (b.ao - a.ao) * t, 63.0);
@@ -110,7 +112,7 @@ fn pixel_of(x_major: bool, m: i32, n: i32) -> vec2<i32> {
 }
 
 // Target::segment: a DDA over the major axis, one column at a time.
-fn draw_segment(a: End, b: End, bits: vec2<u32>) {
+fn draw_segment(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
     let ma = select(a.y, a.x, x_major);
     let na = select(a.x, a.y, x_major);
@@ -140,7 +142,7 @@ fn draw_segment(a: End, b: End, bits: vec2<u32>) {
             for (var row = r; row <= r + 1; row++) {
                 if abs((n - (f32(row) + 0.5)) * cosa) <= half {
                     let p = pixel_of(x_major, ci, row);
-                    write_sample(a, b, t, p.x, p.y, 0u, bits);
+                    write_sample(a, b, t, p.x, p.y, 0u, bits, per_sample);
                 }
             }
         }
@@ -152,7 +154,7 @@ fn draw_segment(a: End, b: End, bits: vec2<u32>) {
             let tm = 0.5 * (t0 + t1);
             for (var row = r0; row <= r1; row++) {
                 let p = pixel_of(x_major, ci, row);
-                write_sample(a, b, tm, p.x, p.y, 1u, bits);
+                write_sample(a, b, tm, p.x, p.y, 1u, bits, per_sample);
             }
         }
     }
@@ -179,7 +181,7 @@ fn sample_offset(n: u32, s: u32) -> vec2<f32> {
 
 // Target::segment_msaa: every sample within centre_diameter / 2 of the
 // segment, in every pixel the segment touches.
-fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>) {
+fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     let n = params.msaa;
     let layers = min(n, arrayLength(&gbuffer) / max(params.width * params.height, 1u));
     let half = params.centre_diameter * 0.5;
@@ -209,26 +211,46 @@ fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>) {
                 let ex = a.x + dx * t - px;
                 let ey = a.y + dy * t - py;
                 if ex * ex + ey * ey <= half * half {
-                    write_sample(a, b, t, p.x, p.y, s, bits);
+                    write_sample(a, b, t, p.x, p.y, s, bits, per_sample);
                 }
             }
         }
     }
 }
 
-fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>) {
+fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>, per_sample: bool) {
     let pa = project(a, ta);
     let pb = project(b, tb);
     if pa.ok && pb.ok {
-        let bits = segment_bits(pa, pb, uv);
+        let bits = segment_bits(pa, pb, uv, per_sample);
         if params.msaa > 1u {
-            draw_segment_msaa(pa, pb, bits);
+            draw_segment_msaa(pa, pb, bits, per_sample);
         } else {
-            draw_segment(pa, pb, bits);
+            draw_segment(pa, pb, bits, per_sample);
         }
     }
 }
 
+
+// The strands of this workgroup; `per_sample`: the tangent packed per
+// sample (raster::segment_payload off).
+fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, per_sample: bool) {
+    let total = raster_args[3];
+    let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
+    let stride = max(groups, 1u);
+    for (var s = wg; s < total; s += stride) {
+        let st = load_strand(count, s, params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        for (var m = 0u; m < strip_segments(strip); m++) {
+            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv, per_sample);
+        }
+        // smLayer is rewritten by the next strand.
+        workgroupBarrier();
+    }
+}
 
 @compute @workgroup_size(32)
 fn raster(
@@ -238,19 +260,16 @@ fn raster(
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
 ) {
-    let total = raster_args[3];
-    let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
-    let stride = max(groups.x, 1u);
-    for (var s = wg.x; s < total; s += stride) {
-        let st = load_strand(count, s, params.styling != 0u);
-        pass_one(st, l);
-        workgroupBarrier();
-        let strip = pass_two(st, l);
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv);
-        }
-        // smLayer is rewritten by the next strand.
-        workgroupBarrier();
-    }
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false);
+}
+
+@compute @workgroup_size(32)
+fn raster_sample_payload(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true);
 }

@@ -126,8 +126,7 @@ fn build_pass(
     let gpu = cx.gpu;
     let d = &gpu.device;
     let pass = &cx.plan.graph.passes[prep.p];
-    let shader = prep.def.shader();
-    let mut entries = vec![shader.entry];
+    let mut entries = vec![prep.entry];
     if let Some(state) = &prep.raster {
         entries.extend(state.draws.iter().map(|d| d.fragment));
     }
@@ -208,7 +207,7 @@ fn compute_work(
     index: usize,
 ) -> Result<(Work, Vec<SetPlan>), AshError> {
     let d = &cx.gpu.device;
-    let entry = entry_name(cx, prep.p, prep.def.shader().entry)?;
+    let entry = entry_name(cx, prep.p, prep.entry)?;
     let stage = vk::PipelineShaderStageCreateInfo::default()
         .stage(vk::ShaderStageFlags::COMPUTE)
         .module(module)

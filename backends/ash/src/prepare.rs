@@ -16,6 +16,8 @@ pub(crate) struct Prepared<'d> {
     /// Binding name, physical resource id and usage, in `bindings()` order.
     pub bindings: Vec<(String, usize, Usage)>,
     pub params: Vec<u32>,
+    /// The compute (or vertex) entry point these parameters run (`PassDef::entry`).
+    pub entry: &'static str,
     pub composed: Composed,
     /// The draw state of a raster pass (`PassDef::raster`).
     pub raster: Option<RasterState>,
@@ -51,6 +53,7 @@ pub(crate) fn prepare<'d>(
             .map(|b| (b.name, g.physical(b.access.resource), b.access.usage))
             .collect();
         let params = def.gpu_params(&pass.params, &instance.quantities)?;
+        let entry = def.entry(&pass.params)?;
         let file = def.shader().file;
         let composed = shaders
             .compose(file)
@@ -77,6 +80,7 @@ pub(crate) fn prepare<'d>(
             def,
             bindings,
             params,
+            entry,
             composed,
             raster,
         };

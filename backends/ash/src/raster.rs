@@ -144,7 +144,7 @@ fn graphics_pipeline(
     layout: vk::PipelineLayout,
 ) -> Result<Owned<vk::Pipeline>, AshError> {
     let d = &cx.gpu.device;
-    let vs_name = entry_name(cx, prep.p, prep.def.shader().entry)?;
+    let vs_name = entry_name(cx, prep.p, prep.entry)?;
     let fs_name = entry_name(cx, prep.p, draw.fragment)?;
     let stages = [
         vk::PipelineShaderStageCreateInfo::default()

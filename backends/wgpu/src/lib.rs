@@ -147,6 +147,8 @@ struct Prepared<'d> {
     /// Binding index (into `bindings`) → attachment usage, for raster passes.
     attachments: Vec<(usize, Usage)>,
     params: Vec<u32>,
+    /// The compute (or vertex) entry point these parameters run (`PassDef::entry`).
+    entry: &'static str,
     composed: Composed,
     /// The draw state, for raster passes.
     raster: Option<strandgraph_passes::RasterState>,

@@ -176,7 +176,7 @@ impl<'a> PassContext<'a> {
                 label: Some(self.name),
                 layout: None,
                 module: &self.module,
-                entry_point: Some(self.prep.def.shader().entry),
+                entry_point: Some(self.prep.entry),
                 compilation_options: Default::default(),
                 cache: None,
             })

@@ -45,6 +45,7 @@ pub(crate) fn prepare<'d>(
             });
         }
         let params = def.gpu_params(&pass.params, &instance.quantities)?;
+        let entry = def.entry(&pass.params)?;
         let file = def.shader().file;
         let composed = shaders
             .compose(file)
@@ -55,6 +56,7 @@ pub(crate) fn prepare<'d>(
             bindings,
             attachments,
             params,
+            entry,
             composed,
             raster,
         });

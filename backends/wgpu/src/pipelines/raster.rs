@@ -79,7 +79,7 @@ fn render_pipeline(
             layout: None,
             vertex: wgpu::VertexState {
                 module: &cx.module,
-                entry_point: Some(cx.prep.def.shader().entry),
+                entry_point: Some(cx.prep.entry),
                 compilation_options: Default::default(),
                 buffers: &[],
             },
