@@ -71,16 +71,25 @@ fn tangent_bits(tangent: vec3<f32>) -> vec2<u32> {
     return vec2<u32>(quantize(e.y * 0.5 + 0.5, 255.0) << 24u, quantize(e.x * 0.5 + 0.5, 255.0));
 }
 
-// Target::segment_bits: what every sample of segment (a, b) shares in
-// payload::pack's layout: the strand's u and v, and unless the tangent is
-// packed per sample, the tangent at the segment's middle. `per_sample` is a
-// constant of each entry point, so each compiles only its own side.
-fn segment_bits(a: End, b: End, uv: vec2<f32>, per_sample: bool) -> vec2<u32> {
+// Target::segment_bits: what every sample of a segment with end tangents
+// ta, tb shares in payload::pack's layout: the strand's u and v, and unless
+// the tangent is packed per sample, the tangent at the segment's middle.
+// `per_sample` is a constant of each entry point, so each compiles only its
+// own side.
+fn segment_bits(ta: vec3<f32>, tb: vec3<f32>, uv: vec2<f32>, per_sample: bool) -> vec2<u32> {
     var bits = vec2<u32>((quantize(uv.x, 63.0) << 18u) | (quantize(uv.y, 63.0) << 12u), 0u);
     if !per_sample {
-        bits |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, 0.5)));
+        bits |= tangent_bits(safe_normalize(lerp_vec(ta, tb, 0.5)));
     }
     return bits;
+}
+
+// Segment m's bits (segment_bits), or nothing past the strip's segments.
+fn strip_bits(strip: Strip, m: u32, uv: vec2<f32>, per_sample: bool) -> vec2<u32> {
+    if m >= strip_segments(strip) {
+        return vec2<u32>(0u);
+    }
+    return segment_bits(strip_tangent(strip, m), strip_tangent(strip, m + 1u), uv, per_sample);
 }
 
 // Target::write: payload::pack of the sample at t, from the segment's
@@ -218,11 +227,10 @@ fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     }
 }
 
-fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>, per_sample: bool) {
+fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, bits: vec2<u32>, per_sample: bool) {
     let pa = project(a, ta);
     let pb = project(b, tb);
     if pa.ok && pb.ok {
-        let bits = segment_bits(pa, pb, uv, per_sample);
         if params.msaa > 1u {
             draw_segment_msaa(pa, pb, bits, per_sample);
         } else {
@@ -231,6 +239,10 @@ fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2
     }
 }
 
+
+fn pick_bits(a: vec2<u32>, b: vec2<u32>, c: vec2<u32>, d: vec2<u32>, m: u32) -> vec2<u32> {
+    return select(select(select(d, c, m == 2u), b, m == 1u), a, m == 0u);
+}
 
 // The strands of this workgroup; `per_sample`: the tangent packed per
 // sample (raster::segment_payload off).
@@ -244,8 +256,15 @@ fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, p
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
+        // Every segment's payload bits before the walk: past this point the
+        // shipped entry needs no tangent, and their registers are free.
+        let bits_a = strip_bits(strip, 0u, st.uv, per_sample);
+        let bits_b = strip_bits(strip, 1u, st.uv, per_sample);
+        let bits_c = strip_bits(strip, 2u, st.uv, per_sample);
+        let bits_d = strip_bits(strip, 3u, st.uv, per_sample);
         for (var m = 0u; m < strip_segments(strip); m++) {
-            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), st.uv, per_sample);
+            let bits = pick_bits(bits_a, bits_b, bits_c, bits_d, m);
+            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), bits, per_sample);
         }
         // smLayer is rewritten by the next strand.
         workgroupBarrier();
