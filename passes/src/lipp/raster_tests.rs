@@ -168,6 +168,18 @@ fn segment_payload_changes_only_the_tangent_bits() {
 }
 
 #[test]
+fn the_per_sample_payload_is_an_entry_point_of_its_own() {
+    use crate::contract::PassDef;
+    let entry = |p: &str| RASTER.entry(&ron::from_str(p).unwrap()).unwrap();
+    assert_eq!(entry("{}"), "raster");
+    assert_eq!(
+        entry(r#"{"segment_payload": false}"#),
+        "raster_sample_payload"
+    );
+    assert_eq!(RASTER.entries(), ["raster", "raster_sample_payload"]);
+}
+
+#[test]
 fn depth_test_against_the_scene_rejects_hidden_strands() {
     let (mut h, groups) = harness("{}", 32);
     h.buffer("scene.depth", vec![0.0f32.to_bits(); (W * H) as usize])
