@@ -1,4 +1,5 @@
-// lipp.raster (entry `raster`): Lipp §3.1 and Appendix B Code 1. One
+// lipp.raster (entries `raster`, and `raster_sample_payload` for
+// segment_payload off): Lipp §3.1 and Appendix B Code 1. One
 // 32-lane workgroup per strand (indirect; workgroups stride over strands
 // beyond 65535), the strand assembled cooperatively (assembly.wgsl, shared
 // with the deep opacity maps in dom_maps.wgsl), then DDA rasterization into
@@ -239,7 +240,7 @@ fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, bits: ve
     }
 }
 
-
+// Segment m's bits of the four a lane's strip holds.
 fn pick_bits(a: vec2<u32>, b: vec2<u32>, c: vec2<u32>, d: vec2<u32>, m: u32) -> vec2<u32> {
     return select(select(select(d, c, m == 2u), b, m == 1u), a, m == 0u);
 }
