@@ -70,3 +70,56 @@ fn far_view_lod_cuts_raster_work_at_least_five_fold() {
     assert!(off.segments >= 5 * on.segments, "segments");
     assert!(off.pixels >= 5 * on.pixels, "pixels written");
 }
+
+/// Strands each bundle draws into `resource` (a `bundle_lod` layout).
+fn strands_in(p: &Prepared, resource: &str) -> u64 {
+    let frame = CpuBackend {
+        alias: false,
+        ..CpuBackend::default()
+    }
+    .execute(&p.plan, &p.instance, &p.upload)
+    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+    let lod = frame.read(&p.plan, resource).unwrap();
+    let bundles = p.upload.quantities.bundles as usize;
+    lod.chunks(4).take(bundles).map(|b| u64::from(b[0])).sum()
+}
+
+/// The deep opacity maps' own LOD (`shadow_lod`, `view: Light`): measured
+/// in the light's map, it does not move with the camera unless bound by it,
+/// and at close range it keeps fewer strands than the camera's (λ 0.25).
+#[test]
+fn shadow_lod_is_measured_in_the_lights_map() {
+    let scene =
+        |v: &str| Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/distances/{v}.ron"));
+    let prepared = |v: &str, params: &[&str]| {
+        let mut p = prepare(&scene(v), None, Some((W, H))).unwrap_or_else(|e| panic!("{e:?}"));
+        for spec in params {
+            override_param(&mut p.plan, spec).unwrap();
+        }
+        p
+    };
+    let unbound = ["shadow_lod.camera_bound=false"];
+    let (close, far) = (
+        strands_in(&prepared("close", &unbound), "shadow_lod"),
+        strands_in(&prepared("far", &unbound), "shadow_lod"),
+    );
+    assert_eq!(close, far, "the light's map does not see the camera move");
+    let shipped = prepared("close", &[]);
+    let (maps, camera) = (
+        strands_in(&shipped, "shadow_lod"),
+        strands_in(&shipped, "bundle_lod"),
+    );
+    let bound_far = strands_in(&prepared("far", &[]), "shadow_lod");
+    eprintln!(
+        "shadow LOD strands: {close} unbound (close and far), {maps} close and {bound_far} far \
+         bound by the camera; camera LOD at close {camera}"
+    );
+    assert!(
+        maps > 0 && maps * 2 < camera,
+        "{maps} vs the camera's {camera}"
+    );
+    assert!(
+        bound_far < maps,
+        "bound by the camera, the far view keeps fewer"
+    );
+}
