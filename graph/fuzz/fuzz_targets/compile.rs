@@ -21,7 +21,11 @@ fuzz_target!(|data: &[u8]| {
     };
     let scale = |i: usize| {
         let b = byte(i);
-        if b == 255 { u64::MAX / 3 } else { b << (b % 40) }
+        if b == 255 {
+            u64::MAX / 3
+        } else {
+            b << (b % 40)
+        }
     };
     let q = Quantities {
         strands: scale(1),
