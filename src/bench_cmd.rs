@@ -18,7 +18,9 @@ use report::{Ceilings, Cell, Report, Stats};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandgraph::frame::{Prepared, bake_shadows, override_param, parse_size, prepare};
+use strandgraph::frame::{
+    Prepared, bake_shadows, build_patches, override_param, parse_size, prepare,
+};
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -160,6 +162,7 @@ fn prepare_graph(
         override_param(&mut plan, &format!("{name}.{QUICK_SHADOW}"))?;
     }
     let mut upload = strandgraph_passes::upload::upload(&scene, w, h);
+    build_patches(&plan, &scene, &mut upload);
     bake_shadows(&plan, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
     Ok(Prepared {
@@ -178,6 +181,7 @@ const QUICK_ROWS: &[&str] = &[
     "Kulikov: no loop flattening",
     "Lipp: SWR 1+L",
     "Lipp: SWR 1+F+L (as published)",
+    "Scheuermann: Z-primed (as published)",
 ];
 
 /// What `--quick` sets on every `kulikov.shade` pass.

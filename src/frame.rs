@@ -51,6 +51,7 @@ pub fn prepare_with(
         override_param(&mut plan, spec)?;
     }
     let mut upload = upload(&scene, w, h);
+    build_patches(&plan, &scene, &mut upload);
     bake_shadows(&plan, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
     Ok(Prepared {
@@ -59,6 +60,16 @@ pub fn prepare_with(
         plan,
         instance,
     })
+}
+
+/// Scheuermann's hair patches: built from the grooms (and the patch count
+/// set) only for a graph that imports `patches.vertices`, since no other
+/// pipeline draws them. Does nothing when the upload already holds them.
+pub fn build_patches(plan: &Plan, scene: &Scene, up: &mut Upload) {
+    use strandgraph_passes::scheuermann::upload::{VERTICES, pack};
+    if plan.graph.resource_id(VERTICES).is_some() && !up.resources.contains_key(VERTICES) {
+        pack(scene, up);
+    }
 }
 
 /// Kulikov's precomputed self-shadowing: when a live `kulikov.shade` pass

@@ -82,6 +82,9 @@ fn from_scene(c: SceneCounts) -> Quantities {
         segments: c.segments,
         bundles: c.bundles,
         models: c.models,
+        // Patches are built only when a graph draws them; estimated here
+        // from the default PatchParams (a clump per 48 strands, 3 layers).
+        patches: c.strands.div_ceil(48) * 3,
         triangles: c.triangles,
         lights: c.lights,
         width: c.width,
@@ -105,6 +108,7 @@ fn quantities(mut q: Quantities, pairs: &[String]) -> Result<Quantities> {
             "segments" => q.segments = v,
             "bundles" => q.bundles = v,
             "models" => q.models = v,
+            "patches" => q.patches = v,
             "triangles" => q.triangles = v,
             "lights" => q.lights = v,
             "width" => q.width = small()?,

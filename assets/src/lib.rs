@@ -16,15 +16,20 @@
 //! - [`hair_color`]: melanin and redness to absorption and colour (d'Eon 2011, Chiang 2016).
 //! - [`HairMesh`]: `procedural`, `fit` (k-means bundles), `to_groom`, and
 //!   [`hairmesh::strandgen::strand_point`], the (bundle, uv, w) -> point function (Lipp §2).
+//! - [`hairpatch::HairPatches`]: layered, textured ribbon patches with baked per-vertex
+//!   AO in a static inside-to-outside draw order, generated from any groom, and their
+//!   procedural [`hairpatch::texture::HairTexture`] (Scheuermann 2004).
 //! - [`skinning::bake`]: `hairRootSkinningInfo_t` records for strand roots (Kulikov).
 
 #![forbid(unsafe_code)]
 
 pub mod bounds;
+pub mod density;
 pub mod error;
 pub mod groom;
 pub mod hair_color;
 pub mod hairmesh;
+pub mod hairpatch;
 pub mod loaders;
 pub mod mesh;
 pub mod octahedral;

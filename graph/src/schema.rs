@@ -104,6 +104,9 @@ pub enum Quantity {
     Bundles,
     /// Hair models (grooms) in the scene.
     Models,
+    /// Hair patches: textured ribbon strips built from the grooms
+    /// (Scheuermann 2004's polygonal hair model).
+    Patches,
     /// Triangles of the scene's meshes (heads, bodies).
     Triangles,
     Lights,
@@ -115,13 +118,13 @@ pub enum Quantity {
 
 impl Quantity {
     /// Scene content a scene may lack: meshes (a groom with no head),
-    /// hair meshes, lights. Buffers sized by these hold at least one element
+    /// hair meshes, hair patches (built only for the graphs that draw them), lights. Buffers sized by these hold at least one element
     /// so their bindings stay valid; passes count from the quantities, never
     /// from a buffer's length, so the placeholder is never read as content.
     pub fn may_be_empty(self) -> bool {
         matches!(
             self,
-            Quantity::Triangles | Quantity::Bundles | Quantity::Lights
+            Quantity::Triangles | Quantity::Bundles | Quantity::Patches | Quantity::Lights
         )
     }
 }

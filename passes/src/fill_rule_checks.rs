@@ -1,6 +1,6 @@
 //! Fill-rule checks shared by the tests of both triangle rasterizers: the
 //! hardware rules the graphics roofline's CPU kernel follows
-//! (`bench::hardware_rules`) and the compute rasterizer of the opaque head
+//! (`hardware_raster`) and the compute rasterizer of the opaque head
 //! (`opaque_mesh::setup`). Each takes the rasterizer as `cover`: the pixel
 //! centres a screen-space triangle (pixels, y down, either winding) covers
 //! on a `w` × `h` screen.

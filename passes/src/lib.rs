@@ -20,6 +20,7 @@ pub mod contract;
 pub mod describe;
 #[cfg(test)]
 mod fill_rule_checks;
+pub mod hardware_raster;
 pub mod kernel;
 pub mod kulikov;
 pub mod layout;
@@ -27,6 +28,7 @@ pub mod lipp;
 pub mod opaque_mesh;
 pub mod params;
 pub mod raster_state;
+pub mod scheuermann;
 pub mod spirv;
 pub mod upload;
 pub mod wgsl;
@@ -46,6 +48,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &opaque_mesh::visibility::VISIBILITY,
     &opaque_mesh::depth_resolve::DEPTH_RESOLVE,
     &opaque_mesh::opaque::OPAQUE,
+    &opaque_mesh::depth_attachment::DEPTH_ATTACHMENT,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
     &kulikov::lod::LOD,
     &kulikov::skin::SKIN,
@@ -72,6 +75,11 @@ pub static PASSES: &[&dyn PassDef] = &[
     &lipp::dom::DOM_OPACITY,
     &lipp::shade::SHADE,
     &lipp::filter::FILTER,
+    // Scheuermann 2004: polygonal hair, the baseline.
+    &scheuermann::hair::PRIME_DEPTH,
+    &scheuermann::hair::OPAQUE,
+    &scheuermann::hair::BACK_FACES,
+    &scheuermann::hair::FRONT_FACES,
     // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,

@@ -169,8 +169,12 @@ fn lower_first(s: &str) -> String {
 
 /// `model_index` as `Option<u32>`: ron's `Value` has no options of its own,
 /// so a present number means `Some`.
-pub fn some<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
-    <u32 as serde::Deserialize>::deserialize(d).map(Some)
+pub fn some<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: serde::Deserialize<'de>,
+{
+    T::deserialize(d).map(Some)
 }
 
 /// `value` within `range`, or an error naming `key`.

@@ -13,11 +13,19 @@
 pub struct RasterState {
     /// Vertices per draw (3 per triangle).
     pub vertices: u64,
-    pub cull_back_faces: bool,
+    pub cull: Cull,
     pub color_load: ColorLoad,
     pub depth_load: DepthLoad,
     /// In order; the first one's fragment entry is `Shader::fragment`.
     pub draws: Vec<Draw>,
+}
+
+/// Which faces the rasterizer drops (front faces are counter-clockwise).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cull {
+    None,
+    Back,
+    Front,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]

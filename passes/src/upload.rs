@@ -81,6 +81,8 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
             .map(|g| g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64))
             .sum(),
         models: hair.models.len() as u64,
+        // Built only for graphs that draw them (scheuermann::upload::pack).
+        patches: 0,
         triangles: triangles.len() as u64,
         lights: lights.len() as u64,
         width,

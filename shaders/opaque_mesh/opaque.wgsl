@@ -12,6 +12,7 @@
 // first), 6 = output (Rgba16Float storage image).
 //
 #import strandgraph::layout::{FrameData, TriangleData, LightData}
+#import strandgraph::octahedral::unpack_unit_vector
 #import strandgraph::opaque_setup::{setup_world, edges, barycentrics}
 
 // passes/src/opaque_mesh/opaque.rs: OpaqueParams::uniform.
@@ -36,27 +37,6 @@ struct OpaqueParams {
 
 // 1/π, multiplied as the CPU kernel does (std::f32::consts::FRAC_1_PI).
 const FRAC_1_PI: f32 = 0.318309886183791;
-
-// assets/src/octahedral.rs: unpack_unit_vector (two snorm16, x low, y high;
-// Cigolle et al. 2014). unpack2x16snorm clamps at -1 like unsnorm16.
-fn sign_not_zero(v: vec2<f32>) -> vec2<f32> {
-    return select(vec2<f32>(-1.0), vec2<f32>(1.0), v >= vec2<f32>(0.0));
-}
-
-fn unpack_unit_vector(bits: u32) -> vec3<f32> {
-    let e = unpack2x16snorm(bits);
-    let z = 1.0 - abs(e.x) - abs(e.y);
-    var xy = e;
-    if z < 0.0 {
-        xy = (vec2<f32>(1.0) - abs(e.yx)) * sign_not_zero(e);
-    }
-    let n = vec3<f32>(xy, z);
-    let len2 = dot(n, n);
-    if len2 > 0.0 {
-        return n * inverseSqrt(len2);
-    }
-    return vec3<f32>(0.0);
-}
 
 // Each corner's painted albedo (8-bit square roots) or the pass's albedo.
 fn corner_albedo(packed: u32) -> vec3<f32> {

@@ -238,7 +238,29 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Scheuermann 2004's optimized scheme as published (Z primed), and its
+    // unoptimized "Sorted Hair Rendering Scheme" (the opaque pass alpha tests
+    // and writes Z itself). Every hair pass goes through the hardware rasterizer.
+    Variant {
+        pipeline: "Scheuermann",
+        name: "Z-primed (as published)",
+        graph: SCHEUERMANN,
+        overrides: &[],
+        raster: &SCHEUERMANN_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "Scheuermann",
+        name: "no Z prime",
+        graph: SCHEUERMANN,
+        overrides: &["prime_depth.enabled=false", "opaque_hair.primed=false"],
+        raster: &SCHEUERMANN_PASSES,
+        ceiling: "fragments",
+    },
 ];
 
 const LIPP: &str = "scenes/graphs/lipp.ron";
 const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";
+const SCHEUERMANN: &str = "scenes/graphs/scheuermann.ron";
+/// Its hair passes, all hardware raster.
+const SCHEUERMANN_PASSES: [&str; 4] = ["prime_depth", "opaque_hair", "back_faces", "front_faces"];

@@ -5,6 +5,7 @@
 use glam::{IVec3, Vec3};
 
 use super::HairMesh;
+use crate::density::DensityGrid;
 
 const RES: i32 = 32;
 
@@ -12,20 +13,9 @@ impl HairMesh {
     /// Bakes AO into every layer vertex. `extinction` is optical depth per (strand count
     /// per voxel); larger values darken the groom's interior faster.
     pub fn bake_ao(&mut self, extinction: f32) {
-        let b = self.bounds();
-        if b.is_empty() {
+        let Some(mut density) = DensityGrid::new(self.bounds(), IVec3::splat(RES)) else {
             return;
-        }
-        let size = b.size().max(Vec3::splat(1e-4));
-        let cell = size / RES as f32;
-        let idx = |p: Vec3| -> IVec3 {
-            ((p - b.min) / cell)
-                .floor()
-                .as_ivec3()
-                .clamp(IVec3::ZERO, IVec3::splat(RES - 1))
         };
-        let flat = |c: IVec3| (c.x + RES * (c.y + RES * c.z)) as usize;
-        let mut density = vec![0f32; (RES * RES * RES) as usize];
         // Each bundle's strands are spread over its layers' quads.
         for bd in &self.bundles {
             let layers =
@@ -33,33 +23,28 @@ impl HairMesh {
             let per = bd.strands as f32 / (layers.len() * 4) as f32;
             for l in layers {
                 for p in l.positions {
-                    density[flat(idx(p))] += per;
+                    density.add(p, per);
                 }
             }
         }
-        let max = density.iter().copied().fold(0.0, f32::max).max(1e-6);
-        density.iter_mut().for_each(|d| *d /= max);
+        density.normalize_max();
+        let marcher = density.marcher();
         let dirs = [
-            IVec3::X,
-            IVec3::NEG_X,
-            IVec3::Y,
-            IVec3::NEG_Y,
-            IVec3::Z,
-            IVec3::NEG_Z,
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::NEG_Y,
+            Vec3::Z,
+            Vec3::NEG_Z,
         ];
         for l in &mut self.layers {
             for k in 0..4 {
-                let start = idx(l.positions[k]);
-                let mut sum = 0.0;
-                for d in dirs {
-                    let mut c = start + d;
-                    let mut depth = 0.0;
-                    while c.cmpge(IVec3::ZERO).all() && c.cmplt(IVec3::splat(RES)).all() {
-                        depth += density[flat(c)];
-                        c += d;
-                    }
-                    sum += (-extinction * depth).exp();
-                }
+                // March from the centre of the vertex's cell, one cell at a time.
+                let start = density.cell_of(l.positions[k]).as_vec3() + 0.5;
+                let sum: f32 = dirs
+                    .iter()
+                    .map(|&d| (-extinction * marcher.optical_depth(start, d, f32::INFINITY)).exp())
+                    .sum();
                 l.ao[k] = sum / dirs.len() as f32;
             }
         }

@@ -8,6 +8,7 @@ use super::{GroomDesc, GroomSource, LodSettings, Material, MeshSource, SceneDesc
 use crate::error::AssetError;
 use crate::groom::Groom;
 use crate::hairmesh::{HairMesh, HairMeshParams};
+use crate::hairpatch::PatchParams;
 use crate::loaders::envmap::{self, EnvMap};
 use crate::loaders::{self, LoadOptions};
 use crate::mesh::TriMesh;
@@ -32,6 +33,10 @@ pub struct SceneGroom {
     /// Kulikov: one hairRootSkinningInfo_t per strand root, against the parent mesh.
     pub skinning: Option<Vec<RootSkinningInfo>>,
     pub hair_mesh: Option<HairMesh>,
+    /// How this groom's hair patches are generated (Scheuermann 2004), resolved to the
+    /// defaults when the scene gives none. The patches themselves are built lazily, only
+    /// when a graph draws them.
+    pub patches: PatchParams,
     pub material: Material,
     pub lod: LodSettings,
     pub facial_hair: bool,
@@ -246,6 +251,10 @@ fn load_groom(
     g.material
         .validate()
         .map_err(|m| err(&name, format!("groom {:?}: material: {m}", g.name)))?;
+    let patches = g.patches.unwrap_or_default();
+    patches
+        .validate()
+        .map_err(|m| err(&name, format!("groom {:?}: patches: {m}", g.name)))?;
     let mut skinning = None;
     let mut hair_mesh = None;
     let mut groom = match &g.source {
@@ -329,6 +338,7 @@ fn load_groom(
         parent,
         skinning,
         hair_mesh,
+        patches,
         material: g.material,
         lod: g.lod,
         facial_hair: g.facial_hair,
@@ -453,6 +463,33 @@ mod tests {
         );
         let e = load_err(&p).to_string();
         assert!(e.contains("nope.obj") && e.contains(":10:"), "{e}");
+    }
+
+    #[test]
+    fn patch_params_resolve_and_are_validated() {
+        let d = tmp("patches");
+        let s = Scene::load(&write(
+            &d,
+            "ok.ron",
+            &MINI.replace("layers: 4)),", "layers: 4), patches: (layers: 2)),"),
+        ))
+        .unwrap();
+        assert_eq!(s.grooms[0].patches, PatchParams::default());
+        let want = PatchParams {
+            layers: 2,
+            ..Default::default()
+        };
+        assert_eq!(s.grooms[1].patches, want);
+        let p = write(
+            &d,
+            "bad.ron",
+            &MINI.replace("layers: 4)),", "layers: 4), patches: (layers: 9)),"),
+        );
+        let e = load_err(&p).to_string();
+        assert!(
+            e.contains("bad.ron:15:") && e.contains("\"beard\"") && e.contains("layers"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -10,6 +10,7 @@ mod load;
 use serde::{Deserialize, Serialize};
 
 use crate::hairmesh::HairMeshParams;
+use crate::hairpatch::PatchParams;
 use crate::loaders::Units;
 use crate::procedural::{BodyParams, GroomParams, HeadParams};
 use crate::transform::Transform;
@@ -150,6 +151,9 @@ pub struct GroomDesc {
     /// `HairMesh` source, generated procedurally.
     #[serde(default)]
     pub hair_mesh: Option<HairMeshParams>,
+    /// Scheuermann: how the groom's hair patches are generated (default PatchParams).
+    #[serde(default)]
+    pub patches: Option<PatchParams>,
     /// Kulikov's "fedora culling" shapes around a hat, in world space.
     #[serde(default)]
     pub fedora: Option<Fedora>,

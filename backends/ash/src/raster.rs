@@ -9,7 +9,7 @@ use crate::pipelines::{Context, Work, entry_name};
 use crate::prepare::Prepared;
 use ash::vk;
 use strandgraph_graph::schema::Usage;
-use strandgraph_passes::raster_state::{Blend, Compare, Draw, RasterState};
+use strandgraph_passes::raster_state::{Blend, Compare, Cull, Draw, RasterState};
 
 fn compare(c: Compare) -> vk::CompareOp {
     match c {
@@ -166,10 +166,10 @@ fn graphics_pipeline(
     // negative-height viewport (record.rs).
     let raster = vk::PipelineRasterizationStateCreateInfo::default()
         .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(if state.cull_back_faces {
-            vk::CullModeFlags::BACK
-        } else {
-            vk::CullModeFlags::NONE
+        .cull_mode(match state.cull {
+            Cull::None => vk::CullModeFlags::NONE,
+            Cull::Back => vk::CullModeFlags::BACK,
+            Cull::Front => vk::CullModeFlags::FRONT,
         })
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);

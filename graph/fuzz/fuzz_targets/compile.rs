@@ -33,6 +33,7 @@ fuzz_target!(|data: &[u8]| {
         segments: scale(3),
         bundles: scale(4),
         models: u64::from(models),
+        patches: scale(4),
         triangles: scale(5),
         lights: byte(6) % 8,
         width: (byte(7) * 17 + 1) as u32,

@@ -16,7 +16,6 @@
 //! Addresses and values come from a hash of the invocation's global id, so
 //! every backend performs the same sequence of operations.
 
-pub mod hardware_rules;
 mod raster;
 mod roofline;
 

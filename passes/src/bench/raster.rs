@@ -11,12 +11,12 @@
 //! is the same whatever order triangles are drawn in, on every backend.
 
 use super::roofline::pcg;
-use crate::bench::hardware_rules::Setup;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
+use crate::hardware_raster::Setup;
 use crate::kernel::{CounterValues, Ctx};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw, RasterState};
+use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, RasterState};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
@@ -126,7 +126,7 @@ pub static RASTER: PassKind<RasterBenchParams, RasterBenchGpu> = PassKind {
 fn draw(p: &RasterBenchParams, q: &Quantities) -> RasterState {
     RasterState {
         vertices: 3 * p.triangles(q.width, q.height),
-        cull_back_faces: false,
+        cull: Cull::None,
         color_load: ColorLoad::Clear([0.0; 4]),
         depth_load: DepthLoad::Load,
         draws: vec![Draw {

@@ -5,11 +5,14 @@
 //!   into a 64-bit visibility buffer (depth and triangle index per pixel);
 //! - `scene.depth_resolve` turns it into `scene.depth`, the depth image the
 //!   hair pipelines cull and depth-test against;
-//! - `scene.opaque` shades each covered pixel's triangle once.
+//! - `scene.opaque` shades each covered pixel's triangle once;
+//! - `scene.depth_attachment` copies `scene.depth` into a depth attachment
+//!   for hair drawn through the hardware rasterizer.
 //!
 //! All three run the same integer rasterizer ([`setup`]) on every backend
 //! (`shaders/opaque_mesh/*.wgsl` mirror the CPU kernels).
 
+pub mod depth_attachment;
 pub mod depth_resolve;
 pub mod opaque;
 pub mod setup;

@@ -2,7 +2,7 @@
 //! and the translation of the pass's draw state into wgpu's.
 
 use super::*;
-use strandgraph_passes::raster_state::{Blend, ColorLoad, Compare, DepthLoad, Draw};
+use strandgraph_passes::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw};
 
 /// Which of a raster pass's bindings are attachments, and which are bound.
 struct Attachments {
@@ -86,7 +86,11 @@ fn render_pipeline(
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 front_face: wgpu::FrontFace::Ccw,
-                cull_mode: state.cull_back_faces.then_some(wgpu::Face::Back),
+                cull_mode: match state.cull {
+                    Cull::None => None,
+                    Cull::Back => Some(wgpu::Face::Back),
+                    Cull::Front => Some(wgpu::Face::Front),
+                },
                 ..Default::default()
             },
             depth_stencil,

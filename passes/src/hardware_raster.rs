@@ -1,6 +1,7 @@
-//! Triangle rasterization as hardware does it, for the CPU kernel of
-//! `bench.raster` (the graphics roofline), which must make the same coverage
-//! decisions as the GPU backends' hardware rasterizers. The rules are the
+//! Triangle rasterization as hardware does it, for the CPU kernels of the
+//! raster passes (`bench.raster`, the graphics roofline; Scheuermann's hair
+//! patches), which must make the same coverage decisions as the GPU
+//! backends' hardware rasterizers. The rules are the
 //! ones D3D11 and Vulkan specify for hardware:
 //!
 //! - corners snap to a fixed-point grid of 1/256 pixel (8 sub-pixel bits, the
@@ -17,8 +18,10 @@
 //!   perspective-correctly (Vulkan §28.7.1 "Polygon Interpolation").
 //!
 //! Front faces are counter-clockwise in NDC (y up), the convention of glam's
-//! `perspective_rh` and wgpu's default `FrontFace::Ccw`.
+//! `perspective_rh` and wgpu's default `FrontFace::Ccw`; [`Cull`] says which
+//! faces a pass drops.
 
+pub use crate::raster_state::Cull;
 use glam::Vec4;
 
 /// Sub-pixel precision: corners snap to 1/2^8 pixel.
@@ -43,7 +46,7 @@ pub struct Fragment {
     pub screen: [f32; 3],
 }
 
-/// A front-facing triangle ready to rasterize.
+/// A triangle that survived culling, ready to rasterize.
 #[derive(Debug, Clone, Copy)]
 pub struct Setup {
     /// Snapped corners, reordered so that the signed area is positive.
@@ -71,6 +74,17 @@ impl Setup {
     /// near plane in our scenes, and the WGSL vertex shaders drop them the same
     /// way so every backend agrees.
     pub fn from_clip(clip: [Vec4; 3], near: f32, width: u32, height: u32) -> Option<Self> {
+        Self::from_clip_culled(clip, near, width, height, Cull::Back)
+    }
+
+    /// [`Setup::from_clip`] dropping the faces `cull` names.
+    pub fn from_clip_culled(
+        clip: [Vec4; 3],
+        near: f32,
+        width: u32,
+        height: u32,
+        cull: Cull,
+    ) -> Option<Self> {
         let near = near.max(0.0);
         let mut xy = [[0.0f32; 2]; 3];
         let mut z = [0.0f32; 3];
@@ -89,7 +103,7 @@ impl Setup {
             z[k] = c.z * iw;
             inv_w[k] = iw;
         }
-        Self::from_screen(xy, z, inv_w, width, height)
+        Self::from_screen_culled(xy, z, inv_w, width, height, cull)
     }
 
     /// Sets up a triangle from screen positions (pixels, y down), per-corner
@@ -100,6 +114,19 @@ impl Setup {
         inv_w: [f32; 3],
         width: u32,
         height: u32,
+    ) -> Option<Self> {
+        Self::from_screen_culled(xy, z, inv_w, width, height, Cull::Back)
+    }
+
+    /// [`Setup::from_screen`] dropping the faces `cull` names (and
+    /// degenerate triangles, always).
+    pub fn from_screen_culled(
+        xy: [[f32; 2]; 3],
+        z: [f32; 3],
+        inv_w: [f32; 3],
+        width: u32,
+        height: u32,
+        cull: Cull,
     ) -> Option<Self> {
         let mut sx = [0i64; 3];
         let mut sy = [0i64; 3];
@@ -116,11 +143,18 @@ impl Setup {
         // counter-clockwise in NDC (y up) comes out negative here. The winding
         // is decided on the *snapped* corners so that every backend agrees.
         let signed = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sy[1] - sy[0]) * (sx[2] - sx[0]);
-        if signed >= 0 {
-            return None; // back face or degenerate
+        let front = signed < 0;
+        let culled = match cull {
+            Cull::None => false,
+            Cull::Back => !front,
+            Cull::Front => front,
+        };
+        if signed == 0 || culled {
+            return None;
         }
-        // Swap b and c so the area is positive and interior edge functions are > 0.
-        let order = [0usize, 2, 1];
+        // A front face swaps b and c so the area is positive and interior
+        // edge functions are > 0; a back face already has that order.
+        let order = if front { [0usize, 2, 1] } else { [0, 1, 2] };
         let x = order.map(|k| sx[k]);
         let y = order.map(|k| sy[k]);
         let bias = [0, 1, 2].map(|i| {
@@ -144,7 +178,7 @@ impl Setup {
         Some(Self {
             x,
             y,
-            area: -signed,
+            area: signed.abs(),
             bias,
             order,
             z,
@@ -165,8 +199,18 @@ impl Setup {
     }
 
     /// Calls `f` for every covered pixel centre, row by row.
-    pub fn rasterize(&self, mut f: impl FnMut(Fragment)) {
+    pub fn rasterize(&self, f: impl FnMut(Fragment)) {
+        self.rasterize_rows(0, u32::MAX, f);
+    }
+
+    /// [`Setup::rasterize`] limited to rows `first..=last` (a CPU workgroup's
+    /// band of the screen: bands draw in parallel, triangles in order).
+    pub fn rasterize_rows(&self, first: u32, last: u32, mut f: impl FnMut(Fragment)) {
         let [x0, y0, x1, y1] = self.bounds;
+        let (y0, y1) = (y0.max(first), y1.min(last));
+        if y1 < y0 {
+            return;
+        }
         let (px, py) = (i64::from(x0) * ONE + HALF, i64::from(y0) * ONE + HALF);
         let mut row = [0, 1, 2].map(|i| self.edge(i, px, py));
         // Exact integer steps, so stepping equals evaluating at every pixel.
@@ -237,6 +281,38 @@ mod tests {
     #[test]
     fn triangles_sharing_edges_cover_every_pixel_once() {
         crate::fill_rule_checks::shared_edges_cover_every_pixel_once(&cover);
+    }
+
+    #[test]
+    fn each_cull_mode_keeps_its_faces_and_coverage_ignores_winding() {
+        let front = [[1.0f32, 1.0], [1.0, 9.0], [9.0, 1.0]];
+        let back = [front[0], front[2], front[1]];
+        let setup = |t, cull| Setup::from_screen_culled(t, [0.5; 3], [1.0; 3], 16, 16, cull);
+        let pixels = |s: Option<Setup>| {
+            let mut out = Vec::new();
+            s.expect("kept")
+                .rasterize(|f| out.push((f.x, f.y, f.screen)));
+            out
+        };
+        assert!(setup(back, Cull::Back).is_none() && setup(front, Cull::Front).is_none());
+        let a = pixels(setup(front, Cull::None));
+        let b = pixels(setup(back, Cull::Front));
+        assert!(!a.is_empty());
+        assert_eq!(
+            a.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+            b.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>()
+        );
+        // Barycentrics stay attached to the source corners whatever the winding.
+        for (pa, pb) in a.iter().zip(&b) {
+            let (sa, sb) = (pa.2, pb.2);
+            assert!((sa[0] - sb[0]).abs() < 1e-6 && (sa[1] - sb[2]).abs() < 1e-6);
+        }
+        // Rows outside a band are skipped.
+        let mut rows = Vec::new();
+        setup(front, Cull::None)
+            .unwrap()
+            .rasterize_rows(3, 4, |f| rows.push(f.y));
+        assert!(!rows.is_empty() && rows.iter().all(|&y| (3..=4).contains(&y)));
     }
 
     #[test]
