@@ -13,8 +13,9 @@
 # Each style is a scene generated from one template (written next to the
 # images, docs/gallery/scenes/, so every picture can be re-rendered): the
 # sculpted head, the style's hair with eyebrows and eyelashes, one key light
-# and the studio environment. Both pipelines read the same groom: Kulikov its
-# strands, Lipp a hair mesh fitted to them (`hair_mesh:` on every groom).
+# and the studio environment. Every pipeline reads the same groom: Kulikov its
+# strands, Lipp a hair mesh fitted to them (`hair_mesh:` on every groom),
+# Scheuermann patches built from them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -45,7 +46,7 @@ declare -A colour=(
 )
 # view: orbit distance, pitch
 declare -A view=([close]="0.95 0.0" [mid]="2.2 4.0" [far]="8.0 8.0")
-pipelines=(kulikov lipp)
+pipelines=(kulikov lipp scheuermann)
 
 scene() { # style view -> RON
   local style=$1 v=$2
@@ -111,7 +112,8 @@ page=$out/README.md
   echo "Every image here was made by \`scripts/gallery.sh --backend $backend --size $size\`"
   echo "(the scenes it rendered are in [scenes/](scenes/)). Rows: hair styles; columns:"
   echo "pipeline and view. Kulikov 2025 draws the groom's strands; Lipp et al. draw"
-  echo "strands generated from a hair mesh fitted to the same groom."
+  echo "strands generated from a hair mesh fitted to the same groom; Scheuermann"
+  echo "2004 draws textured patches built from it (docs/scheuermann.md)."
   echo
   echo "What differs and why: Lipp's shading adds the studio environment (SH"
   echo "irradiance and a prefiltered probe, its §3.4), which the Kulikov graph"
@@ -119,7 +121,8 @@ page=$out/README.md
   echo "meshes are fitted by k-means over roots and directions; where strands"
   echo "converge and cross (the ponytail's tie, the bun) a bundle's quads span"
   echo "strands going different ways and Lipp's generated strands fan out: a"
-  echo "limit of fitting bundles to such grooms, not of the renderer."
+  echo "limit of fitting bundles to such grooms, not of the renderer. Scheuermann's"
+  echo "hair has baked ambient occlusion and no shadows, as the paper's."
   echo
   header="| style |"; rule="|---|"
   for p in "${pipelines[@]}"; do for v in close mid far; do

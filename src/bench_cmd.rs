@@ -378,16 +378,26 @@ fn variant_plan(p: &Prepared, v: &Variant, extra: &[String]) -> Result<strandgra
     Ok(plan)
 }
 
-/// The raster passes' atomics in an instrumented CPU run of this
-/// configuration. GPUs expose no atomic counters, so GPU rows use this count.
+/// The raster passes' work in an instrumented CPU run of this
+/// configuration, in the unit of the row's ceiling: atomics, or for rows
+/// drawn by the hardware rasterizer (ceiling `fragments`) the fragments
+/// they shade. GPUs expose no such counters, so GPU rows use this count.
 fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptions) -> Result<u64> {
     let plan = variant_plan(p, v, extra)?;
     let mut counter = runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
+    let fragments = v.ceiling == "fragments";
     Ok(counter
         .run(&p.upload)?
         .iter()
         .filter(|t| v.raster.contains(&strandgraph_graph::base_name(&t.name)))
-        .filter_map(|t| t.counters.as_ref().map(|c| c.atomics))
+        .filter_map(|t| {
+            let c = t.counters.as_ref()?;
+            Some(if fragments {
+                c.pixels_written
+            } else {
+                c.atomics
+            })
+        })
         .sum())
 }
 

@@ -16,14 +16,15 @@ const RES: i32 = 48;
 
 /// Optical depth per cell length at the groom's typical density (see [`typical`]).
 /// Chosen so that where the hair lies on the scalp (on the procedural head's Straight
-/// and Long grooms, 6k to 60k strands) the outermost tenth of the vertices get AO ≈ 0.9
-/// (their hemisphere leaves the hair within a cell; only grazing directions cross it)
-/// and the innermost tenth, next to the skin under 2-3 cm of hair, ≈ 0.35-0.55; inside
-/// dense coils (a bun) it falls to about 0.1. A third of this (0.35) left the inner
-/// vertices at 0.7-0.8, barely darker than the outer ones. The density is normalized per
+/// and Long grooms, 6k to 60k strands) the outermost vertices stay near 1 (their
+/// hemisphere leaves the hair within a cell; only grazing directions cross it) and the
+/// innermost, next to the skin under 2-3 cm of hair, are clearly darker. Twice this
+/// (1.2) put the innermost tenth at 0.35-0.55 but took the hair bunched over the
+/// shoulders nearly black in the renders; 0.35 left the inner vertices at 0.7-0.8,
+/// barely darker than the outer ones. The density is normalized per
 /// groom, so a sparse groom darkens like a dense one of the same shape: AO here
 /// measures depth in the hair, not strand count.
-const EXTINCTION: f32 = 1.2;
+const EXTINCTION: f32 = 0.6;
 
 /// The directions, in the vertex's (binormal, tangent, normal) frame: eight points of a
 /// Fibonacci spiral on the unit disc lifted onto the hemisphere, which spreads them

@@ -485,7 +485,11 @@ impl<'a> Shared<'a> {
     }
 
     /// Depth test, fragment shader and output merger for one fragment;
-    /// whether it wrote anything.
+    /// whether the fragment shader ran (the `pixels_written` the bench
+    /// compares with the fragment roofline). Every stage that writes depth
+    /// here may also discard, which makes the hardware test depth after
+    /// shading ("Early Z culling can't be used when alpha test is enabled");
+    /// the others test first.
     fn fragment(&self, tri: &Triangle, f: &Fragment) -> bool {
         let (state, p) = (self.draw, &self.p);
         let i = f.y as usize * self.width as usize + f.x as usize;
@@ -497,7 +501,7 @@ impl<'a> Shared<'a> {
         };
         // Depth clipping: hardware discards fragments outside [0, 1].
         if !passes || !(0.0..=1.0).contains(&f.depth) {
-            return false;
+            return state.depth_write;
         }
         let (surface, uv, density, w) = tri.at(f);
         let fetch = |k: usize| self.texture.load(k);
@@ -510,7 +514,7 @@ impl<'a> Shared<'a> {
             Stage::BackFaces | Stage::FrontFaces => alpha >= MIN_ALPHA,
         };
         if !keep {
-            return false;
+            return true;
         }
         if state.color_writes {
             let model: ModelData = read(&self.models, tri.model as usize);
