@@ -40,10 +40,7 @@ fn directions() -> [Vec3; 8] {
 }
 
 /// Bakes `ao` into every vertex of `patches`.
-pub(super) fn bake(patches: &mut [Patch], strands: &Strands) {
-    let Some(grid) = density(strands) else {
-        return;
-    };
+pub(super) fn bake(patches: &mut [Patch], grid: &DensityGrid) {
     let dirs = directions();
     let marcher = grid.marcher();
     // Beyond this depth a direction's transmittance is below 1e-4.
@@ -68,7 +65,7 @@ pub(super) fn bake(patches: &mut [Patch], strands: &Strands) {
 /// segment so that long segments leave no holes, then divided by [`typical`]. Splatted
 /// in a fixed number of chunks summed in order, so the result does not depend on the
 /// thread count.
-fn density(strands: &Strands) -> Option<DensityGrid> {
+pub(super) fn density(strands: &Strands) -> Option<DensityGrid> {
     let bounds = strands
         .valid
         .iter()

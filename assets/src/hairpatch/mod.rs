@@ -10,6 +10,7 @@
 
 mod ao;
 mod centre;
+mod outward;
 mod strip;
 pub mod texture;
 
@@ -168,11 +169,16 @@ impl HairPatches {
         let params = params.sanitized();
         let strands = Strands::new(groom);
         let centre = centre::head_centre(&strands);
+        let density = ao::density(&strands);
+        let outward = outward::Outward {
+            centre,
+            grid: density.as_ref(),
+        };
         let clumps = clumps(&strands, &params);
         let mut keyed: Vec<(f32, Patch)> = clumps
             .par_iter()
             .enumerate()
-            .flat_map_iter(|(c, m)| strip::clump_patches(&strands, m, c as u32, centre, &params))
+            .flat_map_iter(|(c, m)| strip::clump_patches(&strands, m, c as u32, &outward, &params))
             .collect();
         // Inner first; ties by clump then layer, so the order is deterministic.
         keyed.sort_by(|(ka, a), (kb, b)| {
@@ -181,7 +187,9 @@ impl HairPatches {
                 .then(a.layer.cmp(&b.layer))
         });
         let mut patches: Vec<Patch> = keyed.into_iter().map(|(_, p)| p).collect();
-        ao::bake(&mut patches, &strands);
+        if let Some(grid) = &density {
+            ao::bake(&mut patches, grid);
+        }
         HairPatches { patches, centre }
     }
 
@@ -357,9 +365,14 @@ mod tests {
         let params = PatchParams::default();
         let strands = Strands::new(&g);
         let centre = centre::head_centre(&strands);
+        let density = ao::density(&strands);
+        let outward = outward::Outward {
+            centre,
+            grid: density.as_ref(),
+        };
         let (mut inside, mut total) = (0, 0);
         for (c, m) in clumps(&strands, &params).iter().enumerate() {
-            let layers = strip::clump_layers(&strands, m, centre, params.layers).unwrap();
+            let layers = strip::clump_layers(&strands, m, &outward, params.layers).unwrap();
             for (l, group) in layers.groups.iter().enumerate() {
                 let (_, p) = strip::strip(
                     &strands, group, &layers.n, c as u32, l as u32, centre, &params,

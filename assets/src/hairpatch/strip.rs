@@ -6,6 +6,7 @@
 
 use glam::Vec3;
 
+use super::outward::Outward;
 use super::texture::{HairTexture, hash};
 use super::{PATCH_SEGMENTS, Patch, PatchParams, PatchVertex, Strands};
 
@@ -27,14 +28,14 @@ pub(super) struct ClumpLayers {
 pub(super) fn clump_layers(
     strands: &Strands,
     members: &[u32],
-    centre: Vec3,
+    outward: &Outward<'_>,
     layers: u32,
 ) -> Option<ClumpLayers> {
     let mut guide = mean_line(strands, members);
     relax(&mut guide);
     let t = tangents(&guide)?;
-    // Outward: away from the head, perpendicular to the strands.
-    let n = frame_normals(&t, |i| (guide[i] - centre).normalize_or_zero());
+    // Outward: out of the hair volume (outward.rs), perpendicular to the strands.
+    let n = frame_normals(&t, |i| outward.at(guide[i]));
     let ranked = ranked_outward(strands, members, &guide, &n);
     let l = (layers as usize).min(ranked.len());
     let groups = (0..l)
@@ -48,16 +49,16 @@ pub(super) fn clump_patches(
     strands: &Strands,
     members: &[u32],
     clump: u32,
-    centre: Vec3,
+    outward: &Outward<'_>,
     params: &PatchParams,
 ) -> Vec<(f32, Patch)> {
-    let Some(c) = clump_layers(strands, members, centre, params.layers) else {
+    let Some(c) = clump_layers(strands, members, outward, params.layers) else {
         return Vec::new();
     };
     c.groups
         .iter()
         .enumerate()
-        .filter_map(|(l, g)| strip(strands, g, &c.n, clump, l as u32, centre, params))
+        .filter_map(|(l, g)| strip(strands, g, &c.n, clump, l as u32, outward.centre, params))
         .collect()
 }
 
