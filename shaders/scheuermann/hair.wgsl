@@ -187,23 +187,14 @@ fn strand_specular(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, exponent: f32) -> f
     return dir_atten * pow(max(sin_th, 1e-6), exponent);
 }
 
-// shading.rs: fibre_colour, exp(-4 sigma_a) from the albedo (Chiang Eq. 9).
-fn fibre_colour(albedo: vec3<f32>, roughness: f32) -> vec3<f32> {
-    let b = clamp(roughness, 0.02, 1.0);
-    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b
-        + 5.574 * b * b * b * b
-        + 0.245 * b * b * b * b * b;
-    let l = log(clamp(albedo, vec3<f32>(1e-4), vec3<f32>(1.0))) / d;
-    return exp(-4.0 * (l * l));
-}
-
 // shading.rs: hair_lighting (Scheuermann: HairLighting), summed over the
 // lights; straight (not premultiplied) colour and alpha.
 fn hair_lighting(in: VertexOut, tex: vec4<f32>) -> vec4<f32> {
     let model = models[in.model];
-    let base_colour = fibre_colour(model.color.rgb, model.color.w);
+    let colour = max(model.color.rgb, vec3<f32>(0.0));
+    let base_colour = sqrt(colour);
     let primary = vec3<f32>(params.primary_r, params.primary_g, params.primary_b);
-    let secondary = params.secondary_strength * base_colour;
+    let secondary = params.secondary_strength * pow(colour, vec3<f32>(0.8));
     let t = safe_normalize(in.tangent);
     let n = safe_normalize(in.normal);
     let v = safe_normalize(frame.camera_pos.xyz - in.world);

@@ -29,7 +29,7 @@
 //! so blending happens in primitive order per pixel, as the hardware's
 //! output merger guarantees.
 
-use super::shading::{Shading, Surface, fibre_colour, hair_lighting};
+use super::shading::{Shading, Surface, hair_lighting};
 use super::texture;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
@@ -104,8 +104,8 @@ impl Default for HairParams {
             shift_scale: 0.3,
             primary_exponent: 180.0,
             secondary_exponent: 24.0,
-            primary_colour: [0.2, 0.19, 0.18],
-            secondary_strength: 2.5,
+            primary_colour: [0.25, 0.24, 0.23],
+            secondary_strength: 2.0,
             diffuse_floor: 0.25,
             lod_bias: 0.0,
         }
@@ -518,8 +518,7 @@ impl<'a> Shared<'a> {
         }
         if state.color_writes {
             let model: ModelData = read(&self.models, tri.model as usize);
-            let albedo = Vec3::new(model.color[0], model.color[1], model.color[2]);
-            let colour = fibre_colour(albedo, model.color[3]);
+            let colour = Vec3::new(model.color[0], model.color[1], model.color[2]);
             let camera = Vec3::new(
                 self.frame.camera_pos[0],
                 self.frame.camera_pos[1],

@@ -2,7 +2,7 @@
 //! test, culling, alpha test and blending in draw order.
 
 use super::hair::{BACK_FACES, FRONT_FACES, HairParams, OPAQUE, PRIME_DEPTH, SEGMENTS};
-use super::shading::{Surface, fibre_colour, hair_lighting};
+use super::shading::{Surface, hair_lighting};
 use super::upload::Placement;
 use crate::contract::PassDef;
 use crate::kernel::harness::Harness;
@@ -146,7 +146,7 @@ fn lit(colour: [f32; 3], z: f32, alpha: f32) -> Vec4 {
         &p.shading(),
         &at,
         tex,
-        fibre_colour(Vec3::from(colour), 0.3),
+        Vec3::from(colour),
         Vec3::Z,
         &[light()],
     )

@@ -10,20 +10,18 @@
 //!   a smooth directional attenuation), each with its own tangent shifted
 //!   along the normal by `ShiftTangent`: the primary "shifted towards hair
 //!   tip" in the light's colour, the secondary "shifted towards hair root",
-//!   "colored" (ours: the fibre colour times a strength, so dark
+//!   "colored" (ours: the TRT tint times a strength, so dark
 //!   hair keeps a dim secondary, as Marschner's TRT lobe) and masked by the
 //!   sparkle texture ("Sparkling appearance of secondary highlight");
 //! - `(diffuse + specular) · base texture · light colour`, times the baked
 //!   ambient occlusion; alpha from the alpha texture.
 //!
 //! The paper's colours are an artist's; ours come from the groom's
-//! material, so every pipeline draws the same hair colour. The scene gives
-//! an albedo (Chiang 2016 Eq. 9's multiply-scattered colour, which is what
-//! `models` carries); [`fibre_colour`] inverts Eq. 9 to the fibre's
-//! absorption σa and takes what light keeps that enters a fibre and leaves it
-//! on the side it came from, crossing it twice at normal incidence,
-//! `exp(−4σa)` (Marschner's TRT path, the coloured one): the diffuse colour
-//! and the secondary highlight's.
+//! material (the colour `models` carries), derived as the Kulikov
+//! pipeline's hair shading (Karis's, `shaders/kulikov/shade.wgsl`) derives
+//! its own, so every pipeline draws the same hair colour: the diffuse colour
+//! is `sqrt(colour)` (Karis's Kajiya-Kay diffuse) and the secondary
+//! highlight's is `colour^0.8` (his TRT lobe's tint at normal incidence).
 //!
 //! Two deviations, both of scale. The paper's colours were LDR and its
 //! light colour at most 1; our scenes' lights are radiometric, calibrated
@@ -50,7 +48,7 @@ pub struct Shading {
     pub secondary_exponent: f32,
     /// Linear RGB of the primary highlight.
     pub primary: Vec3,
-    /// The secondary highlight's colour is this times the fibre colour.
+    /// The secondary highlight's colour is this times `colour^0.8`.
     pub secondary_strength: f32,
     /// The lerp's lower end: 0.25 in the paper.
     pub diffuse_floor: f32,
@@ -96,35 +94,19 @@ pub fn strand_specular(t: Vec3, v: Vec3, l: Vec3, exponent: f32) -> f32 {
     dir_atten * sin_th.max(1e-6).powf(exponent)
 }
 
-/// What a fibre leaves of light crossing it twice, `exp(−4σa)`, from the
-/// material's albedo (Chiang 2016 Eq. 9, as `Material::color` computes it)
-/// and roughness β_n: `strandgraph_assets::hair_color::sigma_a_from_color`,
-/// operation for operation as the WGSL does it.
-pub fn fibre_colour(albedo: Vec3, roughness: f32) -> Vec3 {
-    let b = roughness.clamp(0.02, 1.0);
-    let d = 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b
-        + 5.574 * b * b * b * b
-        + 0.245 * b * b * b * b * b;
-    let sigma_a = albedo.map(|c| {
-        let l = c.clamp(1e-4, 1.0).ln() / d;
-        l * l
-    });
-    (-4.0 * sigma_a).exp()
-}
-
 /// Scheuermann: `HairLighting`, summed over `lights`; straight (not
 /// premultiplied) colour and alpha. `tex` is the sampled texture (base,
-/// alpha, shift, sparkle), `fibre` the groom's [`fibre_colour`].
+/// alpha, shift, sparkle), `colour` the groom's.
 pub fn hair_lighting(
     s: &Shading,
     at: &Surface,
     tex: Vec4,
-    fibre: Vec3,
+    colour: Vec3,
     camera: Vec3,
     lights: &[LightData],
 ) -> Vec4 {
-    let base_colour = fibre;
-    let secondary = s.secondary_strength * fibre;
+    let base_colour = colour.max(Vec3::ZERO).map(f32::sqrt);
+    let secondary = s.secondary_strength * colour.max(Vec3::ZERO).powf(0.8);
     let (t, n) = (safe_normalize(at.tangent), safe_normalize(at.normal));
     let v = safe_normalize(camera - at.world);
     let shift_tex = (tex.z - 0.5) * s.shift_scale;
@@ -152,47 +134,6 @@ pub fn hair_lighting(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use strandgraph_assets::hair_color::{color_from_sigma_a, sigma_a_from_melanin};
-
-    #[test]
-    fn the_fibre_colour_inverts_the_albedo_of_the_material() {
-        // Up to brown: blacker albedos clamp at 1e-4 in blue and cannot invert.
-        for (melanin, beta) in [(0.3f32, 0.3f32), (0.9, 0.28), (1.3, 0.35)] {
-            let sigma_a = sigma_a_from_melanin(melanin, 0.0);
-            let albedo = Vec3::from(color_from_sigma_a(sigma_a, beta));
-            let expect = (-4.0 * Vec3::from(sigma_a)).exp();
-            let got = fibre_colour(albedo, beta);
-            assert!(
-                ((got - expect) / expect).abs().max_element() < 2e-3,
-                "{got} vs {expect}"
-            );
-        }
-        // Brown hair (melanin 0.9) is brown, not the near-black of its albedo.
-        let brown = fibre_colour(
-            Vec3::from(color_from_sigma_a(sigma_a_from_melanin(0.9, 0.0), 0.28)),
-            0.28,
-        );
-        assert!(
-            brown.x > 0.15 && brown.y > 0.05 && brown.z < 0.02,
-            "{brown}"
-        );
-    }
-
-    /// The light elevation (radians, in the plane of T and N, seen from
-    /// along N) where the highlight of a tangent shifted by `shift` peaks.
-    fn peak(shift: f32) -> f32 {
-        let (t, n) = (Vec3::Y, Vec3::Z);
-        let shifted = shift_tangent(t, n, shift);
-        (-1500..=1500)
-            .map(|i| i as f32 * 1e-3)
-            .max_by(|&a, &b| {
-                let s = |th: f32| {
-                    strand_specular(shifted, n, Vec3::new(0.0, th.sin(), th.cos()), 200.0)
-                };
-                s(a).total_cmp(&s(b))
-            })
-            .unwrap()
-    }
 
     #[test]
     fn a_shift_along_the_normal_moves_the_highlight_by_twice_its_angle() {
@@ -255,9 +196,9 @@ mod tests {
         let (dull, sparkling) = (lit(0.0), lit(1.0));
         let secondary = sparkling.truncate() - dull.truncate();
         assert!(secondary.min_element() > 0.0, "{secondary}");
-        // The secondary term has the fibre colour's hue.
+        // The secondary term has the colour's TRT tint.
         let hue = secondary / secondary.x;
-        let expect = red / red.x;
+        let expect = red.powf(0.8) / red.x.powf(0.8);
         assert!((hue - expect).abs().max_element() < 1e-4, "{hue}");
         assert_eq!(dull.w, 0.7, "alpha is the alpha texture's");
     }
@@ -293,7 +234,7 @@ mod tests {
             };
             hair_lighting(&diffuse, &surface(1.0), Vec4::ONE, c, camera, &[light]).truncate()
         };
-        let lambert = 2.0 * FRAC_1_PI * c;
+        let lambert = 2.0 * FRAC_1_PI * c.map(f32::sqrt);
         assert!((from([0.0, 0.0, -1.0]) - lambert).abs().max_element() < 1e-6);
         assert!(
             (from([0.0, -1.0, 0.0]) - 0.25 * lambert)
