@@ -21,14 +21,12 @@
 //! No device or no validation layer is a failure, not a skip.
 
 use std::path::PathBuf;
-use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
-use strandgraph::images::{Display, to_picture};
 use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, out_dir, read_ash, root};
+use common::{ash, check_flip, out_dir, read_ash, root};
 
 const W: u32 = 200;
 const H: u32 = 120;
@@ -186,32 +184,6 @@ fn check_lod(label: &str, p: &Prepared, reference: &[u32], test: &[u32]) {
     assert!(same as f64 >= 0.99 * bundles as f64, "{label}: bundle_lod");
 }
 
-fn check_flip(p: &Prepared, label: &str, reference: &[u32], test: &[u32]) {
-    let label = &format!("{}.{label}", p.plan.graph.name);
-    let name = "output.final";
-    let r = p.plan.graph.resource_id(name).unwrap();
-    let a = to_picture(&p.plan, r, reference, W, H, Display::CLIP).unwrap();
-    let b = to_picture(&p.plan, r, test, W, H, Display::CLIP).unwrap();
-    let d = flip(&a, &b).unwrap();
-    eprintln!(
-        "{name} {label}: mean FLIP {:.5}, max {:.4} at {:?}",
-        d.mean, d.max, d.max_at
-    );
-    if d.mean > MAX_MEAN_FLIP {
-        let dir = out_dir("diff_lipp");
-        a.save(dir.join("output.cpu.png")).unwrap();
-        b.save(dir.join(format!("output.{label}.png"))).unwrap();
-        d.error_map
-            .save(dir.join(format!("output.{label}.flip.png")))
-            .unwrap();
-        panic!(
-            "{label}: mean FLIP {} > {MAX_MEAN_FLIP}; images in {}",
-            d.mean,
-            dir.display()
-        );
-    }
-}
-
 #[test]
 fn lipp_graph_matches_on_cpu_wgpu_and_ash() {
     run(None, false);
@@ -317,8 +289,22 @@ fn run(graph: Option<&str>, beard: bool) {
     );
 
     let out = read_cpu("output");
-    check_flip(&p, "ash", &out, &read_ash(&plain, "output"));
-    check_flip(&p, "wgpu", &out, &read_wgpu("output"));
+    check_flip(
+        &p,
+        "diff_lipp",
+        "ash",
+        &out,
+        &read_ash(&plain, "output"),
+        MAX_MEAN_FLIP,
+    );
+    check_flip(
+        &p,
+        "diff_lipp",
+        "wgpu",
+        &out,
+        &read_wgpu("output"),
+        MAX_MEAN_FLIP,
+    );
     assert_eq!(
         read_ash(&plain, "output"),
         read_ash(&aliased, "output"),

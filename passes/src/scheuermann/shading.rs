@@ -135,6 +135,22 @@ pub fn hair_lighting(
 mod tests {
     use super::*;
 
+    /// The light elevation (radians, in the plane of T and N, seen from
+    /// along N) where the highlight of a tangent shifted by `shift` peaks.
+    fn peak(shift: f32) -> f32 {
+        let (t, n) = (Vec3::Y, Vec3::Z);
+        let shifted = shift_tangent(t, n, shift);
+        (-1500..=1500)
+            .map(|i| i as f32 * 1e-3)
+            .max_by(|&a, &b| {
+                let s = |th: f32| {
+                    strand_specular(shifted, n, Vec3::new(0.0, th.sin(), th.cos()), 200.0)
+                };
+                s(a).total_cmp(&s(b))
+            })
+            .unwrap()
+    }
+
     #[test]
     fn a_shift_along_the_normal_moves_the_highlight_by_twice_its_angle() {
         // H ⟂ T' where θ/2 = −atan(shift): a positive nudge needs light from
