@@ -52,7 +52,19 @@ const ROOFLINE: Case = Case {
     graph: "scenes/graphs/roofline.ron",
     size: (64, 64),
 };
-const ALL: [&Case; 5] = [&SHOWCASE, &VISIBILITY, &LIPP, &LIPP_MSAA, &ROOFLINE];
+const SCHEUERMANN: Case = Case {
+    scene: "scenes/showcase.ron",
+    graph: "scenes/graphs/scheuermann.ron",
+    size: (250, 140),
+};
+const ALL: [&Case; 6] = [
+    &SHOWCASE,
+    &VISIBILITY,
+    &LIPP,
+    &LIPP_MSAA,
+    &ROOFLINE,
+    &SCHEUERMANN,
+];
 
 fn prepared(scene: &Path, graph: &str, size: (u32, u32)) -> Prepared {
     prepare(scene, Some(&root().join(graph)), Some(size)).unwrap_or_else(|e| panic!("{e:?}"))
@@ -105,6 +117,11 @@ fn lipp_passes_agree_on_two_grooms() {
 #[test]
 fn lipp_msaa_passes_agree() {
     run(&LIPP_MSAA);
+}
+
+#[test]
+fn scheuermann_passes_agree() {
+    run(&SCHEUERMANN);
 }
 
 #[test]
