@@ -35,7 +35,8 @@ impl Outward<'_> {
         let diff = |o: Vec3| 0.5 * (g.sample(q + o) - g.sample(q - o));
         let falling = -Vec3::new(diff(Vec3::X), diff(Vec3::Y), diff(Vec3::Z));
         let len = falling.length();
-        if !(len > 1e-6) {
+        // Also catches a NaN gradient.
+        if len.is_nan() || len <= 1e-6 {
             return radial;
         }
         let weight = (len / CLEAR_GRADIENT).min(1.0);

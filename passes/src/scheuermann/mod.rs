@@ -11,11 +11,13 @@
 //!   pass (prime Z, opaque, back faces, front faces) through the hardware
 //!   rasterizer, patches in their static inside-to-outside order
 //!   (`scenes/graphs/scheuermann.ron`).
+//! - [`kernel`] is the stages' CPU kernel: the hardware pipeline emulated.
 //! - [`texture`] filters the generated textures, the same on every backend.
 
 pub mod hair;
 #[cfg(test)]
 mod hair_tests;
+mod kernel;
 pub mod shading;
 pub mod texture;
 pub mod upload;
