@@ -58,7 +58,7 @@ pub struct HairParams {
     /// False draws nothing: how a bench row drops the prime stage (with
     /// `primed: false` on the opaque stage) without another graph file.
     pub enabled: bool,
-    /// `scheuermann.opaque` only: whether a `PrimeDepth` pass ran before (test `Equal`)
+    /// `scheuermann.opaque` only: whether a `scheuermann.prime_depth` pass ran before (test `Equal`)
     /// or not (alpha test at `opaque_alpha`, test `Less`, write depth).
     pub primed: bool,
     /// Alpha at which a texel counts as opaque: "alpha test to only pass
