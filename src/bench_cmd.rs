@@ -18,9 +18,7 @@ use report::{Ceilings, Cell, Report, Stats};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandgraph::frame::{
-    Prepared, bake_shadows, build_patches, override_param, parse_size, prepare,
-};
+use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -133,7 +131,7 @@ fn missing_kernel(graph: &Path) -> Result<Option<String>> {
 
 /// [`prepare`], with `--quick`'s graph-wide override applied before the
 /// self-shadow bake: quick runs shade with `VoxelMarch` self-shadowing, as
-/// the offline bake (`frame::bake_shadows`) takes minutes per groom on a
+/// the offline bake (`frame::bake_shadows`, run by `frame::complete_upload`) takes minutes per groom on a
 /// 2-core CI machine and its cache is per machine. Full runs keep the
 /// graph's `Baked`, baked once and then read from the cache.
 fn prepare_graph(
@@ -162,8 +160,7 @@ fn prepare_graph(
         override_param(&mut plan, &format!("{name}.{QUICK_SHADOW}"))?;
     }
     let mut upload = strandgraph_passes::upload::upload(&scene, w, h);
-    build_patches(&plan, &scene, &mut upload);
-    bake_shadows(&plan, &mut upload)?;
+    complete_upload(&plan, &scene, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
     Ok(Prepared {
         scene,

@@ -51,8 +51,7 @@ pub fn prepare_with(
         override_param(&mut plan, spec)?;
     }
     let mut upload = upload(&scene, w, h);
-    build_patches(&plan, &scene, &mut upload);
-    bake_shadows(&plan, &mut upload)?;
+    complete_upload(&plan, &scene, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
     Ok(Prepared {
         scene,
@@ -62,10 +61,19 @@ pub fn prepare_with(
     })
 }
 
+/// What `upload` leaves to the plan, because only some graphs need it and
+/// it costs time: Scheuermann's hair patches ([`build_patches`]) and
+/// Kulikov's baked self-shadowing ([`bake_shadows`]). Call it after
+/// `--param` overrides, before instantiating the plan.
+pub fn complete_upload(plan: &Plan, scene: &Scene, up: &mut Upload) -> Result<Option<BakeOutcome>> {
+    build_patches(plan, scene, up);
+    bake_shadows(plan, up)
+}
+
 /// Scheuermann's hair patches: built from the grooms (and the patch count
 /// set) only for a graph that imports `patches.vertices`, since no other
 /// pipeline draws them. Does nothing when the upload already holds them.
-pub fn build_patches(plan: &Plan, scene: &Scene, up: &mut Upload) {
+fn build_patches(plan: &Plan, scene: &Scene, up: &mut Upload) {
     use strandgraph_passes::scheuermann::upload::{VERTICES, pack};
     if plan.graph.resource_id(VERTICES).is_some() && !up.resources.contains_key(VERTICES) {
         pack(scene, up);

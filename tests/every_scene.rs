@@ -8,7 +8,7 @@
 //! is the same for every graph and is tested on its own (bake/tests).
 
 use std::path::{Path, PathBuf};
-use strandgraph::frame::{bake_shadows, build_patches, override_param};
+use strandgraph::frame::{complete_upload, override_param};
 use strandgraph_assets::Scene;
 use strandgraph_cpu::CpuBackend;
 use strandgraph_graph::compile_file;
@@ -72,8 +72,7 @@ fn render(scene: &Scene, graph: &Path) -> Result<usize, String> {
             .map_err(|e| format!("{e:?}"))?;
     }
     let mut up = upload(scene, W, H);
-    build_patches(&plan, scene, &mut up);
-    bake_shadows(&plan, &mut up).map_err(|e| format!("{e:?}"))?;
+    complete_upload(&plan, scene, &mut up).map_err(|e| format!("{e:?}"))?;
     let instance = plan
         .instantiate(&up.quantities)
         .map_err(|e| format!("{e:?}"))?;

@@ -154,7 +154,9 @@ impl CpuKernel for HairKernel {
 struct Shared<'a> {
     frame: FrameData,
     lights: Vec<LightData>,
-    models: Words<'a>,
+    /// Each model's colour, decoded once per band rather than per fragment.
+    colours: Vec<Vec3>,
+    camera: Vec3,
     texture: Words<'a>,
     output: Words<'a>,
     depth: Words<'a>,
@@ -173,10 +175,20 @@ impl<'a> Shared<'a> {
         let lights = (0..(frame.light_count as usize).min(stored))
             .map(|i| read(&lights, i))
             .collect();
+        let models = ctx.words("models");
+        let stored = models.len() / (std::mem::size_of::<ModelData>() / 4);
+        let colours = (0..(ctx.quantities.models as usize).min(stored))
+            .map(|i| {
+                let c = read::<ModelData>(&models, i).color;
+                Vec3::new(c[0], c[1], c[2])
+            })
+            .collect();
+        let camera = Vec3::from_slice(&frame.camera_pos[..3]);
         Self {
             frame,
             lights,
-            models: ctx.words("models"),
+            colours,
+            camera,
             texture: ctx.words("patches.texture"),
             output: ctx.words("output"),
             depth: ctx.words("depth_buffer"),
@@ -221,14 +233,17 @@ impl<'a> Shared<'a> {
             return true;
         }
         if state.color_writes {
-            let model: ModelData = read(&self.models, tri.model as usize);
-            let colour = Vec3::new(model.color[0], model.color[1], model.color[2]);
-            let camera = Vec3::new(
-                self.frame.camera_pos[0],
-                self.frame.camera_pos[1],
-                self.frame.camera_pos[2],
+            // Past the bound models a GPU's robust access reads zeros.
+            let colour = self.colours.get(tri.model as usize).copied();
+            let colour = colour.unwrap_or(Vec3::ZERO);
+            let lit = hair_lighting(
+                &self.shading,
+                &surface,
+                tex,
+                colour,
+                self.camera,
+                &self.lights,
             );
-            let lit = hair_lighting(&self.shading, &surface, tex, colour, camera, &self.lights);
             let src = match state.blend {
                 Blend::Replace => lit.truncate().extend(1.0),
                 Blend::PremultipliedOverKeepAlpha => (lit.truncate() * lit.w).extend(lit.w),

@@ -63,19 +63,9 @@ pub struct Surface {
     pub ao: f32,
 }
 
-/// WGSL's `v * inverseSqrt(dot(v, v))`, zero for a zero vector.
-pub fn safe_normalize(v: Vec3) -> Vec3 {
-    let len2 = v.dot(v);
-    if len2 > 0.0 {
-        v * (1.0 / len2.sqrt())
-    } else {
-        Vec3::ZERO
-    }
-}
-
 /// Scheuermann: `ShiftTangent`.
 pub fn shift_tangent(t: Vec3, n: Vec3, shift: f32) -> Vec3 {
-    safe_normalize(t + shift * n)
+    (t + shift * n).normalize_or_zero()
 }
 
 /// WGSL `smoothstep`.
@@ -87,7 +77,7 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 /// Scheuermann: `StrandSpecular`, sin(T, H)^exponent attenuated smoothly
 /// where T·H < 0.
 pub fn strand_specular(t: Vec3, v: Vec3, l: Vec3, exponent: f32) -> f32 {
-    let h = safe_normalize(l + v);
+    let h = (l + v).normalize_or_zero();
     let dot_th = t.dot(h);
     let sin_th = (1.0 - dot_th * dot_th).max(0.0).sqrt();
     let dir_atten = smoothstep(-1.0, 0.0, dot_th);
@@ -107,18 +97,21 @@ pub fn hair_lighting(
 ) -> Vec4 {
     let base_colour = colour.max(Vec3::ZERO).map(f32::sqrt);
     let secondary = s.secondary_strength * colour.max(Vec3::ZERO).powf(0.8);
-    let (t, n) = (safe_normalize(at.tangent), safe_normalize(at.normal));
-    let v = safe_normalize(camera - at.world);
+    let (t, n) = (
+        at.tangent.normalize_or_zero(),
+        at.normal.normalize_or_zero(),
+    );
+    let v = (camera - at.world).normalize_or_zero();
     let shift_tex = (tex.z - 0.5) * s.shift_scale;
     let t1 = shift_tangent(t, n, s.primary_shift + shift_tex);
     let t2 = shift_tangent(t, n, s.secondary_shift + shift_tex);
     let mut rgb = Vec3::ZERO;
     for light in lights {
         let pd = light.position_or_direction;
-        let (mut l, mut atten) = (safe_normalize(-Vec3::new(pd[0], pd[1], pd[2])), 1.0);
+        let (mut l, mut atten) = ((-Vec3::new(pd[0], pd[1], pd[2])).normalize_or_zero(), 1.0);
         if pd[3] != 0.0 {
             let d = Vec3::new(pd[0], pd[1], pd[2]) - at.world;
-            l = safe_normalize(d);
+            l = d.normalize_or_zero();
             atten = 1.0 / d.dot(d).max(1e-4);
         }
         let lerp = s.diffuse_floor * (1.0 - n.dot(l)) + n.dot(l);
