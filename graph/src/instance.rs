@@ -178,6 +178,7 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
             format,
             size,
             layers,
+            samples,
             ..
         } => {
             let (w, h) = match *size {
@@ -190,6 +191,7 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
                 u64::from(w),
                 u64::from(h),
                 u64::from(*layers),
+                u64::from(*samples),
                 format.texel_bytes(),
             ]
             .into_iter()

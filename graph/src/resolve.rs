@@ -124,6 +124,14 @@ pub fn resolve(
                 format!("image `{}` has zero layers", decl.name()),
             ));
         }
+        if let Some(why) = samples_problem(decl) {
+            errors.push(GraphError::new(
+                ErrorKind::Size,
+                src,
+                loc.span(&format!("resources[{i}].samples")),
+                format!("image `{}` {why}", decl.name()),
+            ));
+        }
         resources.push(Resource {
             name: decl.name().to_string(),
             decl: decl.clone(),
@@ -528,6 +536,18 @@ fn unknown_resource(
     e
 }
 
+/// Why an image's sample count is not one an attachment can have.
+pub fn samples_problem(decl: &ResourceDecl) -> Option<String> {
+    let ResourceDecl::Image { samples, layers, .. } = decl else {
+        return None;
+    };
+    if ![1, 2, 4, 8].contains(samples) {
+        return Some(format!("has {samples} samples, not 1, 2, 4 or 8"));
+    }
+    (*samples > 1 && *layers > 1)
+        .then(|| "is multisampled and layered; multisampled images have one layer".into())
+}
+
 /// Why a usage does not fit the resource, if it does not.
 fn usage_problem(a: &Access, decl: &ResourceDecl) -> Option<&'static str> {
     let format = match decl {
@@ -545,6 +565,9 @@ fn usage_problem(a: &Access, decl: &ResourceDecl) -> Option<&'static str> {
     }
     if a.usage == Usage::Color && format.is_some_and(ImageFormat::is_depth) {
         return Some("is a colour attachment, but the image has a depth format");
+    }
+    if decl.samples() > 1 && !matches!(a.usage, Usage::Color | Usage::Depth) {
+        return Some("is not an attachment, but the image is multisampled (only draws use one)");
     }
     match a.mode {
         AccessMode::Atomic if a.usage != Usage::Storage => {

@@ -55,6 +55,11 @@ pub enum ResourceDecl {
         size: ImageSize,
         #[serde(default = "one")]
         layers: u32,
+        /// Samples per texel: 1, or 2, 4 or 8 for a multisampled attachment
+        /// (only attachment usages may touch it; the draws that render into
+        /// it rasterize with that many samples).
+        #[serde(default = "one")]
+        samples: u32,
         #[serde(default)]
         lifetime: LifetimeClass,
     },
@@ -79,6 +84,13 @@ impl ResourceDecl {
     }
     pub fn is_image(&self) -> bool {
         matches!(self, ResourceDecl::Image { .. })
+    }
+    /// Samples per texel: 1 for buffers and single-sampled images.
+    pub fn samples(&self) -> u32 {
+        match self {
+            ResourceDecl::Image { samples, .. } => *samples,
+            ResourceDecl::Buffer { .. } => 1,
+        }
     }
 }
 

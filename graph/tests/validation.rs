@@ -344,6 +344,42 @@ fn sampling_a_buffer_is_a_bad_access() {
 }
 
 #[test]
+fn sample_counts_are_those_attachments_have() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Image(name: "depth", format: D32Float, size: Screen,
+              samples: 3), // <-
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "p", kind: "test.draw", writes: ["depth:depth", "out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::Size, &["depth", "3 samples"]);
+}
+
+#[test]
+fn a_multisampled_image_is_only_an_attachment() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Image(name: "depth", format: D32Float, size: Screen, samples: 4),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "p", kind: "test.draw", writes: ["depth:depth", "out"]),
+        Pass(name: "q", kind: "test.consume",
+             reads: ["sampled:depth"], // <-
+             writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    expect_error(src, ErrorKind::BadAccess, &["sampled:depth", "multisampled"]);
+}
+
+#[test]
 fn unknown_usage_prefix() {
     let src = r#"Graph(
     name: "g",

@@ -3,7 +3,9 @@
 //!
 //! Raster passes draw non-indexed triangle lists with no vertex buffers
 //! (vertex shaders fetch from storage buffers), counter-clockwise front
-//! faces. One pass may issue several draws over the same attachments with
+//! faces, with as many samples per pixel as their attachments have (the
+//! graph's `samples`). The vertex count is fixed or read from a buffer an
+//! earlier pass wrote (an indirect draw). One pass may issue several draws over the same attachments with
 //! different fragment entries and state (say, colour blended, then depth
 //! written with the same geometry). The CPU kernels implement the same state in
 //! software; each definition's `raster()` documents the pairing.
@@ -11,13 +13,24 @@
 /// A raster pass's draws and attachment load operations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RasterState {
-    /// Vertices per draw (3 per triangle).
+    /// Vertices per draw (3 per triangle); ignored when `indirect` is set.
     pub vertices: u64,
+    /// Where the vertex count lies when an earlier pass writes it.
+    pub indirect: Option<IndirectDraw>,
     pub cull: Cull,
     pub color_load: ColorLoad,
     pub depth_load: DepthLoad,
     /// In order; the first one's fragment entry is `Shader::fragment`.
     pub draws: Vec<Draw>,
+}
+
+/// An indirect draw's arguments: Vulkan's `VkDrawIndirectCommand` (vertex
+/// count, instance count, first vertex, first instance) at word `word` of
+/// the buffer bound as `binding`, which the pass reads as `indirect:`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IndirectDraw {
+    pub binding: &'static str,
+    pub word: usize,
 }
 
 /// Which faces the rasterizer drops (front faces are counter-clockwise).

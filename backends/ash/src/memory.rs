@@ -211,6 +211,7 @@ impl Creation<'_> {
         name: &str,
         f: ImageFormat,
         extent: [u32; 3],
+        samples: u32,
         usage: vk::ImageUsageFlags,
     ) -> Result<(Unbound, vk::MemoryRequirements), AshError> {
         let d = &self.gpu.device;
@@ -220,6 +221,7 @@ impl Creation<'_> {
             u &= !vk::ImageUsageFlags::STORAGE;
         }
         check_format(self.gpu, vf, u, name)?;
+        let samples = sample_count(self.gpu, vf, u, samples, name)?;
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(vf)
@@ -230,7 +232,7 @@ impl Creation<'_> {
             })
             .mip_levels(1)
             .array_layers(extent[2])
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(samples)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(u)
             .sharing_mode(self.sharing)
@@ -492,12 +494,14 @@ fn create_unbound(
         }
         let made = match &res.decl {
             ResourceDecl::Buffer { .. } => creation.buffer(&res.name, instance.sizes[r].bytes)?,
-            ResourceDecl::Image { format: f, .. } => {
+            ResourceDecl::Image {
+                format: f, samples, ..
+            } => {
                 let extent = instance.sizes[r]
                     .extent
                     .unwrap_or([1, 1, 1])
                     .map(|x| x.max(1));
-                creation.image(&res.name, *f, extent, usage[r])?
+                creation.image(&res.name, *f, extent, *samples, usage[r])?
             }
         };
         out.push(Some(made));
@@ -516,6 +520,41 @@ pub(crate) fn full_range(aspect: vk::ImageAspectFlags, layers: u32) -> vk::Image
 }
 
 /// Refuses an image whose format cannot be used as the passes use it.
+/// The sample count flag for `samples`, or an error naming the limit when
+/// the device cannot make `f` with that many (lavapipe has 1 and 4).
+fn sample_count(
+    gpu: &Gpu,
+    f: vk::Format,
+    usage: vk::ImageUsageFlags,
+    samples: u32,
+    name: &str,
+) -> Result<vk::SampleCountFlags, AshError> {
+    let flag = vk::SampleCountFlags::from_raw(samples);
+    if samples == 1 {
+        return Ok(flag);
+    }
+    // SAFETY: plain query.
+    let props = unsafe {
+        gpu.instance.get_physical_device_image_format_properties(
+            gpu.physical,
+            f,
+            vk::ImageType::TYPE_2D,
+            vk::ImageTiling::OPTIMAL,
+            usage,
+            vk::ImageCreateFlags::empty(),
+        )
+    };
+    match props {
+        Ok(p) if p.sample_counts.contains(flag) => Ok(flag),
+        _ => Err(AshError::MissingFeature {
+            device: gpu.name.clone(),
+            feature: format!("{samples} samples of {f:?} (VkImageFormatProperties::sampleCounts)"),
+            pass: format!("(image `{name}`)"),
+            why: format!("the graph declares `{name}` with {samples} samples"),
+        }),
+    }
+}
+
 fn check_format(
     gpu: &Gpu,
     f: vk::Format,

@@ -41,6 +41,8 @@ pub(crate) enum Work {
         depth: Option<usize>,
         state: RasterState,
         vertices: u32,
+        /// The draw's arguments (physical resource, byte offset) when indirect.
+        indirect: Option<(usize, u64)>,
         extent: [u32; 2],
     },
 }

@@ -26,6 +26,8 @@ struct Attachments {
     color_formats: Vec<vk::Format>,
     depth_format: Option<vk::Format>,
     extent: [u32; 2],
+    /// Every attachment's sample count, which the draws rasterize with.
+    samples: vk::SampleCountFlags,
 }
 
 fn attachments(cx: &Context<'_>, prep: &Prepared<'_>) -> Result<Attachments, AshError> {
@@ -60,7 +62,16 @@ fn attachments(cx: &Context<'_>, prep: &Prepared<'_>) -> Result<Attachments, Ash
             return Err(cx.pass_error(prep.p, "a raster pass without attachments".into()));
         }
     };
+    let mut counts = color.iter().chain(&depth).map(|&r| g.resources[r].decl.samples());
+    let samples = counts.next().unwrap_or(1);
+    if counts.any(|n| n != samples) {
+        return Err(cx.pass_error(
+            prep.p,
+            "its attachments have different sample counts".into(),
+        ));
+    }
     Ok(Attachments {
+        samples: vk::SampleCountFlags::from_raw(samples),
         color,
         depth,
         color_formats,
@@ -87,6 +98,16 @@ pub(crate) fn raster_work(
         .collect::<Result<Vec<_>, _>>()?;
     let vertices = u32::try_from(state.vertices)
         .map_err(|_| cx.pass_error(prep.p, format!("{} vertices are too many", state.vertices)))?;
+    let indirect = state
+        .indirect
+        .map(|i| {
+            prep.bindings
+                .iter()
+                .find(|(n, _, _)| n == i.binding)
+                .map(|(_, r, _)| (*r, i.word as u64 * 4))
+                .ok_or_else(|| cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding)))
+        })
+        .transpose()?;
     let bound = prep
         .bindings
         .iter()
@@ -100,6 +121,7 @@ pub(crate) fn raster_work(
         depth: at.depth,
         state: state.clone(),
         vertices,
+        indirect,
         extent: at.extent,
     };
     let set = SetPlan {
@@ -174,7 +196,7 @@ fn graphics_pipeline(
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
     let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-        .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        .rasterization_samples(at.samples);
     let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(at.depth.is_some())
         .depth_write_enable(at.depth.is_some() && draw.depth_write)

@@ -418,6 +418,7 @@ unsafe fn record_raster(
         pipelines,
         set,
         vertices,
+        indirect,
         extent,
         ..
     } = &built.work
@@ -473,8 +474,14 @@ unsafe fn record_raster(
                 &[*set],
                 &[],
             );
-            if *vertices > 0 {
-                d.cmd_draw(cmd, *vertices, 1, 0, 0);
+            match indirect {
+                Some((r, offset)) => {
+                    if let Some(Res::Buffer { buffer, .. }) = &memory.res[*r] {
+                        d.cmd_draw_indirect(cmd, buffer.raw(), *offset, 1, 16);
+                    }
+                }
+                None if *vertices > 0 => d.cmd_draw(cmd, *vertices, 1, 0, 0),
+                None => {}
             }
         }
         d.cmd_end_rendering(cmd);

@@ -51,6 +51,11 @@ pub(crate) fn create_memory(
                 let extent = size.extent.unwrap_or([1, 1, 1]);
                 let wformat = texture_format(*format);
                 let mut usage = usages[r];
+                let samples = res.decl.samples();
+                if samples > 1 {
+                    // Only draws touch a multisampled image (the graph checks it).
+                    usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+                }
                 if format.is_depth() {
                     // Uploads draw into depth images (crate::depth_upload).
                     usage -= wgpu::TextureUsages::STORAGE_BINDING;
@@ -64,7 +69,7 @@ pub(crate) fn create_memory(
                         depth_or_array_layers: extent[2].max(1),
                     },
                     mip_level_count: 1,
-                    sample_count: 1,
+                    sample_count: samples,
                     dimension: wgpu::TextureDimension::D2,
                     format: wformat,
                     usage,

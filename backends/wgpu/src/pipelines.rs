@@ -30,6 +30,8 @@ pub(crate) enum Built {
         depth: Option<wgpu::TextureView>,
         state: RasterState,
         vertices: u32,
+        /// The draw's arguments (physical resource, byte offset) when indirect.
+        indirect: Option<(usize, u64)>,
     },
 }
 
@@ -62,6 +64,7 @@ pub(crate) fn build(
 /// of pipeline binds its resources with.
 struct PassContext<'a> {
     device: &'a wgpu::Device,
+    plan: &'a Plan,
     instance: &'a Instance,
     prep: &'a Prepared<'a>,
     memory: &'a [Option<Memory>],
@@ -102,6 +105,7 @@ impl<'a> PassContext<'a> {
             .collect();
         Self {
             device,
+            plan,
             instance,
             prep,
             memory,

@@ -51,6 +51,7 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
                 depth,
                 state,
                 vertices,
+                indirect,
             } => {
                 let color_attachments: Vec<Option<wgpu::RenderPassColorAttachment<'_>>> = color
                     .iter()
@@ -93,7 +94,10 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
                     rp.set_pipeline(pipeline);
                     rp.set_bind_group(0, bind_group, &[]);
                     // No vertex buffers: the vertex shader fetches (shader headers).
-                    rp.draw(0..*vertices, 0..1);
+                    match indirect.and_then(|(r, offset)| Some((buffer_of(r)?, offset))) {
+                        Some((buffer, offset)) => rp.draw_indirect(buffer, offset),
+                        None => rp.draw(0..*vertices, 0..1),
+                    }
                 }
                 workgroups.push(*vertices);
             }

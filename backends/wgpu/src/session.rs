@@ -186,6 +186,33 @@ fn required_features(
                 )?;
             }
         }
+        for &(_, r) in &prep.bindings {
+            let ResourceDecl::Image {
+                format, samples, ..
+            } = plan.graph.resources[r].decl
+            else {
+                continue;
+            };
+            let format = crate::texture_format(format);
+            let guaranteed = format.guaranteed_format_features(wgpu::Features::empty());
+            if samples > 1 && !guaranteed.flags.sample_count_supported(samples) {
+                let why = format!("{samples} samples of {format:?} (`{}`)", plan.graph.resources[r].name);
+                need(
+                    wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,
+                    "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES",
+                    name,
+                    why.clone(),
+                )?;
+                if !adapter.get_texture_format_features(format).flags.sample_count_supported(samples) {
+                    return Err(WgpuError::MissingFeature {
+                        adapter: adapter_name.to_string(),
+                        feature: "a multisampled format",
+                        pass: name.to_string(),
+                        why,
+                    });
+                }
+            }
+        }
         if let Some(format) = read_only_storage_texture_needs(&prep.composed.module) {
             need(
                 wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,

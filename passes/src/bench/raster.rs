@@ -126,6 +126,7 @@ pub static RASTER: PassKind<RasterBenchParams, RasterBenchGpu> = PassKind {
 fn draw(p: &RasterBenchParams, q: &Quantities) -> RasterState {
     RasterState {
         vertices: 3 * p.triangles(q.width, q.height),
+        indirect: None,
         cull: Cull::None,
         color_load: ColorLoad::Clear([0.0; 4]),
         depth_load: DepthLoad::Load,

@@ -44,6 +44,7 @@ pub static DEPTH_ATTACHMENT: PassKind<NoParams, DepthAttachmentGpu> = PassKind {
 fn draw(_: &NoParams, _: &Quantities) -> RasterState {
     RasterState {
         vertices: 3,
+        indirect: None,
         cull: Cull::None,
         color_load: ColorLoad::Load,
         depth_load: DepthLoad::Clear(1.0),

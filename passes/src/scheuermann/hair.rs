@@ -281,6 +281,7 @@ pub(super) fn stage_state(stage: Stage, p: &HairParams, q: &Quantities) -> Raste
     };
     RasterState {
         vertices: if p.enabled { 3 * triangles(q) } else { 0 },
+        indirect: None,
         cull,
         color_load: ColorLoad::Load,
         depth_load: DepthLoad::Load,

@@ -10,28 +10,40 @@ struct Attachments {
     depth: Option<usize>,
     /// The bindings that are no attachment, bound from binding 1 on.
     bound: Vec<usize>,
+    /// The attachments' sample count (the graph's `samples`).
+    samples: u32,
 }
 
 impl Attachments {
-    fn of(prep: &Prepared<'_>) -> Self {
+    fn of(cx: &PassContext<'_>) -> Result<Self, WgpuError> {
+        let prep = cx.prep;
         let attachment = |usage: Usage| {
             prep.attachments
                 .iter()
                 .filter(move |(_, u)| *u == usage)
                 .map(|(b, _)| *b)
         };
-        Self {
+        let samples: Vec<u32> = prep
+            .attachments
+            .iter()
+            .map(|&(b, _)| cx.plan.graph.resources[prep.bindings[b].1].decl.samples())
+            .collect();
+        if samples.windows(2).any(|w| w[0] != w[1]) {
+            return Err(cx.error("its attachments have different sample counts".into()));
+        }
+        Ok(Self {
             color: attachment(Usage::Color).collect(),
             depth: attachment(Usage::Depth).next(),
             bound: (0..prep.bindings.len())
                 .filter(|b| !prep.attachments.iter().any(|(a, _)| a == b))
                 .collect(),
-        }
+            samples: samples.first().copied().unwrap_or(1),
+        })
     }
 }
 
 pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<Built, WgpuError> {
-    let at = Attachments::of(cx.prep);
+    let at = Attachments::of(cx)?;
     let params = cx.uniform(&cx.prep.params);
     let entries = cx.entries(&params, &at.bound)?;
     let mut draws = Vec::new();
@@ -52,6 +64,17 @@ pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<
         depth: at.depth.map(|b| attachment_view(cx, b)).transpose()?,
         state: state.clone(),
         vertices,
+        indirect: state
+            .indirect
+            .map(|i| {
+                cx.prep
+                    .bindings
+                    .iter()
+                    .find(|(n, _)| n == i.binding)
+                    .map(|(_, r)| (*r, i.word as u64 * 4))
+                    .ok_or_else(|| cx.error(format!("indirect `{}` is not bound", i.binding)))
+            })
+            .transpose()?,
     })
 }
 
@@ -94,7 +117,10 @@ fn render_pipeline(
                 ..Default::default()
             },
             depth_stencil,
-            multisample: Default::default(),
+            multisample: wgpu::MultisampleState {
+                count: at.samples,
+                ..Default::default()
+            },
             fragment: Some(wgpu::FragmentState {
                 module: &cx.module,
                 entry_point: Some(d.fragment),
