@@ -81,6 +81,7 @@ fn from_scene(c: SceneCounts) -> Quantities {
         vertices: c.vertices,
         segments: c.segments,
         bundles: c.bundles,
+        mesh_strands: c.mesh_strands,
         models: c.models,
         // Patches are built only when a graph draws them; estimated here
         // from the default PatchParams (a clump per 48 strands, 3 layers).
@@ -107,6 +108,7 @@ fn quantities(mut q: Quantities, pairs: &[String]) -> Result<Quantities> {
             "vertices" => q.vertices = v,
             "segments" => q.segments = v,
             "bundles" => q.bundles = v,
+            "mesh_strands" => q.mesh_strands = v,
             "models" => q.models = v,
             "patches" => q.patches = v,
             "triangles" => q.triangles = v,

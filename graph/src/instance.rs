@@ -14,6 +14,8 @@ pub struct Quantities {
     pub vertices: u64,
     pub segments: u64,
     pub bundles: u64,
+    /// Σ N over the hair meshes' bundles.
+    pub mesh_strands: u64,
     pub models: u64,
     pub patches: u64,
     pub triangles: u64,
@@ -34,6 +36,7 @@ impl Quantities {
             vertices: strands * points,
             segments: strands * (points - 1),
             bundles: 4_096,
+            mesh_strands: 130_000,
             models: 3,
             // One per 48 strands, three layers (PatchParams' defaults).
             patches: strands / 48 * 3,
@@ -51,6 +54,7 @@ impl Quantities {
             Quantity::Vertices => self.vertices,
             Quantity::Segments => self.segments,
             Quantity::Bundles => self.bundles,
+            Quantity::MeshStrands => self.mesh_strands,
             Quantity::Models => self.models,
             Quantity::Patches => self.patches,
             Quantity::Triangles => self.triangles,

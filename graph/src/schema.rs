@@ -114,6 +114,8 @@ pub enum Quantity {
     Segments,
     /// Hair-mesh bundles (Lipp §2).
     Bundles,
+    /// Strands the hair meshes generate: Σ N over bundles (Lipp §2).
+    MeshStrands,
     /// Hair models (grooms) in the scene.
     Models,
     /// Hair patches: textured ribbon strips built from the grooms
@@ -136,7 +138,11 @@ impl Quantity {
     pub fn may_be_empty(self) -> bool {
         matches!(
             self,
-            Quantity::Triangles | Quantity::Bundles | Quantity::Patches | Quantity::Lights
+            Quantity::Triangles
+                | Quantity::Bundles
+                | Quantity::MeshStrands
+                | Quantity::Patches
+                | Quantity::Lights
         )
     }
 }

@@ -64,6 +64,55 @@ pub struct Setup {
     inv_w: [f32; 3],
     /// Inclusive pixel bounds clipped to the screen: x0, y0, x1, y1.
     bounds: [u32; 4],
+    /// Made by [`Setup::from_clip_multisampled`].
+    multisampled: bool,
+}
+
+/// Which pixels a setup visits.
+#[derive(Clone, Copy)]
+enum Bounds {
+    /// Those whose centre lies in the bounding box.
+    Centres,
+    /// Every pixel the bounding box touches (multisampling).
+    Touched,
+}
+
+/// One pixel with at least one covered sample (multisampled rasterization).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampledFragment {
+    pub x: u32,
+    pub y: u32,
+    /// Bit s: sample s is covered (Vulkan's `SampleMask` input).
+    pub mask: u32,
+    /// NDC depth at each covered sample (what the depth test compares).
+    pub sample_depth: [f32; 8],
+    /// Depth and screen-space barycentrics at the pixel centre, where a
+    /// fragment shader without sample shading evaluates its inputs
+    /// (extrapolated when the centre lies outside the triangle).
+    pub depth: f32,
+    pub screen: [f32; 3],
+}
+
+/// A standard sample pattern in sub-pixel units (1/256 pixel) from the pixel
+/// centre: Vulkan's standard locations (the same as Direct3D's) for 1, 2,
+/// 4 and 8 samples, on their 1/16-pixel grid.
+pub fn standard_samples(n: u32) -> Vec<[i64; 2]> {
+    let grid: &[[i64; 2]] = match n {
+        2 => &[[4, 4], [-4, -4]],
+        4 => &[[-2, -6], [6, -2], [-6, 2], [2, 6]],
+        8 => &[
+            [1, -3],
+            [-1, 3],
+            [5, 1],
+            [-3, -5],
+            [-5, 5],
+            [-7, -1],
+            [3, 7],
+            [7, -7],
+        ],
+        _ => &[[0, 0]],
+    };
+    grid.iter().map(|g| [g[0] * ONE / 16, g[1] * ONE / 16]).collect()
 }
 
 impl Setup {
@@ -85,6 +134,45 @@ impl Setup {
         height: u32,
         cull: Cull,
     ) -> Option<Self> {
+        Self::from_clip_culled_bounds(clip, near, width, height, cull, Bounds::Centres)
+    }
+
+    /// Sets up a triangle from screen positions (pixels, y down), per-corner
+    /// depth and 1/w. Culls back faces and degenerate triangles.
+    pub fn from_screen(
+        xy: [[f32; 2]; 3],
+        z: [f32; 3],
+        inv_w: [f32; 3],
+        width: u32,
+        height: u32,
+    ) -> Option<Self> {
+        Self::from_screen_culled(xy, z, inv_w, width, height, Cull::Back)
+    }
+
+    /// [`Setup::from_clip_culled`] for a multisampled attachment: the
+    /// bounds are every pixel the snapped bounding box touches, since a
+    /// triangle may cover samples of pixels whose centre it misses (a thin
+    /// strand quad often does). Rasterize it with [`Setup::rasterize_samples`].
+    pub fn from_clip_multisampled(
+        clip: [Vec4; 3],
+        near: f32,
+        width: u32,
+        height: u32,
+        cull: Cull,
+    ) -> Option<Self> {
+        let mut s = Self::from_clip_culled_bounds(clip, near, width, height, cull, Bounds::Touched)?;
+        s.multisampled = true;
+        Some(s)
+    }
+
+    fn from_clip_culled_bounds(
+        clip: [Vec4; 3],
+        near: f32,
+        width: u32,
+        height: u32,
+        cull: Cull,
+        bounds: Bounds,
+    ) -> Option<Self> {
         let near = near.max(0.0);
         let mut xy = [[0.0f32; 2]; 3];
         let mut z = [0.0f32; 3];
@@ -103,19 +191,7 @@ impl Setup {
             z[k] = c.z * iw;
             inv_w[k] = iw;
         }
-        Self::from_screen_culled(xy, z, inv_w, width, height, cull)
-    }
-
-    /// Sets up a triangle from screen positions (pixels, y down), per-corner
-    /// depth and 1/w. Culls back faces and degenerate triangles.
-    pub fn from_screen(
-        xy: [[f32; 2]; 3],
-        z: [f32; 3],
-        inv_w: [f32; 3],
-        width: u32,
-        height: u32,
-    ) -> Option<Self> {
-        Self::from_screen_culled(xy, z, inv_w, width, height, Cull::Back)
+        Self::build(xy, z, inv_w, width, height, cull, bounds)
     }
 
     /// [`Setup::from_screen`] dropping the faces `cull` names (and
@@ -127,6 +203,18 @@ impl Setup {
         width: u32,
         height: u32,
         cull: Cull,
+    ) -> Option<Self> {
+        Self::build(xy, z, inv_w, width, height, cull, Bounds::Centres)
+    }
+
+    fn build(
+        xy: [[f32; 2]; 3],
+        z: [f32; 3],
+        inv_w: [f32; 3],
+        width: u32,
+        height: u32,
+        cull: Cull,
+        bounds: Bounds,
     ) -> Option<Self> {
         let mut sx = [0i64; 3];
         let mut sy = [0i64; 3];
@@ -166,9 +254,15 @@ impl Setup {
             let top_left = dy < 0 || (dy == 0 && dx > 0);
             i64::from(!top_left)
         });
-        // Pixels whose centre (p + 0.5) lies within the snapped bounding box.
-        let lo = |v: i64| (v - HALF + ONE - 1).div_euclid(ONE);
-        let hi = |v: i64| (v - HALF).div_euclid(ONE);
+        // Pixels whose centre (p + 0.5) lies within the snapped bounding box,
+        // or for samples anywhere in the pixel, every pixel the box touches.
+        let (lo, hi): (fn(i64) -> i64, fn(i64) -> i64) = match bounds {
+            Bounds::Centres => (
+                |v| (v - HALF + ONE - 1).div_euclid(ONE),
+                |v| (v - HALF).div_euclid(ONE),
+            ),
+            Bounds::Touched => (|v| v.div_euclid(ONE), |v| v.div_euclid(ONE)),
+        };
         let (x0, x1) = (lo(*x.iter().min()?).max(0), hi(*x.iter().max()?));
         let (y0, y1) = (lo(*y.iter().min()?).max(0), hi(*y.iter().max()?));
         let (x1, y1) = (x1.min(i64::from(width) - 1), y1.min(i64::from(height) - 1));
@@ -184,6 +278,7 @@ impl Setup {
             z,
             inv_w,
             bounds: [x0 as u32, y0 as u32, x1 as u32, y1 as u32],
+            multisampled: false,
         })
     }
 
@@ -221,17 +316,11 @@ impl Setup {
             let mut e = row;
             for x in x0..=x1 {
                 if e.iter().zip(&self.bias).all(|(ei, b)| ei >= b) {
-                    let mut screen = [0.0f32; 3];
-                    let mut depth = 0.0f64;
-                    for (&ei, &src) in e.iter().zip(&self.order) {
-                        let w = ei as f64 / area;
-                        screen[src] = w as f32;
-                        depth += w * f64::from(self.z[src]);
-                    }
+                    let (depth, screen) = self.depth_at(e, area);
                     f(Fragment {
                         x,
                         y,
-                        depth: depth as f32,
+                        depth,
                         screen,
                     });
                 }
@@ -243,6 +332,59 @@ impl Setup {
                 *r += s;
             }
         }
+    }
+
+    /// Multisampled rasterization of rows `first..=last`: calls `f` for every
+    /// pixel with a covered sample of `samples` ([`standard_samples`]; at
+    /// most 8), with the same fill rules per sample as [`Setup::rasterize`]
+    /// applies per centre. Needs a setup from [`Setup::from_clip_multisampled`].
+    pub fn rasterize_samples(
+        &self,
+        first: u32,
+        last: u32,
+        samples: &[[i64; 2]],
+        mut f: impl FnMut(SampledFragment),
+    ) {
+        debug_assert!(self.multisampled && samples.len() <= 8);
+        let [x0, y0, x1, y1] = self.bounds;
+        let area = self.area as f64;
+        let weights = |px: i64, py: i64| [0, 1, 2].map(|i| self.edge(i, px, py));
+        for y in y0.max(first)..=y1.min(last) {
+            for x in x0..=x1 {
+                let (cx, cy) = (i64::from(x) * ONE + HALF, i64::from(y) * ONE + HALF);
+                let mut frag = SampledFragment {
+                    x,
+                    y,
+                    mask: 0,
+                    sample_depth: [0.0; 8],
+                    depth: 0.0,
+                    screen: [0.0; 3],
+                };
+                for (s, o) in samples.iter().enumerate() {
+                    let e = weights(cx + o[0], cy + o[1]);
+                    if e.iter().zip(&self.bias).all(|(ei, b)| ei >= b) {
+                        frag.mask |= 1 << s;
+                        frag.sample_depth[s] = self.depth_at(e, area).0;
+                    }
+                }
+                if frag.mask != 0 {
+                    (frag.depth, frag.screen) = self.depth_at(weights(cx, cy), area);
+                    f(frag);
+                }
+            }
+        }
+    }
+
+    /// Depth and source-order barycentrics from edge functions.
+    fn depth_at(&self, e: [i64; 3], area: f64) -> (f32, [f32; 3]) {
+        let mut screen = [0.0f32; 3];
+        let mut depth = 0.0f64;
+        for (&ei, &src) in e.iter().zip(&self.order) {
+            let w = ei as f64 / area;
+            screen[src] = w as f32;
+            depth += w * f64::from(self.z[src]);
+        }
+        (depth as f32, screen)
     }
 
     /// Perspective-correct barycentrics of the source corners from screen-space
@@ -313,6 +455,54 @@ mod tests {
             .unwrap()
             .rasterize_rows(3, 4, |f| rows.push(f.y));
         assert!(!rows.is_empty() && rows.iter().all(|&y| (3..=4).contains(&y)));
+    }
+
+    /// Samples covered by a screen-space triangle at `n` samples, per pixel.
+    fn samples(tri: [[f32; 2]; 3], n: u32, w: u32) -> Vec<(u32, u32, u32)> {
+        let clip = tri.map(|[x, y]| {
+            Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / w as f32 * 2.0, 0.5, 1.0)
+        });
+        let mut out = Vec::new();
+        if let Some(s) = Setup::from_clip_multisampled(clip, 0.0, w, w, Cull::None) {
+            s.rasterize_samples(0, u32::MAX, &standard_samples(n), |f| {
+                out.push((f.x, f.y, f.mask))
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn one_sample_at_the_centre_is_the_single_sampled_rasterizer() {
+        let tri = [[1.3f32, 0.7], [13.9, 4.1], [5.2, 14.6]];
+        let single = cover(tri, 16, 16);
+        let multi = samples(tri, 1, 16);
+        assert_eq!(multi.len(), single.len());
+        assert!(multi.iter().all(|&(x, y, m)| m == 1 && single.contains(&(x, y))));
+    }
+
+    #[test]
+    fn sample_coverage_tracks_area_and_reaches_pixels_whose_centre_is_missed() {
+        // A 0.4-pixel-wide horizontal sliver between two rows of centres.
+        let sliver = [[0.0f32, 3.55], [16.0, 3.55], [0.0, 3.95]];
+        assert!(samples(sliver, 1, 16).is_empty());
+        for n in [4, 8] {
+            let hits: u32 = samples(sliver, n, 16)
+                .iter()
+                .map(|&(_, y, m)| {
+                    assert_eq!(y, 3);
+                    m.count_ones()
+                })
+                .sum();
+            assert!(hits > 0, "{n} samples: the sliver covers none");
+        }
+        // A large triangle: covered samples / n ≈ its area in pixels.
+        let tri = [[0.5f32, 0.5], [30.5, 2.5], [8.5, 29.5]];
+        let area = 0.5 * ((30.0f32 * 29.0) - (2.0 * 8.0));
+        for n in [2, 4, 8] {
+            let covered: u32 = samples(tri, n, 32).iter().map(|s| s.2.count_ones()).sum();
+            let est = covered as f32 / n as f32;
+            assert!((est - area).abs() < 0.03 * area, "{n}: {est} vs {area}");
+        }
     }
 
     #[test]

@@ -71,15 +71,13 @@ pub fn upload(scene: &Scene, width: u32, height: u32) -> Upload {
     let hair = pack_grooms(scene, &triangle_first);
     let lights: Vec<LightData> = scene.desc.lights.iter().map(light_data).collect();
     let frame = frame(scene, width, height, hair.models.len() as u32);
+    let counts = scene.counts();
     up.quantities = Quantities {
         strands: hair.strands.len() as u64,
         vertices: hair.vertices.len() as u64,
         segments: hair.segments,
-        bundles: scene
-            .grooms
-            .iter()
-            .map(|g| g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64))
-            .sum(),
+        bundles: counts.bundles,
+        mesh_strands: counts.mesh_strands,
         models: hair.models.len() as u64,
         // Built only for graphs that draw them (scheuermann::upload::pack).
         patches: 0,

@@ -74,6 +74,8 @@ pub struct SceneCounts {
     pub vertices: u64,
     pub segments: u64,
     pub bundles: u64,
+    /// Strands the hair meshes generate (Σ N over bundles).
+    pub mesh_strands: u64,
     /// Hair models (grooms).
     pub models: u64,
     pub meshes: u64,
@@ -209,6 +211,9 @@ impl Scene {
             c.vertices += g.groom.point_count() as u64;
             c.segments += g.groom.segment_count() as u64;
             c.bundles += g.hair_mesh.as_ref().map_or(0, |h| h.bundle_count() as u64);
+            c.mesh_strands += g.hair_mesh.as_ref().map_or(0, |h| {
+                h.bundles.iter().map(|b| u64::from(b.strands)).sum::<u64>()
+            });
         }
         c.triangles = self
             .meshes

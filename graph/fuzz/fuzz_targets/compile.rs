@@ -32,6 +32,7 @@ fuzz_target!(|data: &[u8]| {
         vertices: scale(2),
         segments: scale(3),
         bundles: scale(4),
+        mesh_strands: scale(5),
         models: u64::from(models),
         patches: scale(4),
         triangles: scale(5),

@@ -333,26 +333,13 @@ impl Target<'_> {
     }
 }
 
-/// Direct3D's standard sample positions for 2, 4 and 8 samples, in pixels
-/// from the pixel centre (1/16-pixel grid).
+/// Direct3D's standard sample positions for 2, 4 and 8 samples (Vulkan's
+/// standard locations), in pixels from the pixel centre (1/16-pixel grid).
 pub fn sample_positions(n: u32) -> Vec<[f32; 2]> {
-    let grid: &[[i32; 2]] = match n {
-        2 => &[[4, 4], [-4, -4]],
-        4 => &[[-2, -6], [6, -2], [-6, 2], [2, 6]],
-        8 => &[
-            [1, -3],
-            [-1, 3],
-            [5, 1],
-            [-3, -5],
-            [-5, 5],
-            [-7, -1],
-            [3, 7],
-            [7, -7],
-        ],
-        _ => &[[0, 0]],
-    };
-    grid.iter()
-        .map(|g| [g[0] as f32 / 16.0, g[1] as f32 / 16.0])
+    let unit = (1 << crate::hardware_raster::SUBPIXEL_BITS) as f32;
+    crate::hardware_raster::standard_samples(n)
+        .iter()
+        .map(|o| [o[0] as f32 / unit, o[1] as f32 / unit])
         .collect()
 }
 
