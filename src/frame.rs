@@ -181,18 +181,25 @@ fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Re
         .trim()
         .parse()
         .map_err(|_| miette::miette!("--param {spec}: samples must be 1, 2, 4 or 8"))?;
-    let r = plan.graph.resource_id(image).expect("checked by the caller");
+    let r = plan
+        .graph
+        .resource_id(image)
+        .expect("checked by the caller");
     let g = &mut plan.graph;
     let ResourceDecl::Image { samples, .. } = &mut g.resources[r].decl else {
-        return Err(miette::miette!("--param {spec}: `{image}` is a buffer, not an image"));
+        return Err(miette::miette!(
+            "--param {spec}: `{image}` is a buffer, not an image"
+        ));
     };
     *samples = n;
     if let Some(why) = strandgraph_graph::resolve::samples_problem(&g.resources[r].decl) {
         return Err(miette::miette!("--param {spec}: image `{image}` {why}"));
     }
-    let attachment_only = g.passes.iter().flat_map(|p| &p.accesses).all(|a| {
-        g.physical(a.resource) != r || matches!(a.usage, Usage::Color | Usage::Depth)
-    });
+    let attachment_only = g
+        .passes
+        .iter()
+        .flat_map(|p| &p.accesses)
+        .all(|a| g.physical(a.resource) != r || matches!(a.usage, Usage::Color | Usage::Depth));
     if n > 1 && !attachment_only {
         return Err(miette::miette!(
             "--param {spec}: a pass uses `{image}` as more than an attachment, so it cannot be multisampled"

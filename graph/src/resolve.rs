@@ -538,7 +538,10 @@ fn unknown_resource(
 
 /// Why an image's sample count is not one an attachment can have.
 pub fn samples_problem(decl: &ResourceDecl) -> Option<String> {
-    let ResourceDecl::Image { samples, layers, .. } = decl else {
+    let ResourceDecl::Image {
+        samples, layers, ..
+    } = decl
+    else {
         return None;
     };
     if ![1, 2, 4, 8].contains(samples) {

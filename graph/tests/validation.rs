@@ -376,7 +376,11 @@ fn a_multisampled_image_is_only_an_attachment() {
     ],
     outputs: ["out"],
 )"#;
-    expect_error(src, ErrorKind::BadAccess, &["sampled:depth", "multisampled"]);
+    expect_error(
+        src,
+        ErrorKind::BadAccess,
+        &["sampled:depth", "multisampled"],
+    );
 }
 
 #[test]

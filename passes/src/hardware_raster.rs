@@ -112,7 +112,9 @@ pub fn standard_samples(n: u32) -> Vec<[i64; 2]> {
         ],
         _ => &[[0, 0]],
     };
-    grid.iter().map(|g| [g[0] * ONE / 16, g[1] * ONE / 16]).collect()
+    grid.iter()
+        .map(|g| [g[0] * ONE / 16, g[1] * ONE / 16])
+        .collect()
 }
 
 impl Setup {
@@ -160,7 +162,8 @@ impl Setup {
         height: u32,
         cull: Cull,
     ) -> Option<Self> {
-        let mut s = Self::from_clip_culled_bounds(clip, near, width, height, cull, Bounds::Touched)?;
+        let mut s =
+            Self::from_clip_culled_bounds(clip, near, width, height, cull, Bounds::Touched)?;
         s.multisampled = true;
         Some(s)
     }
@@ -459,9 +462,8 @@ mod tests {
 
     /// Samples covered by a screen-space triangle at `n` samples, per pixel.
     fn samples(tri: [[f32; 2]; 3], n: u32, w: u32) -> Vec<(u32, u32, u32)> {
-        let clip = tri.map(|[x, y]| {
-            Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / w as f32 * 2.0, 0.5, 1.0)
-        });
+        let clip = tri
+            .map(|[x, y]| Vec4::new(x / w as f32 * 2.0 - 1.0, 1.0 - y / w as f32 * 2.0, 0.5, 1.0));
         let mut out = Vec::new();
         if let Some(s) = Setup::from_clip_multisampled(clip, 0.0, w, w, Cull::None) {
             s.rasterize_samples(0, u32::MAX, &standard_samples(n), |f| {
@@ -477,7 +479,11 @@ mod tests {
         let single = cover(tri, 16, 16);
         let multi = samples(tri, 1, 16);
         assert_eq!(multi.len(), single.len());
-        assert!(multi.iter().all(|&(x, y, m)| m == 1 && single.contains(&(x, y))));
+        assert!(
+            multi
+                .iter()
+                .all(|&(x, y, m)| m == 1 && single.contains(&(x, y)))
+        );
     }
 
     #[test]

@@ -21,6 +21,7 @@ pub mod describe;
 #[cfg(test)]
 mod fill_rule_checks;
 pub mod hardware_raster;
+pub mod hw_strands;
 pub mod kernel;
 pub mod kulikov;
 pub mod layout;
@@ -80,6 +81,9 @@ pub static PASSES: &[&dyn PassDef] = &[
     &scheuermann::hair::OPAQUE,
     &scheuermann::hair::BACK_FACES,
     &scheuermann::hair::FRONT_FACES,
+    // Hardware-rasterized strands: Lipp's Table 1 baseline.
+    &hw_strands::assemble::ASSEMBLE,
+    &hw_strands::raster::RASTER,
     // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,

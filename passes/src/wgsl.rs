@@ -26,7 +26,8 @@ use std::path::{Path, PathBuf};
 /// allows only `atomicMin`/`atomicMax` on storage `atomic<u64>` whose
 /// result is unused; anything else needs `SHADER_INT64_ATOMIC_ALL_OPS`
 /// (docs/architecture.md, "Shaders").
-pub const CAPABILITIES: [Capabilities; 6] = [
+pub const CAPABILITIES: [Capabilities; 7] = [
+    Capabilities::EARLY_DEPTH_TEST,
     Capabilities::SUBGROUP,
     Capabilities::SUBGROUP_BARRIER,
     Capabilities::FLOAT64,

@@ -32,6 +32,8 @@ pub(crate) struct Needs {
     pub caps: Vec<(Capabilities, String, String)>,
     /// A raster pass (dynamic rendering).
     pub raster: Option<String>,
+    /// A raster pass that writes storage (its fragment shader's atomics).
+    pub fragment_stores: Option<String>,
 }
 
 pub(crate) struct Gpu {

@@ -111,6 +111,17 @@ impl Wanted {
             want.dynamic_rendering = true;
             want.names.push("dynamicRendering".into());
         }
+        if let Some(pass) = &needs.fragment_stores {
+            if have.core.fragment_stores_and_atomics == vk::FALSE {
+                return Err(missing(
+                    "fragmentStoresAndAtomics",
+                    pass,
+                    "its fragment shader writes storage buffers",
+                ));
+            }
+            want.core.fragment_stores_and_atomics = vk::TRUE;
+            want.names.push("fragmentStoresAndAtomics".into());
+        }
         let mut seen = Capabilities::empty();
         for (cap, pass, why) in &needs.caps {
             if !seen.contains(*cap) {
@@ -130,6 +141,8 @@ impl Wanted {
     fn enable(&mut self, cap: Capabilities, have: &Supported) -> Result<(), String> {
         use naga::back::spv::Capability as C;
         match cap {
+            // SPIR-V's EarlyFragmentTests execution mode is core Vulkan.
+            Capabilities::EARLY_DEPTH_TEST => {}
             Capabilities::FLOAT64 => {
                 if have.core.shader_float64 == vk::FALSE {
                     return Err("shaderFloat64".into());

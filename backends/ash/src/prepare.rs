@@ -4,7 +4,7 @@
 use crate::device::Needs;
 use crate::error::AshError;
 use strandgraph_graph::resolve::PassId;
-use strandgraph_graph::schema::Usage;
+use strandgraph_graph::schema::{AccessMode, Usage};
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::wgsl::{CAPABILITIES, Composed, Shaders};
 use strandgraph_passes::{Definitions, PassDef, RasterState};
@@ -86,6 +86,13 @@ pub(crate) fn prepare<'d>(
         };
         if prep.is_raster() && needs.raster.is_none() {
             needs.raster = Some(pass.name.clone());
+        }
+        let stores = pass
+            .accesses
+            .iter()
+            .any(|a| a.usage == Usage::Storage && a.mode != AccessMode::Read);
+        if prep.is_raster() && stores && needs.fragment_stores.is_none() {
+            needs.fragment_stores = Some(pass.name.clone());
         }
         out.push(prep);
     }

@@ -62,7 +62,10 @@ fn attachments(cx: &Context<'_>, prep: &Prepared<'_>) -> Result<Attachments, Ash
             return Err(cx.pass_error(prep.p, "a raster pass without attachments".into()));
         }
     };
-    let mut counts = color.iter().chain(&depth).map(|&r| g.resources[r].decl.samples());
+    let mut counts = color
+        .iter()
+        .chain(&depth)
+        .map(|&r| g.resources[r].decl.samples());
     let samples = counts.next().unwrap_or(1);
     if counts.any(|n| n != samples) {
         return Err(cx.pass_error(
@@ -105,7 +108,9 @@ pub(crate) fn raster_work(
                 .iter()
                 .find(|(n, _, _)| n == i.binding)
                 .map(|(_, r, _)| (*r, i.word as u64 * 4))
-                .ok_or_else(|| cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding)))
+                .ok_or_else(|| {
+                    cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding))
+                })
         })
         .transpose()?;
     let bound = prep
@@ -195,8 +200,8 @@ fn graphics_pipeline(
         })
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
-    let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-        .rasterization_samples(at.samples);
+    let multisample =
+        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(at.samples);
     let depth_state = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(at.depth.is_some())
         .depth_write_enable(at.depth.is_some() && draw.depth_write)

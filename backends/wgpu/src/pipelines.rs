@@ -153,7 +153,18 @@ impl<'a> PassContext<'a> {
 
     fn entry(&self, binding: u32, b: usize) -> Result<wgpu::BindGroupEntry<'_>, WgpuError> {
         let resource = match (&self.memory[self.prep.bindings[b].1], &self.views[b]) {
-            (Some(Memory::Buffer(buf, _)), _) => buf.as_entire_binding(),
+            (Some(Memory::Buffer(buf, _)), _) => {
+                let limit = self.device.limits().max_storage_buffer_binding_size;
+                if buf.size() > limit {
+                    return Err(self.error(format!(
+                        "`{}` is {} MiB, more than this adapter binds at once ({} MiB, max_storage_buffer_binding_size): render a smaller scene or use a device with a larger limit",
+                        self.prep.bindings[b].0,
+                        buf.size() >> 20,
+                        limit >> 20
+                    )));
+                }
+                buf.as_entire_binding()
+            }
             (Some(Memory::Texture { .. }), Some(view)) => wgpu::BindingResource::TextureView(view),
             _ => {
                 return Err(self.error(format!("`{}` has no memory", self.prep.bindings[b].0)));

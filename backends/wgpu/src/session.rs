@@ -196,14 +196,21 @@ fn required_features(
             let format = crate::texture_format(format);
             let guaranteed = format.guaranteed_format_features(wgpu::Features::empty());
             if samples > 1 && !guaranteed.flags.sample_count_supported(samples) {
-                let why = format!("{samples} samples of {format:?} (`{}`)", plan.graph.resources[r].name);
+                let why = format!(
+                    "{samples} samples of {format:?} (`{}`)",
+                    plan.graph.resources[r].name
+                );
                 need(
                     wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES,
                     "TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES",
                     name,
                     why.clone(),
                 )?;
-                if !adapter.get_texture_format_features(format).flags.sample_count_supported(samples) {
+                if !adapter
+                    .get_texture_format_features(format)
+                    .flags
+                    .sample_count_supported(samples)
+                {
                     return Err(WgpuError::MissingFeature {
                         adapter: adapter_name.to_string(),
                         feature: "a multisampled format",

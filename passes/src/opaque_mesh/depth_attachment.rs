@@ -65,9 +65,15 @@ impl CpuKernel for CopyKernel {
         let q = ctx.quantities;
         let pixels = q.width as usize * q.height as usize;
         let (from, to) = (ctx.words("scene.depth"), ctx.words("depth_buffer"));
+        // A multisampled attachment: `samples` words per pixel, each the
+        // texel's depth (frag_depth is written to every covered sample).
+        let samples = (to.len() / pixels.max(1)).max(1);
         let first = group as usize * PIXEL_GROUP as usize;
         for i in first..(first + PIXEL_GROUP as usize).min(pixels) {
-            to.store(i, from.load(i));
+            let d = from.load(i);
+            for s in 0..samples {
+                to.store(i * samples + s, d);
+            }
         }
     }
 }

@@ -1,0 +1,291 @@
+//! `hw_strands.raster`: the segment records of [`super::assemble`] drawn by
+//! the hardware rasterizer (`shaders/hw_strands/raster.wgsl`), one
+//! camera-facing quad per segment ([`quad_corner`]), six vertices pulled
+//! from storage per segment, an indirect draw whose count the assembly
+//! wrote.
+//!
+//! The draw rasterizes at the depth attachment's sample count (the graph's
+//! `strand_depth.samples`: MSAA 1, 4, 8) with early depth tests (`Less`,
+//! writes on) against the head (`scene.depth_attachment`) and the strands
+//! drawn before. The fragment shader runs once per pixel; it tests the
+//! pixel-centre depth as `lipp.raster` tests a sample (against
+//! `scene.depth`, and after the first groom `hair_depth`) and writes the
+//! payload into the G-buffer layer of every sample the quad covers, with
+//! 64-bit `atomicMin`: Lipp's MSAA reference layout, which `lipp.shade`
+//! and `lipp.filter` (its `msaa` set to the same count) resolve.
+//!
+//! Without post-depth coverage the shader's mask is the rasterizer's
+//! coverage, so a fragment that passes the depth test at one sample also
+//! writes samples where a nearer strand already is; the `atomicMin` keeps
+//! the nearer payload wherever the two compare as their pixel-centre
+//! depths do. The CPU kernel emulates exactly this ([`Band::fragment`]):
+//! per-sample depth from [`crate::hardware_raster`] at the standard sample
+//! locations, triangles in draw order.
+
+use super::{CORNERS, SEGMENT_WORDS, Segment, VERTICES_PER_SEGMENT, quad_corner};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
+use crate::describe::PassKind;
+use crate::hardware_raster::{SampledFragment, Setup, standard_samples};
+use crate::kernel::{CounterValues, Ctx, Words};
+use crate::layout::{FrameData, read};
+use crate::params::{Invalid, PassParams};
+use crate::raster_state::{
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, IndirectDraw, RasterState,
+};
+use glam::{Vec2, Vec4};
+use std::sync::RwLock;
+use strandgraph_graph::Quantities;
+
+/// Bands of rows the CPU kernel rasterizes in parallel.
+const BANDS: u32 = 64;
+
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RasterParams {
+    /// Quad width in pixels: `lipp.raster`'s `centre_diameter`, the width
+    /// its MSAA reference mode draws strands at.
+    pub width: f32,
+    /// The groom drawn, in the graph's per-model block; grooms after the
+    /// first also test `hair_depth` (Lipp §3.5).
+    pub model_index: u32,
+}
+
+impl Default for RasterParams {
+    fn default() -> Self {
+        Self {
+            width: 0.5,
+            model_index: 0,
+        }
+    }
+}
+
+impl PassParams for RasterParams {
+    const READS_MODEL_INDEX: bool = true;
+
+    fn validate(&self) -> Result<(), Invalid> {
+        if !(self.width > 0.0 && self.width <= 4.0) {
+            return Err(Invalid::new("width", "expected a width in (0, 4] pixels"));
+        }
+        Ok(())
+    }
+}
+
+crate::gpu_block! {
+    /// `RasterParams` in shaders/hw_strands/raster.wgsl.
+    pub struct RasterGpu {
+        width_px: f32,
+        width: u32,
+        height: u32,
+        model_index: u32,
+        capacity: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
+    }
+}
+
+pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
+    kind: "hw_strands.raster",
+    summary: "segments drawn by the hardware rasterizer as camera-facing quads at the attachment's MSAA, each covered sample into its G-buffer layer",
+    source: "Lipp Table 1's hardware baseline (Bhokare et al. 2024), into Lipp §3.3's MSAA G-buffer layout",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("hw_segments"),
+        Binding::read("hw_draw_args"),
+        Binding::read("scene.depth"),
+        Binding::read("hair_depth"),
+        Binding::atomic("gbuffer"),
+        Binding::write("strand_depth"),
+    ]),
+    workgroup_size: 1,
+    dispatch: Dispatch::Fixed(BANDS),
+    shader: Shader {
+        file: "hw_strands/raster.wgsl",
+        entry: "vs_main",
+        fragment: Some("fs_main"),
+    },
+    kernel: |p| Box::new(RasterKernel::new(*p)),
+    gpu: |p, q| RasterGpu {
+        width_px: p.width,
+        width: q.width,
+        height: q.height,
+        model_index: p.model_index,
+        capacity: crate::contract::count(super::assemble::capacity(q.mesh_strands)),
+        ..RasterGpu::default()
+    },
+    raster: Some(draw),
+};
+
+/// An indirect draw of the assembled segments, early depth tests, no colour.
+fn draw(_: &RasterParams, _: &Quantities) -> RasterState {
+    RasterState {
+        vertices: 0,
+        indirect: Some(IndirectDraw {
+            binding: "hw_draw_args",
+            word: 0,
+        }),
+        cull: Cull::None,
+        color_load: ColorLoad::Load,
+        depth_load: DepthLoad::Load,
+        draws: vec![Draw {
+            fragment: "fs_main",
+            blend: Blend::Replace,
+            color_writes: false,
+            depth_compare: Compare::Less,
+            depth_write: true,
+        }],
+    }
+}
+
+/// A triangle of a segment's quad, set up, with its corners' `t`.
+struct Triangle {
+    setup: Setup,
+    t: [f32; 3],
+    segment: Segment,
+}
+
+struct RasterKernel {
+    p: RasterParams,
+    /// The vertex stage and setup of every triangle, in draw order (the
+    /// prologue's work, redone every frame).
+    triangles: RwLock<Vec<Triangle>>,
+}
+
+impl RasterKernel {
+    fn new(p: RasterParams) -> Self {
+        Self {
+            p,
+            triangles: RwLock::new(Vec::new()),
+        }
+    }
+}
+
+/// The vertex shader and primitive setup of segment `s`'s two triangles.
+fn triangles(s: &Segment, f: &FrameData, half: f32, w: u32, h: u32) -> Vec<Triangle> {
+    if s.a.w <= f.near || s.b.w <= f.near {
+        return Vec::new();
+    }
+    let size = Vec2::new(w as f32, h as f32);
+    let corner = |k: u32| quad_corner(s.a, s.b, k, half, size);
+    CORNERS
+        .chunks(3)
+        .filter_map(|tri| {
+            let clip: [Vec4; 3] = [corner(tri[0]), corner(tri[1]), corner(tri[2])];
+            let setup = Setup::from_clip_multisampled(clip, f.near, w, h, Cull::None)?;
+            Some(Triangle {
+                setup,
+                t: [0, 1, 2].map(|k| (tri[k] & 1) as f32),
+                segment: *s,
+            })
+        })
+        .collect()
+}
+
+impl CpuKernel for RasterKernel {
+    fn prologue(&self, ctx: &Ctx<'_>) {
+        use rayon::prelude::*;
+        let f: FrameData = read(&ctx.words("frame"), 0);
+        let (records, args) = (ctx.words("hw_segments"), ctx.words("hw_draw_args"));
+        let count = (args.load(0) / VERTICES_PER_SEGMENT) as usize;
+        let count = count.min(records.len() / SEGMENT_WORDS);
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let half = 0.5 * self.p.width;
+        let list: Vec<Triangle> = (0..count)
+            .into_par_iter()
+            .flat_map_iter(|i| {
+                let words: Vec<u32> = (0..SEGMENT_WORDS)
+                    .map(|k| records.load(i * SEGMENT_WORDS + k))
+                    .collect();
+                triangles(&Segment::from_words(&words), &f, half, w, h)
+            })
+            .collect();
+        *self.triangles.write().unwrap_or_else(|e| e.into_inner()) = list;
+    }
+
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let list = self.triangles.read().unwrap_or_else(|e| e.into_inner());
+        let h = ctx.quantities.height;
+        let rows = h.div_ceil(BANDS);
+        let (first, last) = (group * rows, ((group + 1) * rows).min(h));
+        if first >= last {
+            return;
+        }
+        let band = Band::load(ctx, &self.p);
+        let samples = standard_samples(band.samples);
+        let mut counters = CounterValues::default();
+        for tri in list.iter() {
+            tri.setup.rasterize_samples(first, last - 1, &samples, |f| {
+                band.fragment(tri, &f, &mut counters);
+            });
+        }
+        if ctx.instrument {
+            ctx.counters.add(&counters);
+        }
+    }
+}
+
+/// What every fragment of a band reads and writes.
+struct Band<'a> {
+    scene_depth: Words<'a>,
+    hair_depth: Option<Words<'a>>,
+    gbuffer: Words<'a>,
+    /// The attachment, `samples` words per pixel.
+    depth: Words<'a>,
+    samples: u32,
+    layers: usize,
+    width: u32,
+    pixels: usize,
+}
+
+impl<'a> Band<'a> {
+    fn load(ctx: &Ctx<'a>, p: &RasterParams) -> Self {
+        let q = &ctx.quantities;
+        let pixels = q.width as usize * q.height as usize;
+        let depth = ctx.words("strand_depth");
+        let gbuffer = ctx.words("gbuffer");
+        Self {
+            scene_depth: ctx.words("scene.depth"),
+            hair_depth: (p.model_index > 0).then(|| ctx.words("hair_depth")),
+            layers: (gbuffer.len_u64() / pixels.max(1)).min(8),
+            gbuffer,
+            samples: (depth.len() / pixels.max(1)).clamp(1, 8) as u32,
+            depth,
+            width: q.width,
+            pixels,
+        }
+    }
+
+    /// Early depth test and depth write per sample, then the fragment
+    /// shader if any sample passed.
+    fn fragment(&self, tri: &Triangle, f: &SampledFragment, counters: &mut CounterValues) {
+        let i = f.y as usize * self.width as usize + f.x as usize;
+        let n = self.samples as usize;
+        let mut passed = false;
+        for s in (0..n).filter(|s| f.mask & (1 << s) != 0) {
+            let z = f.sample_depth[s];
+            // Depth clipping, then the test (Less) and the write.
+            if (0.0..=1.0).contains(&z) && z < self.depth.load_f32(i * n + s) {
+                self.depth.store_f32(i * n + s, z);
+                passed = true;
+            }
+        }
+        if !passed {
+            return;
+        }
+        counters.pixels_written += 1;
+        let z = f.depth;
+        if !(0.0..1.0).contains(&z) || z >= self.scene_depth.load_f32(i) {
+            return;
+        }
+        if self.hair_depth.as_ref().is_some_and(|d| z >= d.load_f32(i)) {
+            return;
+        }
+        // `@interpolate(linear)`: screen-space barycentrics at the centre.
+        let t = (0..3).map(|k| f.screen[k] * tri.t[k]).sum::<f32>();
+        let payload = tri.segment.payload(t.clamp(0.0, 1.0), z);
+        for s in (0..self.layers).filter(|s| f.mask & (1 << s) != 0) {
+            self.gbuffer.fetch_min_u64(s * self.pixels + i, payload);
+            counters.atomics += 1;
+        }
+    }
+}
