@@ -82,15 +82,13 @@ enum Bounds {
 pub struct SampledFragment {
     pub x: u32,
     pub y: u32,
-    /// Bit s: sample s is covered (Vulkan's `SampleMask` input).
+    /// Bit s: sample s is covered.
     pub mask: u32,
-    /// NDC depth at each covered sample (what the depth test compares).
-    pub sample_depth: [f32; 8],
-    /// Depth and screen-space barycentrics at the pixel centre, where a
-    /// fragment shader without sample shading evaluates its inputs
-    /// (extrapolated when the centre lies outside the triangle).
-    pub depth: f32,
-    pub screen: [f32; 3],
+    /// At each covered sample: NDC depth (what the depth test compares)
+    /// and screen-space barycentrics of the source corners (what
+    /// `@interpolate(linear, sample)` gives a sample-rate fragment shader).
+    pub depth: [f32; 8],
+    pub screen: [[f32; 3]; 8],
 }
 
 /// A standard sample pattern in sub-pixel units (1/256 pixel) from the pixel
@@ -359,19 +357,17 @@ impl Setup {
                     x,
                     y,
                     mask: 0,
-                    sample_depth: [0.0; 8],
-                    depth: 0.0,
-                    screen: [0.0; 3],
+                    depth: [0.0; 8],
+                    screen: [[0.0; 3]; 8],
                 };
                 for (s, o) in samples.iter().enumerate() {
                     let e = weights(cx + o[0], cy + o[1]);
                     if e.iter().zip(&self.bias).all(|(ei, b)| ei >= b) {
                         frag.mask |= 1 << s;
-                        frag.sample_depth[s] = self.depth_at(e, area).0;
+                        (frag.depth[s], frag.screen[s]) = self.depth_at(e, area);
                     }
                 }
                 if frag.mask != 0 {
-                    (frag.depth, frag.screen) = self.depth_at(weights(cx, cy), area);
                     f(frag);
                 }
             }

@@ -26,8 +26,9 @@ use std::path::{Path, PathBuf};
 /// allows only `atomicMin`/`atomicMax` on storage `atomic<u64>` whose
 /// result is unused; anything else needs `SHADER_INT64_ATOMIC_ALL_OPS`
 /// (docs/architecture.md, "Shaders").
-pub const CAPABILITIES: [Capabilities; 7] = [
+pub const CAPABILITIES: [Capabilities; 8] = [
     Capabilities::EARLY_DEPTH_TEST,
+    Capabilities::MULTISAMPLED_SHADING,
     Capabilities::SUBGROUP,
     Capabilities::SUBGROUP_BARRIER,
     Capabilities::FLOAT64,

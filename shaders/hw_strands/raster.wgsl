@@ -6,11 +6,11 @@
 // resolve it unchanged. Port of passes/src/hw_strands/raster.rs.
 //
 // The depth attachment holds the head (scene.depth_attachment) and the
-// strands drawn so far; early fragment tests reject hidden fragments before
-// the shader's atomics. The shader then writes every sample the quad covers
-// (Vulkan's SampleMask without post-depth coverage), tested as Lipp's
-// write_sample tests: against scene.depth and, after the first groom,
-// against hair_depth.
+// strands drawn so far; early fragment tests reject hidden samples before
+// the shader's atomics. The shader runs per sample (sample_index; naga's
+// SampleMask input is not valid SPIR-V, gfx-rs/wgpu#7311) and writes its
+// sample's layer, tested as Lipp's write_sample tests: against scene.depth
+// and, after the first groom, against hair_depth.
 
 #import strandgraph::layout::FrameData
 #import strandgraph::lipp::{quantize, depth_bits}
@@ -45,7 +45,7 @@ const CORNERS: array<u32, 6> = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
 struct Varyings {
     @builtin(position) position: vec4<f32>,
     // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t.
-    @location(0) @interpolate(linear) t: f32,
+    @location(0) @interpolate(linear, sample) t: f32,
     @location(1) @interpolate(flat) segment: u32,
 }
 
@@ -110,11 +110,10 @@ fn lerp6(a: u32, b: u32, t: f32) -> u32 {
     return quantize((fa + (fb - fa) * t) / 63.0, 63.0);
 }
 
-// Lipp's write_sample for every covered sample: the payload at the pixel
-// centre (where a fragment shader without sample shading is evaluated).
+// Lipp's write_sample for this sample: position and t are the sample's.
 @fragment
 @early_depth_test(force)
-fn fs_main(in: Varyings, @builtin(sample_mask) mask: u32) {
+fn fs_main(in: Varyings, @builtin(sample_index) sample: u32) {
     let x = u32(in.position.x);
     let y = u32(in.position.y);
     let z = in.position.z;
@@ -138,10 +137,7 @@ fn fs_main(in: Varyings, @builtin(sample_mask) mask: u32) {
     let hi = (depth_bits(z) << 8u) | (bits_b & 255u);
     let payload = (u64(hi) << 32u) | u64(lo);
     let pixels = params.width * params.height;
-    let layers = min(8u, arrayLength(&gbuffer) / max(pixels, 1u));
-    for (var s = 0u; s < layers; s++) {
-        if (mask & (1u << s)) != 0u {
-            atomicMin(&gbuffer[s * pixels + pixel], payload);
-        }
+    if sample < min(8u, arrayLength(&gbuffer) / max(pixels, 1u)) {
+        atomicMin(&gbuffer[sample * pixels + pixel], payload);
     }
 }

@@ -143,6 +143,15 @@ impl Wanted {
         match cap {
             // SPIR-V's EarlyFragmentTests execution mode is core Vulkan.
             Capabilities::EARLY_DEPTH_TEST => {}
+            // `sample_index` and sample interpolation: sample-rate shading.
+            Capabilities::MULTISAMPLED_SHADING => {
+                if have.core.sample_rate_shading == vk::FALSE {
+                    return Err("sampleRateShading".into());
+                }
+                self.core.sample_rate_shading = vk::TRUE;
+                self.names.push("sampleRateShading".into());
+                self.spirv_caps.push(C::SampleRateShading);
+            }
             Capabilities::FLOAT64 => {
                 if have.core.shader_float64 == vk::FALSE {
                     return Err("shaderFloat64".into());

@@ -6,7 +6,9 @@ use naga::valid::Capabilities;
 /// wgpu-core derives a device's naga capabilities from its features
 /// (wgpu-core 30 `device/resource.rs`, `create_validator`): `SUBGROUP` gives
 /// `SUBGROUP`, `SUBGROUP_BARRIER` gives `SUBGROUP_BARRIER`, `SHADER_F64`
-/// gives `FLOAT64`, `SHADER_EARLY_DEPTH_TEST` gives `EARLY_DEPTH_TEST`, `SHADER_INT64` gives `SHADER_INT64`, and the two int64
+/// gives `FLOAT64`, `SHADER_EARLY_DEPTH_TEST` gives `EARLY_DEPTH_TEST`
+/// (`MULTISAMPLED_SHADING` is no feature: the downlevel flag of that name,
+/// which every Vulkan adapter with sampleRateShading has, gives it), `SHADER_INT64` gives `SHADER_INT64`, and the two int64
 /// atomic features give their capabilities.
 pub const CAPABILITY_FEATURES: [(Capabilities, wgpu::Features, &str); 7] = [
     (

@@ -7,20 +7,22 @@
 //! The draw rasterizes at the depth attachment's sample count (the graph's
 //! `strand_depth.samples`: MSAA 1, 4, 8) with early depth tests (`Less`,
 //! writes on) against the head (`scene.depth_attachment`) and the strands
-//! drawn before. The fragment shader runs once per pixel; it tests the
-//! pixel-centre depth as `lipp.raster` tests a sample (against
-//! `scene.depth`, and after the first groom `hair_depth`) and writes the
-//! payload into the G-buffer layer of every sample the quad covers, with
-//! 64-bit `atomicMin`: Lipp's MSAA reference layout, which `lipp.shade`
-//! and `lipp.filter` (its `msaa` set to the same count) resolve.
+//! drawn before. The fragment shader runs once per covered sample that
+//! passes (sample-rate shading, `@builtin(sample_index)`), tests the
+//! sample's depth as `lipp.raster` does (against `scene.depth`, and after
+//! the first groom `hair_depth`) and writes its payload into the sample's
+//! G-buffer layer with 64-bit `atomicMin`: Lipp's MSAA reference layout,
+//! which `lipp.shade` and `lipp.filter` (its `msaa` set to the same count)
+//! resolve. The nearest strand at each sample wins whatever the draw order.
 //!
-//! Without post-depth coverage the shader's mask is the rasterizer's
-//! coverage, so a fragment that passes the depth test at one sample also
-//! writes samples where a nearer strand already is; the `atomicMin` keeps
-//! the nearer payload wherever the two compare as their pixel-centre
-//! depths do. The CPU kernel emulates exactly this ([`Band::fragment`]):
-//! per-sample depth from [`crate::hardware_raster`] at the standard sample
-//! locations, triangles in draw order.
+//! Deviation: a hardware MSAA pipeline shades once per pixel and reads the
+//! coverage from `SampleMask`, but naga 30 declares that input as a scalar
+//! where Vulkan requires an array (VUID-SampleMask-SampleMask-04359;
+//! gfx-rs/wgpu#7311), which drivers may misread. Shading per sample is
+//! valid everywhere; at MSAA 1 it is the same thing, at 4 and 8 it runs
+//! more fragment invocations than a per-pixel shader would (bench notes
+//! say so). The CPU kernel emulates it ([`Band::fragment`]) with
+//! [`crate::hardware_raster`] at the standard sample locations.
 
 use super::{CORNERS, SEGMENT_WORDS, Segment, VERTICES_PER_SEGMENT, quad_corner};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
@@ -255,35 +257,28 @@ impl<'a> Band<'a> {
         }
     }
 
-    /// Early depth test and depth write per sample, then the fragment
-    /// shader if any sample passed.
+    /// Per covered sample: the early depth test and depth write, then the
+    /// sample-rate fragment shader where the sample passed.
     fn fragment(&self, tri: &Triangle, f: &SampledFragment, counters: &mut CounterValues) {
         let i = f.y as usize * self.width as usize + f.x as usize;
         let n = self.samples as usize;
-        let mut passed = false;
         for s in (0..n).filter(|s| f.mask & (1 << s) != 0) {
-            let z = f.sample_depth[s];
+            let z = f.depth[s];
             // Depth clipping, then the test (Less) and the write.
-            if (0.0..=1.0).contains(&z) && z < self.depth.load_f32(i * n + s) {
-                self.depth.store_f32(i * n + s, z);
-                passed = true;
+            if !((0.0..=1.0).contains(&z) && z < self.depth.load_f32(i * n + s)) {
+                continue;
             }
-        }
-        if !passed {
-            return;
-        }
-        counters.pixels_written += 1;
-        let z = f.depth;
-        if !(0.0..1.0).contains(&z) || z >= self.scene_depth.load_f32(i) {
-            return;
-        }
-        if self.hair_depth.as_ref().is_some_and(|d| z >= d.load_f32(i)) {
-            return;
-        }
-        // `@interpolate(linear)`: screen-space barycentrics at the centre.
-        let t = (0..3).map(|k| f.screen[k] * tri.t[k]).sum::<f32>();
-        let payload = tri.segment.payload(t.clamp(0.0, 1.0), z);
-        for s in (0..self.layers).filter(|s| f.mask & (1 << s) != 0) {
+            self.depth.store_f32(i * n + s, z);
+            counters.pixels_written += 1;
+            if z >= 1.0 || z >= self.scene_depth.load_f32(i) || s >= self.layers {
+                continue;
+            }
+            if self.hair_depth.as_ref().is_some_and(|d| z >= d.load_f32(i)) {
+                continue;
+            }
+            // `@interpolate(linear, sample)`: screen-space barycentrics.
+            let t = (0..3).map(|k| f.screen[s][k] * tri.t[k]).sum::<f32>();
+            let payload = tri.segment.payload(t.clamp(0.0, 1.0), z);
             self.gbuffer.fetch_min_u64(s * self.pixels + i, payload);
             counters.atomics += 1;
         }
