@@ -90,7 +90,12 @@ pub fn open(
             let _ = strandgraph_ash::keep_driver_loaded();
             let session = strandgraph_wgpu::WgpuBackend::default()
                 .open(&Registry, plan, instance)
-                .into_diagnostic()?;
+                .map_err(|e| match e {
+                    strandgraph_wgpu::WgpuError::MissingFeature { .. } => {
+                        Unsupported(e.to_string()).into()
+                    }
+                    e => miette::Report::from_err(e),
+                })?;
             Box::new(session)
         }
         Backend::Ash => {
@@ -98,7 +103,26 @@ pub fn open(
                 alias: options.alias,
                 ..Default::default()
             };
-            Box::new(b.open(plan, instance).into_diagnostic()?)
+            Box::new(b.open(plan, instance).map_err(|e| match e {
+                strandgraph_ash::AshError::MissingFeature { .. } => {
+                    Unsupported(e.to_string()).into()
+                }
+                e => miette::Report::from_err(e),
+            })?)
         }
     })
 }
+
+/// A backend refused the plan for something the device lacks (a feature,
+/// a sample count, a binding size): the bench marks such a cell skipped.
+#[derive(Debug)]
+pub struct Unsupported(pub String);
+
+impl std::fmt::Display for Unsupported {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Unsupported {}
+impl miette::Diagnostic for Unsupported {}

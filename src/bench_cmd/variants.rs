@@ -257,10 +257,80 @@ pub const VARIANTS: &[Variant] = &[
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
     },
+    // Lipp's Table 1 baseline: the same strands through the hardware
+    // rasterizer (scenes/graphs/hw_strands.ron), MSAA 1/4/8 without and
+    // with LOD. Hopper runs vertex and pixel work on few SMs: the bench's
+    // graphics roofline says how few.
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 1",
+        graph: HW_STRANDS,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=1",
+            "filter.msaa=1",
+        ],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 4",
+        graph: HW_STRANDS,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=4",
+            "filter.msaa=4",
+        ],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 8",
+        graph: HW_STRANDS,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=8",
+            "filter.msaa=8",
+        ],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 1+L",
+        graph: HW_STRANDS,
+        overrides: &["strand_depth.samples=1", "filter.msaa=1"],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 4+L",
+        graph: HW_STRANDS,
+        overrides: &["strand_depth.samples=4", "filter.msaa=4"],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW strands",
+        name: "HW 8+L",
+        graph: HW_STRANDS,
+        overrides: &["strand_depth.samples=8", "filter.msaa=8"],
+        raster: &HW_STRANDS_PASSES,
+        ceiling: "fragments",
+    },
 ];
 
 const LIPP: &str = "scenes/graphs/lipp.ron";
 const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";
 const SCHEUERMANN: &str = "scenes/graphs/scheuermann.ron";
+const HW_STRANDS: &str = "scenes/graphs/hw_strands.ron";
+/// Strand generation and rasterization, as Lipp's raster column counts both.
+const HW_STRANDS_PASSES: [&str; 2] = ["assemble", "raster"];
 /// Its hair passes, all hardware raster.
 const SCHEUERMANN_PASSES: [&str; 4] = ["prime_depth", "opaque_hair", "back_faces", "front_faces"];

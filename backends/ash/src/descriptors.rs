@@ -158,13 +158,28 @@ fn write_set(
         };
         let descriptor = match (&cx.memory.res[r], ty) {
             (
-                Some(Res::Buffer { buffer, .. }),
+                Some(Res::Buffer { buffer, size, .. }),
                 vk::DescriptorType::STORAGE_BUFFER | vk::DescriptorType::UNIFORM_BUFFER,
-            ) => Descriptor::Buffer(vk::DescriptorBufferInfo {
-                buffer: buffer.raw(),
-                offset: 0,
-                range: vk::WHOLE_SIZE,
-            }),
+            ) => {
+                let limit = u64::from(cx.gpu.props.limits.max_storage_buffer_range);
+                if ty == vk::DescriptorType::STORAGE_BUFFER && *size > limit {
+                    return Err(AshError::MissingFeature {
+                        device: cx.gpu.name.clone(),
+                        feature: format!(
+                            "a storage buffer range of {} MiB (maxStorageBufferRange is {} MiB)",
+                            size >> 20,
+                            limit >> 20
+                        ),
+                        pass: cx.plan.pass_name(b.p).to_string(),
+                        why: format!("it binds `{}` whole", g.resources[r].name),
+                    });
+                }
+                Descriptor::Buffer(vk::DescriptorBufferInfo {
+                    buffer: buffer.raw(),
+                    offset: 0,
+                    range: vk::WHOLE_SIZE,
+                })
+            }
             (
                 Some(Res::Image { view, .. }),
                 vk::DescriptorType::SAMPLED_IMAGE | vk::DescriptorType::STORAGE_IMAGE,

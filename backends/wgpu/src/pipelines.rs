@@ -156,12 +156,17 @@ impl<'a> PassContext<'a> {
             (Some(Memory::Buffer(buf, _)), _) => {
                 let limit = self.device.limits().max_storage_buffer_binding_size;
                 if buf.size() > limit {
-                    return Err(self.error(format!(
-                        "`{}` is {} MiB, more than this adapter binds at once ({} MiB, max_storage_buffer_binding_size): render a smaller scene or use a device with a larger limit",
-                        self.prep.bindings[b].0,
-                        buf.size() >> 20,
-                        limit >> 20
-                    )));
+                    return Err(WgpuError::MissingFeature {
+                        adapter: self.device.adapter_info().name,
+                        feature: "max_storage_buffer_binding_size",
+                        pass: self.name.to_string(),
+                        why: format!(
+                            "it binds `{}` whole, {} MiB, over the limit of {} MiB",
+                            self.prep.bindings[b].0,
+                            buf.size() >> 20,
+                            limit >> 20
+                        ),
+                    });
                 }
                 buf.as_entire_binding()
             }

@@ -148,77 +148,134 @@ struct Triangle {
 
 struct RasterKernel {
     p: RasterParams,
-    /// The vertex stage and setup of every triangle, in draw order (the
-    /// prologue's work, redone every frame).
-    triangles: RwLock<Vec<Triangle>>,
+    /// Per band of rows, the segments whose quads may reach it, in draw
+    /// order: the prologue's work, redone every frame. Bands set their
+    /// segments' triangles up themselves (a close view has tens of millions).
+    bands: RwLock<Vec<Vec<u32>>>,
 }
 
 impl RasterKernel {
     fn new(p: RasterParams) -> Self {
         Self {
             p,
-            triangles: RwLock::new(Vec::new()),
+            bands: RwLock::new(Vec::new()),
         }
     }
 }
 
-/// The vertex shader and primitive setup of segment `s`'s two triangles.
-fn triangles(s: &Segment, f: &FrameData, half: f32, w: u32, h: u32) -> Vec<Triangle> {
-    if s.a.w <= f.near || s.b.w <= f.near {
-        return Vec::new();
-    }
-    let size = Vec2::new(w as f32, h as f32);
-    let corner = |k: u32| quad_corner(s.a, s.b, k, half, size);
-    CORNERS
-        .chunks(3)
-        .filter_map(|tri| {
-            let clip: [Vec4; 3] = [corner(tri[0]), corner(tri[1]), corner(tri[2])];
-            let setup = Setup::from_clip_multisampled(clip, f.near, w, h, Cull::None)?;
-            Some(Triangle {
-                setup,
-                t: [0, 1, 2].map(|k| (tri[k] & 1) as f32),
-                segment: *s,
+/// What the vertex stage and primitive setup need.
+struct View {
+    near: f32,
+    half: f32,
+    width: u32,
+    height: u32,
+}
+
+impl View {
+    /// Segment `s`'s two triangles (the vertex shader, then setup).
+    fn triangles(&self, s: &Segment) -> impl Iterator<Item = Triangle> + '_ {
+        let visible = s.a.w > self.near && s.b.w > self.near;
+        let size = Vec2::new(self.width as f32, self.height as f32);
+        let s = *s;
+        CORNERS
+            .chunks(3)
+            .filter(move |_| visible)
+            .filter_map(move |tri| {
+                let clip: [Vec4; 3] =
+                    [0, 1, 2].map(|k| quad_corner(s.a, s.b, tri[k], self.half, size));
+                let setup = Setup::from_clip_multisampled(
+                    clip,
+                    self.near,
+                    self.width,
+                    self.height,
+                    Cull::None,
+                )?;
+                Some(Triangle {
+                    setup,
+                    t: [0, 1, 2].map(|k| (tri[k] & 1) as f32),
+                    segment: s,
+                })
             })
-        })
-        .collect()
+    }
+
+    /// The rows segment `s`'s quad may reach: its ends' rows, `half` a pixel
+    /// and one row of margin either side.
+    fn rows(&self, s: &Segment) -> Option<(u32, u32)> {
+        if s.a.w <= self.near || s.b.w <= self.near {
+            return None;
+        }
+        let y = |c: Vec4| (0.5 - c.y / c.w * 0.5) * self.height as f32;
+        let (lo, hi) = (y(s.a).min(y(s.b)), y(s.a).max(y(s.b)));
+        let margin = self.half + 1.0;
+        if !(hi + margin >= 0.0 && lo - margin < self.height as f32) {
+            return None;
+        }
+        let clamp = |v: f32| v.clamp(0.0, (self.height - 1) as f32) as u32;
+        Some((clamp(lo - margin), clamp(hi + margin)))
+    }
+}
+
+fn load_segment(records: &Words<'_>, i: usize) -> Segment {
+    let words: [u32; SEGMENT_WORDS] = std::array::from_fn(|k| records.load(i * SEGMENT_WORDS + k));
+    Segment::from_words(&words)
+}
+
+impl RasterKernel {
+    fn view(&self, ctx: &Ctx<'_>) -> View {
+        let f: FrameData = read(&ctx.words("frame"), 0);
+        View {
+            near: f.near,
+            half: 0.5 * self.p.width,
+            width: ctx.quantities.width,
+            height: ctx.quantities.height,
+        }
+    }
 }
 
 impl CpuKernel for RasterKernel {
     fn prologue(&self, ctx: &Ctx<'_>) {
         use rayon::prelude::*;
-        let f: FrameData = read(&ctx.words("frame"), 0);
+        let view = self.view(ctx);
         let (records, args) = (ctx.words("hw_segments"), ctx.words("hw_draw_args"));
         let count = (args.load(0) / VERTICES_PER_SEGMENT) as usize;
         let count = count.min(records.len() / SEGMENT_WORDS);
-        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
-        let half = 0.5 * self.p.width;
-        let list: Vec<Triangle> = (0..count)
+        let rows: Vec<Option<(u32, u32)>> = (0..count)
             .into_par_iter()
-            .flat_map_iter(|i| {
-                let words: Vec<u32> = (0..SEGMENT_WORDS)
-                    .map(|k| records.load(i * SEGMENT_WORDS + k))
-                    .collect();
-                triangles(&Segment::from_words(&words), &f, half, w, h)
-            })
+            .map(|i| view.rows(&load_segment(&records, i)))
             .collect();
-        *self.triangles.write().unwrap_or_else(|e| e.into_inner()) = list;
+        let per_band = view.height.div_ceil(BANDS).max(1);
+        let mut bands = vec![Vec::new(); BANDS as usize];
+        for (i, r) in rows.iter().enumerate() {
+            if let Some((y0, y1)) = r {
+                for band in &mut bands[(y0 / per_band) as usize..=(y1 / per_band) as usize] {
+                    band.push(i as u32);
+                }
+            }
+        }
+        *self.bands.write().unwrap_or_else(|e| e.into_inner()) = bands;
     }
 
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let list = self.triangles.read().unwrap_or_else(|e| e.into_inner());
-        let h = ctx.quantities.height;
-        let rows = h.div_ceil(BANDS);
-        let (first, last) = (group * rows, ((group + 1) * rows).min(h));
+        let bands = self.bands.read().unwrap_or_else(|e| e.into_inner());
+        let view = self.view(ctx);
+        let rows = view.height.div_ceil(BANDS);
+        let (first, last) = (group * rows, ((group + 1) * rows).min(view.height));
+        let Some(list) = bands.get(group as usize) else {
+            return;
+        };
         if first >= last {
             return;
         }
+        let records = ctx.words("hw_segments");
         let band = Band::load(ctx, &self.p);
         let samples = standard_samples(band.samples);
         let mut counters = CounterValues::default();
-        for tri in list.iter() {
-            tri.setup.rasterize_samples(first, last - 1, &samples, |f| {
-                band.fragment(tri, &f, &mut counters);
-            });
+        for &i in list {
+            for tri in view.triangles(&load_segment(&records, i as usize)) {
+                tri.setup.rasterize_samples(first, last - 1, &samples, |f| {
+                    band.fragment(&tri, &f, &mut counters);
+                });
+            }
         }
         if ctx.instrument {
             ctx.counters.add(&counters);
