@@ -181,17 +181,20 @@ fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Re
         .trim()
         .parse()
         .map_err(|_| miette::miette!("--param {spec}: samples must be 1, 2, 4 or 8"))?;
-    let r = plan
-        .graph
-        .resource_id(image)
-        .expect("checked by the caller");
     let g = &mut plan.graph;
-    let ResourceDecl::Image { samples, .. } = &mut g.resources[r].decl else {
-        return Err(miette::miette!(
-            "--param {spec}: `{image}` is a buffer, not an image"
-        ));
-    };
-    *samples = n;
+    let r = g.physical(g.resource_id(image).expect("checked by the caller"));
+    // The image and its versions (`a -> a.final`) share one declaration.
+    for v in 0..g.resources.len() {
+        if v != r && g.resources[v].version_of != Some(r) {
+            continue;
+        }
+        let ResourceDecl::Image { samples, .. } = &mut g.resources[v].decl else {
+            return Err(miette::miette!(
+                "--param {spec}: `{image}` is a buffer, not an image"
+            ));
+        };
+        *samples = n;
+    }
     if let Some(why) = strandgraph_graph::resolve::samples_problem(&g.resources[r].decl) {
         return Err(miette::miette!("--param {spec}: image `{image}` {why}"));
     }

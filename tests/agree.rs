@@ -16,58 +16,90 @@ use common::root;
 use std::collections::BTreeSet;
 use std::path::Path;
 use strandgraph::agree::{self, PassCheck};
-use strandgraph::frame::{Prepared, prepare};
+use strandgraph::frame::{Prepared, prepare, prepare_with};
 use strandgraph::runner::Backend;
 use strandgraph_passes::PASSES;
 
 /// A scene, the graph to run on it and the size.
 struct Case {
+    /// A scene file under the repository, or a scene's RON itself
+    /// (starting `Scene(`), written to the test's output directory.
     scene: &'static str,
     graph: &'static str,
     size: (u32, u32),
+    /// `--param` overrides.
+    overrides: &'static [&'static str],
 }
 
 const SHOWCASE: Case = Case {
     scene: "scenes/showcase.ron",
     graph: "scenes/graphs/kulikov.ron",
     size: (250, 140),
+    overrides: &[],
 };
 const VISIBILITY: Case = Case {
     scene: "scenes/showcase.ron",
     graph: "scenes/graphs/kulikov_visibility.ron",
     size: (250, 140),
+    overrides: &[],
 };
 const LIPP: Case = Case {
     scene: "scenes/grooms.ron",
     graph: "scenes/graphs/lipp.ron",
     size: (240, 135),
+    overrides: &[],
 };
 const LIPP_MSAA: Case = Case {
     scene: "scenes/grooms.ron",
     graph: "scenes/graphs/lipp_msaa.ron",
     size: (160, 90),
+    overrides: &[],
 };
 const ROOFLINE: Case = Case {
     scene: "scenes/showcase.ron",
     graph: "scenes/graphs/roofline.ron",
     size: (64, 64),
+    overrides: &[],
 };
 const SCHEUERMANN: Case = Case {
     scene: "scenes/showcase.ron",
     graph: "scenes/graphs/scheuermann.ron",
     size: (250, 140),
+    overrides: &[],
 };
-const ALL: [&Case; 6] = [
+/// At one sample: a multisampled attachment cannot be seeded from the
+/// CPU's words or read back (the MSAA draws are checked whole by
+/// tests/diff_hw_strands.rs).
+const HW_STRANDS: Case = Case {
+    // Small: its segment buffer (5 KiB a strand) must fit lavapipe's
+    // 128 MiB storage binding.
+    scene: TWO_GROOMS,
+    graph: "scenes/graphs/hw_strands.ron",
+    size: (160, 90),
+    overrides: &["strand_depth.samples=1", "filter.msaa=1"],
+};
+const ALL: [&Case; 7] = [
     &SHOWCASE,
     &VISIBILITY,
     &LIPP,
     &LIPP_MSAA,
     &ROOFLINE,
     &SCHEUERMANN,
+    &HW_STRANDS,
 ];
 
-fn prepared(scene: &Path, graph: &str, size: (u32, u32)) -> Prepared {
-    prepare(scene, Some(&root().join(graph)), Some(size)).unwrap_or_else(|e| panic!("{e:?}"))
+fn prepared(case: &Case) -> Prepared {
+    let overrides: Vec<String> = case.overrides.iter().map(|s| s.to_string()).collect();
+    let graph = root().join(case.graph);
+    let scene = if case.scene.starts_with("Scene(") {
+        let path = common::out_dir("agree").join(format!("{}.ron", case.size.0));
+        std::fs::write(&path, case.scene).unwrap();
+        path
+    } else {
+        root().join(case.scene)
+    };
+    prepare_with(&scene, Some(&graph), Some(case.size), &overrides)
+        .unwrap_or_else(|e| panic!("{e:?}"))
 }
 
 /// Every pass of `p` on wgpu and ash against the CPU; panics with the
@@ -96,7 +128,7 @@ fn agree(p: &Prepared) -> Vec<PassCheck> {
 }
 
 fn run(case: &Case) -> Vec<PassCheck> {
-    agree(&prepared(&root().join(case.scene), case.graph, case.size))
+    agree(&prepared(case))
 }
 
 #[test]
@@ -125,6 +157,11 @@ fn scheuermann_passes_agree() {
 }
 
 #[test]
+fn hw_strands_passes_agree() {
+    run(&HW_STRANDS);
+}
+
+#[test]
 fn roofline_passes_agree() {
     run(&ROOFLINE);
 }
@@ -137,7 +174,8 @@ fn passes_agree_when_no_hair_is_visible() {
     let scene = dir.join("looking_away.ron");
     std::fs::write(&scene, LOOKING_AWAY).unwrap();
     for graph in [SHOWCASE.graph, LIPP.graph] {
-        let p = prepared(&scene, graph, (96, 64));
+        let p = prepare(&scene, Some(&root().join(graph)), Some((96, 64)))
+            .unwrap_or_else(|e| panic!("{e:?}"));
         let checks = agree(&p);
         let cull = checks.iter().find(|c| c.kind == "kulikov.cull");
         let lod = checks.iter().find(|c| c.kind == "lipp.lod");
@@ -147,6 +185,30 @@ fn passes_agree_when_no_hair_is_visible() {
         );
     }
 }
+
+/// Long hair and a beard from hair meshes, in view.
+const TWO_GROOMS: &str = r#"Scene(
+    resolution: (160, 90),
+    camera: LookAt(position: (0.42, 1.62, 0.78), target: (0.0, 1.52, 0.0), fov_deg: 35.0),
+    lights: [Directional(direction: (0.4, -0.6, -0.6), color: (1.0, 1.0, 1.0), intensity: 3.0)],
+    meshes: [(name: "head", source: Head(resolution: 32), transform: (translation: (0.0, 1.6, 0.0)))],
+    grooms: [
+        (
+            name: "hair",
+            source: HairMesh(style: Long, strands: 6000, points: 16, seed: 1),
+            parent: "head",
+            hair_mesh: (bundles: 96, layers: 6),
+        ),
+        (
+            name: "beard",
+            source: HairMesh(style: Beard, strands: 2000, points: 8, seed: 2),
+            parent: "head",
+            hair_mesh: (bundles: 32, layers: 4),
+            facial_hair: true,
+        ),
+    ],
+    graph: "unused.ron",
+)"#;
 
 const LOOKING_AWAY: &str = r#"Scene(
     resolution: (96, 64),
@@ -177,7 +239,7 @@ const LOOKING_AWAY: &str = r#"Scene(
 fn every_pass_kind_is_checked() {
     let mut run: BTreeSet<String> = BTreeSet::new();
     for case in ALL {
-        let p = prepared(&root().join(case.scene), case.graph, case.size);
+        let p = prepared(case);
         for &pass in &p.plan.order {
             if p.plan.live[pass] {
                 run.insert(p.plan.graph.passes[pass].kind.clone());

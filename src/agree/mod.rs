@@ -49,6 +49,18 @@ impl PassCheck {
 
 /// Runs `p`'s frame on the CPU simulator, keeping every pass's inputs.
 pub fn capture(p: &Prepared) -> Result<Vec<Captured>> {
+    // Each pass runs alone on the GPU from the CPU's words, and no API
+    // copies words into or out of a multisampled image.
+    let g = &p.plan.graph;
+    if let Some(r) = g.resources.iter().find(|r| r.decl.samples() > 1) {
+        return Err(miette::miette!(
+            "graph `{}` declares `{}` with {} samples, which a pass cannot be seeded with or read back from; check it at one sample (--param {}.samples=1, and the passes' own MSAA settings to match)",
+            g.name,
+            r.name,
+            r.decl.samples(),
+            r.name
+        ));
+    }
     let backend = CpuBackend {
         capture: true,
         ..CpuBackend::default()

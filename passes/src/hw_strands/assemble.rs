@@ -21,10 +21,10 @@ use crate::lipp::payload::quantize;
 use crate::lipp::strand::{ControlPoint, strand_uv};
 use crate::lipp::{
     BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, frame, mix,
-    normalize, oct_encode,
+    normalize, oct_encode, transform,
 };
 use crate::params::{Invalid, PassParams};
-use glam::{Mat4, Vec4};
+use glam::Vec4;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -101,12 +101,13 @@ struct AssembleKernel(AssembleParams);
 /// `write_segment`): the tangent at the middle, packed once per segment
 /// as `lipp.raster` packs it with `segment_payload` on.
 fn record(
-    view_proj: &Mat4,
+    view_proj: &[f32; 16],
     (a, ta): (&ControlPoint, [f32; 3]),
     (b, tb): (&ControlPoint, [f32; 3]),
     uv: [f32; 2],
 ) -> Segment {
-    let clip = |p: [f32; 3]| *view_proj * Vec4::new(p[0], p[1], p[2], 1.0);
+    // lipp.raster's projection, operation for operation (the WGSL's transform).
+    let clip = |p: [f32; 3]| Vec4::from_array(transform(view_proj, [p[0], p[1], p[2], 1.0]));
     let e = oct_encode(normalize(mix(ta, tb, 0.5)));
     Segment {
         a: clip(a.pos),
@@ -131,7 +132,7 @@ fn store(out: &Words<'_>, r: usize, s: &Segment) {
 impl CpuKernel for AssembleKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f: FrameData = frame(ctx);
-        let view_proj = Mat4::from_cols_array(&f.view_proj);
+        let view_proj = f.view_proj;
         let (lods, bundles, layers) = (
             ctx.words("bundle_lod"),
             ctx.words("hairmesh.bundles"),
