@@ -68,6 +68,9 @@ pub struct Setup {
     multisampled: bool,
 }
 
+/// A rounding from sub-pixel units to a pixel index.
+type Round = fn(i64) -> i64;
+
 /// Which pixels a setup visits.
 #[derive(Clone, Copy)]
 enum Bounds {
@@ -257,7 +260,7 @@ impl Setup {
         });
         // Pixels whose centre (p + 0.5) lies within the snapped bounding box,
         // or for samples anywhere in the pixel, every pixel the box touches.
-        let (lo, hi): (fn(i64) -> i64, fn(i64) -> i64) = match bounds {
+        let (lo, hi): (Round, Round) = match bounds {
             Bounds::Centres => (
                 |v| (v - HALF + ONE - 1).div_euclid(ONE),
                 |v| (v - HALF).div_euclid(ONE),

@@ -28,7 +28,7 @@ pub(crate) enum Built {
         draws: Vec<(wgpu::RenderPipeline, wgpu::BindGroup)>,
         color: Vec<wgpu::TextureView>,
         depth: Option<wgpu::TextureView>,
-        state: RasterState,
+        state: Box<RasterState>,
         vertices: u32,
         /// The draw's arguments (physical resource, byte offset) when indirect.
         indirect: Option<(usize, u64)>,

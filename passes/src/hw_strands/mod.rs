@@ -117,7 +117,8 @@ mod tests {
         let s = Segment {
             a: Vec4::new(0.1, -0.2, 0.3, 1.5),
             b: Vec4::new(-0.4, 0.5, 0.6, 2.5),
-            bits_a: (7 << 24) | (5 << 18) | (9 << 12) | (0 << 6) | 63,
+            // w 0 at end a, AO 63.
+            bits_a: (7 << 24) | (5 << 18) | (9 << 12) | 63,
             bits_b: 200 | (63 << 8),
         };
         assert_eq!(Segment::from_words(&s.words()), s);

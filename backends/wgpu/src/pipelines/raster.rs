@@ -62,7 +62,7 @@ pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<
             .map(|&b| attachment_view(cx, b))
             .collect::<Result<_, _>>()?,
         depth: at.depth.map(|b| attachment_view(cx, b)).transpose()?,
-        state: state.clone(),
+        state: Box::new(state.clone()),
         vertices,
         indirect: state
             .indirect
