@@ -47,6 +47,14 @@ fn capabilities_of(file: &str) -> Capabilities {
         "bench/atomic_min64.wgsl" | "lipp/raster.wgsl" | "opaque_mesh/visibility.wgsl" => {
             BASE | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
         }
+        // The same atomicMin from a fragment shader run per sample with
+        // early depth tests (docs/hw_strands.md).
+        "hw_strands/raster.wgsl" => {
+            BASE | Capabilities::SHADER_INT64
+                | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
+                | Capabilities::EARLY_DEPTH_TEST
+                | Capabilities::MULTISAMPLED_SHADING
+        }
         _ => BASE,
     }
 }

@@ -20,7 +20,7 @@ struct AssembleParams {
     cooperative_assembly: u32,
     styling: u32,
     bundles: u32,
-    // Records `segments` holds (its size / SEGMENT_WORDS).
+    // Records `hw_segments` holds (its size / SEGMENT_WORDS).
     capacity: u32,
 }
 
@@ -29,9 +29,9 @@ const SEGMENT_WORDS: u32 = 10u;
 const VERTICES_PER_SEGMENT: u32 = 6u;
 
 @group(0) @binding(0) var<uniform> params: AssembleParams;
-@group(0) @binding(6) var<storage, read_write> segments: array<u32>;
+@group(0) @binding(6) var<storage, read_write> hw_segments: array<u32>;
 // VkDrawIndirectCommand: vertex count, instance count, first vertex, first instance.
-@group(0) @binding(7) var<storage, read_write> draw_args: array<atomic<u32>>;
+@group(0) @binding(7) var<storage, read_write> hw_draw_args: array<atomic<u32>>;
 
 var<workgroup> first_record: u32;
 
@@ -44,16 +44,16 @@ fn write_segment(r: u32, a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: ve
     let ca = transform(frame.view_proj, vec4<f32>(a.pos, 1.0));
     let cb = transform(frame.view_proj, vec4<f32>(b.pos, 1.0));
     for (var k = 0u; k < 4u; k++) {
-        segments[base + k] = bitcast<u32>(ca[k]);
-        segments[base + 4u + k] = bitcast<u32>(cb[k]);
+        hw_segments[base + k] = bitcast<u32>(ca[k]);
+        hw_segments[base + 4u + k] = bitcast<u32>(cb[k]);
     }
     let e = oct_encode(safe_normalize(lerp_vec(ta, tb, 0.5)));
-    segments[base + 8u] = (quantize(e.y * 0.5 + 0.5, 255.0) << 24u)
+    hw_segments[base + 8u] = (quantize(e.y * 0.5 + 0.5, 255.0) << 24u)
         | (quantize(uv.x, 63.0) << 18u)
         | (quantize(uv.y, 63.0) << 12u)
         | (quantize(a.w, 63.0) << 6u)
         | quantize(a.ao, 63.0);
-    segments[base + 9u] = quantize(e.x * 0.5 + 0.5, 255.0)
+    hw_segments[base + 9u] = quantize(e.x * 0.5 + 0.5, 255.0)
         | (quantize(b.w, 63.0) << 8u)
         | (quantize(b.ao, 63.0) << 14u);
 }
@@ -71,12 +71,12 @@ fn assemble(
     let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
     let stride = max(groups.x, 1u);
     if wg.x == 0u && lane == 0u {
-        atomicMax(&draw_args[1], 1u);
+        atomicMax(&hw_draw_args[1], 1u);
     }
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, params.styling != 0u);
         if lane == 0u {
-            let vertices = atomicAdd(&draw_args[0], (st.c - 1u) * VERTICES_PER_SEGMENT);
+            let vertices = atomicAdd(&hw_draw_args[0], (st.c - 1u) * VERTICES_PER_SEGMENT);
             first_record = vertices / VERTICES_PER_SEGMENT;
         }
         pass_one(st, l);

@@ -21,7 +21,7 @@ struct RasterParams {
     width: u32,
     height: u32,
     model_index: u32,
-    // Records `segments` holds.
+    // Records `hw_segments` holds.
     capacity: u32,
     _pad0: u32,
     _pad1: u32,
@@ -36,8 +36,8 @@ const CORNERS: array<u32, 6> = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 @group(0) @binding(1) var<storage, read> frame: FrameData;
-@group(0) @binding(2) var<storage, read> segments: array<u32>;
-@group(0) @binding(3) var<storage, read> draw_args: array<u32>;
+@group(0) @binding(2) var<storage, read> hw_segments: array<u32>;
+@group(0) @binding(3) var<storage, read> hw_draw_args: array<u32>;
 @group(0) @binding(4) var scene_depth: texture_2d<f32>;
 @group(0) @binding(5) var<storage, read> hair_depth: array<u32>;
 @group(0) @binding(6) var<storage, read_write> gbuffer: array<atomic<u64>>;
@@ -51,10 +51,10 @@ struct Varyings {
 
 fn clip_at(base: u32) -> vec4<f32> {
     return vec4<f32>(
-        bitcast<f32>(segments[base]),
-        bitcast<f32>(segments[base + 1u]),
-        bitcast<f32>(segments[base + 2u]),
-        bitcast<f32>(segments[base + 3u]),
+        bitcast<f32>(hw_segments[base]),
+        bitcast<f32>(hw_segments[base + 1u]),
+        bitcast<f32>(hw_segments[base + 2u]),
+        bitcast<f32>(hw_segments[base + 3u]),
     );
 }
 
@@ -88,7 +88,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> Varyings {
     out.segment = segment;
     // Outside the clip volume, every vertex the same: nothing is drawn.
     out.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-    if segment >= min(params.capacity, draw_args[0] / VERTICES_PER_SEGMENT) {
+    if segment >= min(params.capacity, hw_draw_args[0] / VERTICES_PER_SEGMENT) {
         return out;
     }
     let base = segment * SEGMENT_WORDS;
@@ -128,8 +128,8 @@ fn fs_main(in: Varyings, @builtin(sample_index) sample: u32) {
         return;
     }
     let base = in.segment * SEGMENT_WORDS;
-    let lo_a = segments[base + 8u];
-    let bits_b = segments[base + 9u];
+    let lo_a = hw_segments[base + 8u];
+    let bits_b = hw_segments[base + 9u];
     let t = clamp(in.t, 0.0, 1.0);
     let w = lerp6(lo_a >> 6u, bits_b >> 8u, t);
     let ao = lerp6(lo_a, bits_b >> 14u, t);
