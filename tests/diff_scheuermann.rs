@@ -21,42 +21,14 @@ use strandgraph_cpu::CpuBackend;
 use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, check_flip, out_dir, read_ash, root};
+use common::{ash, check_flip, read_ash, two_grooms};
 
 const W: u32 = 200;
 const H: u32 = 120;
 const MAX_MEAN_FLIP: f32 = 0.01;
 
 fn small_scene() -> PathBuf {
-    let graph = root().join("scenes/graphs/scheuermann.ron");
-    let text = format!(
-        r#"Scene(
-    resolution: ({W}, {H}),
-    camera: LookAt(position: (0.42, 1.62, 0.78), target: (0.0, 1.52, 0.0), fov_deg: 35.0),
-    lights: [
-        Directional(direction: (0.45, -0.6, -0.65), color: (1.0, 0.95, 0.88), intensity: 3.0),
-        Point(position: (-0.9, 1.7, 0.6), color: (0.7, 0.8, 1.0), intensity: 6.0),
-    ],
-    meshes: [(name: "head", source: Head(resolution: 48), transform: (translation: (0.0, 1.6, 0.0)))],
-    grooms: [(
-        name: "hair",
-        source: Procedural(style: Long, strands: 6000, points: 16, seed: 7),
-        parent: "head",
-        material: (melanin: 0.9, roughness: 0.3),
-    ), (
-        name: "beard",
-        source: Procedural(style: Beard, strands: 2000, points: 8, seed: 13),
-        parent: "head",
-        material: (melanin: 3.0, roughness: 0.35),
-        facial_hair: true,
-    )],
-    graph: {graph:?},
-)
-"#
-    );
-    let path = out_dir("diff_scheuermann").join("small.ron");
-    std::fs::write(&path, text).unwrap();
-    path
+    two_grooms("diff_scheuermann", "scenes/graphs/scheuermann.ron", W, H)
 }
 
 /// Pixels whose depth the hair changed (from the head's) on exactly one

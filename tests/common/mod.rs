@@ -87,3 +87,39 @@ pub fn check_flip(
         );
     }
 }
+
+/// A small scene the differential tests share: a 6,000-strand groom and a
+/// 2,000-strand beard on a head, the showcase's three-quarter view, two
+/// lights, `width`×`height`, running `graph` (relative to the repository);
+/// written to `out_dir(test)`.
+pub fn two_grooms(test: &str, graph: &str, width: u32, height: u32) -> PathBuf {
+    let text = format!(
+        r#"Scene(
+    resolution: ({width}, {height}),
+    camera: LookAt(position: (0.42, 1.62, 0.78), target: (0.0, 1.52, 0.0), fov_deg: 35.0),
+    lights: [
+        Directional(direction: (0.45, -0.6, -0.65), color: (1.0, 0.95, 0.88), intensity: 3.0),
+        Point(position: (-0.9, 1.7, 0.6), color: (0.7, 0.8, 1.0), intensity: 6.0),
+    ],
+    meshes: [(name: "head", source: Head(resolution: 48), transform: (translation: (0.0, 1.6, 0.0)))],
+    grooms: [(
+        name: "hair",
+        source: Procedural(style: Long, strands: 6000, points: 16, seed: 7),
+        parent: "head",
+        material: (melanin: 0.9, roughness: 0.3),
+    ), (
+        name: "beard",
+        source: Procedural(style: Beard, strands: 2000, points: 8, seed: 13),
+        parent: "head",
+        material: (melanin: 3.0, roughness: 0.35),
+        facial_hair: true,
+    )],
+    graph: {:?},
+)
+"#,
+        root().join(graph)
+    );
+    let path = out_dir(test).join("small.ron");
+    std::fs::write(&path, text).unwrap();
+    path
+}
