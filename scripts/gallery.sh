@@ -46,7 +46,7 @@ declare -A colour=(
 )
 # view: orbit distance, pitch
 declare -A view=([close]="0.95 0.0" [mid]="2.2 4.0" [far]="8.0 8.0")
-pipelines=(kulikov lipp scheuermann)
+pipelines=(kulikov lipp scheuermann hw_strands)
 
 scene() { # style view -> RON
   local style=$1 v=$2
@@ -113,7 +113,9 @@ page=$out/README.md
   echo "(the scenes it rendered are in [scenes/](scenes/)). Rows: hair styles; columns:"
   echo "pipeline and view. Kulikov 2025 draws the groom's strands; Lipp et al. draw"
   echo "strands generated from a hair mesh fitted to the same groom; Scheuermann"
-  echo "2004 draws textured patches built from it (docs/scheuermann.md)."
+  echo "2004 draws textured patches built from it (docs/scheuermann.md); the"
+  echo "hardware strands are Lipp's strands drawn by the GPU's rasterizer at MSAA 4"
+  echo "(docs/hw_strands.md), so beside Lipp's columns only visibility differs."
   echo
   echo "What differs and why: Lipp's shading adds the studio environment (SH"
   echo "irradiance and a prefiltered probe, its §3.4), which the Kulikov graph"
