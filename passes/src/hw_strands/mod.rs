@@ -26,6 +26,8 @@
 
 pub mod assemble;
 pub mod raster;
+#[cfg(test)]
+mod raster_tests;
 
 use glam::{Vec2, Vec4};
 
