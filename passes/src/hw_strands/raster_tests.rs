@@ -3,7 +3,7 @@
 //! winning whatever the draw order, earlier grooms' `hair_depth`.
 
 use super::raster::RASTER;
-use super::{SEGMENT_WORDS, Segment, VERTICES_PER_SEGMENT};
+use super::{Segment, VERTICES_PER_SEGMENT};
 use crate::kernel::harness::Harness;
 use crate::layout::{FrameData, words_of};
 use crate::lipp::payload::unpack;
