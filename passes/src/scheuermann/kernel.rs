@@ -20,7 +20,7 @@ use crate::layout::{FrameData, LightData, ModelData, read};
 use crate::raster_state::{Blend, Compare, Draw};
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::RwLock;
 use strandgraph_assets::octahedral::unpack_unit_vector;
 
 /// What the vertex stage outputs for one vertex.
@@ -90,8 +90,9 @@ pub(super) struct HairKernel {
     stage: Stage,
     p: HairParams,
     /// The vertex stage and setup of every triangle that survives culling,
-    /// in draw order (the prologue's work).
-    triangles: OnceLock<Vec<Triangle>>,
+    /// in draw order: the prologue's work, redone every frame (a session
+    /// keeps its kernels, and the frame's camera may move).
+    triangles: RwLock<Vec<Triangle>>,
 }
 
 impl HairKernel {
@@ -99,7 +100,7 @@ impl HairKernel {
         Self {
             stage,
             p,
-            triangles: OnceLock::new(),
+            triangles: RwLock::new(Vec::new()),
         }
     }
 }
@@ -124,13 +125,11 @@ impl CpuKernel for HairKernel {
                 })
             })
             .collect();
-        let _ = self.triangles.set(list);
+        *self.triangles.write().unwrap_or_else(|e| e.into_inner()) = list;
     }
 
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let Some(list) = self.triangles.get() else {
-            return;
-        };
+        let list = self.triangles.read().unwrap_or_else(|e| e.into_inner());
         let h = ctx.quantities.height;
         let rows = h.div_ceil(BANDS);
         let (first, last) = (group * rows, ((group + 1) * rows).min(h));
@@ -139,7 +138,7 @@ impl CpuKernel for HairKernel {
         }
         let ctx_data = Shared::load(ctx, self.stage, &self.p);
         let mut counters = CounterValues::default();
-        for tri in list {
+        for tri in list.iter() {
             tri.setup.rasterize_rows(first, last - 1, |f| {
                 counters.pixels_written += u64::from(ctx_data.fragment(tri, &f));
             });
