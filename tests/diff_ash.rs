@@ -17,11 +17,9 @@
 use strandgraph::compare::flip;
 use strandgraph::frame::{Prepared, prepare};
 use strandgraph::images::{Display, to_picture};
-use strandgraph_cpu::CpuBackend;
-use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, out_dir, read_ash, root};
+use common::{ash, cpu, out_dir, read_ash, root, wgpu};
 
 // Rows of 250 texels: not a multiple of any copy alignment.
 const W: u32 = 250;
@@ -104,16 +102,8 @@ fn showcase_visibility_matches_cpu_and_wgpu_on_ash() {
         aliased.transient_bytes < plain.transient_bytes,
         "aliasing saves memory"
     );
-    let cpu = CpuBackend {
-        subgroup_width: plain.subgroup_size,
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
-    let wgpu = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| panic!("wgpu backend failed: {e}"));
+    let cpu = cpu(&p, plain.subgroup_size);
+    let wgpu = wgpu(&p);
 
     eprintln!(
         "{:<16} {:>10} {:>10} {:>10}",
@@ -206,13 +196,7 @@ fn showcase_composed_matches_cpu_on_ash() {
     )
     .unwrap_or_else(|e| panic!("{e:?}"));
     let mut session = ash(&p, true);
-    let cpu = CpuBackend {
-        subgroup_width: session.subgroup_size,
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+    let cpu = cpu(&p, session.subgroup_size);
     let name = "output.composed";
     let c = cpu.read(&p.plan, name).unwrap();
     let a = read_ash(&session, name);

@@ -17,11 +17,9 @@
 
 use std::path::PathBuf;
 use strandgraph::frame::{Prepared, prepare_with};
-use strandgraph_cpu::CpuBackend;
-use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, check_flip, read_ash, root, two_grooms};
+use common::{ash, check_flip, cpu, read_ash, root, two_grooms, wgpu};
 
 const W: u32 = 200;
 const H: u32 = 120;
@@ -51,15 +49,8 @@ fn covered(gbuffer: &[u32], layers: usize) -> usize {
 fn three_way(samples: usize, overrides: &[&str]) -> Vec<u32> {
     let p = prepared("scenes/graphs/hw_strands.ron", overrides);
     let ash = ash(&p, false);
-    let cpu = CpuBackend {
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
-    let wgpu = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| panic!("wgpu backend failed: {e}"));
+    let cpu = cpu(&p, 32);
+    let wgpu = wgpu(&p);
     // Both grooms' G-buffers (none of the runs aliases memory).
     let gbuffers = ["gbuffer", "gbuffer[1]"];
     let count = |read: &dyn Fn(&str) -> Vec<u32>| -> usize {
@@ -104,10 +95,7 @@ fn hardware_strands_match_on_cpu_wgpu_and_ash_at_msaa_4_and_1() {
         "scenes/graphs/lipp_msaa.ron",
         &["raster.msaa=4", "filter.msaa=4"],
     );
-    let swr = CpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
-    let swr = swr.read(&p.plan, "output").unwrap();
+    let swr = cpu(&p, 32).read(&p.plan, "output").unwrap();
     check_flip(
         &p,
         "diff_hw_strands_vs_swr",

@@ -22,11 +22,9 @@
 
 use std::path::PathBuf;
 use strandgraph::frame::{Prepared, prepare};
-use strandgraph_cpu::CpuBackend;
-use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, check_flip, out_dir, read_ash, root};
+use common::{ash, check_flip, cpu, out_dir, read_ash, root, wgpu};
 
 const W: u32 = 200;
 const H: u32 = 120;
@@ -218,16 +216,8 @@ fn run(graph: Option<&str>, beard: bool) {
     );
     let plain = ash(&p, false);
     let aliased = ash(&p, true);
-    let cpu = CpuBackend {
-        subgroup_width: plain.subgroup_size,
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
-    let wgpu = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| panic!("wgpu backend failed: {e}"));
+    let cpu = cpu(&p, plain.subgroup_size);
+    let wgpu = wgpu(&p);
     eprintln!(
         "{:<16} {:>10} {:>10} {:>10}",
         "pass", "cpu ms", "wgpu ms", "ash ms"

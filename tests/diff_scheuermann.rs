@@ -17,11 +17,9 @@
 
 use std::path::PathBuf;
 use strandgraph::frame::prepare;
-use strandgraph_cpu::CpuBackend;
-use strandgraph_wgpu::WgpuBackend;
 
 mod common;
-use common::{ash, check_flip, read_ash, two_grooms};
+use common::{ash, check_flip, cpu, read_ash, two_grooms, wgpu};
 
 const W: u32 = 200;
 const H: u32 = 120;
@@ -53,15 +51,8 @@ fn scheuermann_graph_matches_on_cpu_wgpu_and_ash() {
     );
     let plain = ash(&p, false);
     let aliased = ash(&p, true);
-    let cpu = CpuBackend {
-        alias: false,
-        ..CpuBackend::default()
-    }
-    .execute(&p.plan, &p.instance, &p.upload)
-    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
-    let wgpu = WgpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .unwrap_or_else(|e| panic!("wgpu backend failed: {e}"));
+    let cpu = cpu(&p, 32);
+    let wgpu = wgpu(&p);
     let read_cpu = |name: &str| cpu.read(&p.plan, name).unwrap();
     let read_wgpu = |name: &str| wgpu.read(&p.plan, name).unwrap().unwrap();
 

@@ -44,6 +44,30 @@ pub fn ash(p: &Prepared, alias: bool) -> Session {
     session
 }
 
+/// One frame on the CPU simulator (the reference) at `subgroup_width`,
+/// without aliasing so every transient can be read.
+pub fn cpu(p: &Prepared, subgroup_width: u32) -> strandgraph_cpu::Frame<'static> {
+    strandgraph_cpu::CpuBackend {
+        subgroup_width,
+        alias: false,
+        ..strandgraph_cpu::CpuBackend::default()
+    }
+    .execute(&p.plan, &p.instance, &p.upload)
+    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"))
+}
+
+/// One frame on wgpu; no adapter is a failure.
+pub fn wgpu(p: &Prepared) -> strandgraph_wgpu::Frame {
+    strandgraph_wgpu::WgpuBackend::default()
+        .execute(&p.plan, &p.instance, &p.upload)
+        .unwrap_or_else(|e| {
+            panic!(
+                "wgpu backend failed: {e}\n(no adapter? apt-get install mesa-vulkan-drivers \
+                 libvulkan1, or run scripts/test.sh)"
+            )
+        })
+}
+
 /// A resource's words after the frame (it must have memory on ash).
 pub fn read_ash(s: &Session, name: &str) -> Vec<u32> {
     s.read(name)
