@@ -15,6 +15,7 @@ bitflags::bitflags! {
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
     pub struct Stages: u32 {
         const DRAW_INDIRECT = 1 << 0;
+        /// The shaders before rasterization: vertex, or task and mesh.
         const VERTEX_SHADER = 1 << 1;
         const FRAGMENT_SHADER = 1 << 2;
         const EARLY_FRAGMENT_TESTS = 1 << 3;

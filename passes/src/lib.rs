@@ -84,6 +84,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     // Hardware-rasterized strands: Lipp's Table 1 baseline.
     &hw_strands::assemble::ASSEMBLE,
     &hw_strands::raster::RASTER,
+    &hw_strands::mesh::MESH,
     // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,

@@ -1,27 +1,38 @@
 //! The fixed-function state of raster passes: what a GPU backend needs
 //! beyond the shader to draw a pass that has colour or depth attachments.
 //!
-//! Raster passes draw non-indexed triangle lists with no vertex buffers
-//! (vertex shaders fetch from storage buffers), counter-clockwise front
-//! faces, with as many samples per pixel as their attachments have (the
-//! graph's `samples`). The vertex count is fixed or read from a buffer an
-//! earlier pass wrote (an indirect draw). One pass may issue several draws over the same attachments with
-//! different fragment entries and state (say, colour blended, then depth
-//! written with the same geometry). The CPU kernels implement the same state in
-//! software; each definition's `raster()` documents the pairing.
+//! Raster passes draw triangle lists with no vertex buffers (vertex
+//! shaders fetch from storage buffers) or generate them in mesh shaders,
+//! counter-clockwise front faces, with as many samples per pixel as their
+//! attachments have (the graph's `samples`). One pass may issue several
+//! draws over the same attachments with different fragment entries and
+//! state (say, colour blended, then depth written with the same geometry).
+//! The CPU kernels implement the same state in software; each definition's
+//! `raster()` documents the pairing.
 
 /// A raster pass's draws and attachment load operations.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RasterState {
-    /// Vertices per draw (3 per triangle); ignored when `indirect` is set.
-    pub vertices: u64,
-    /// Where the vertex count lies when an earlier pass writes it.
-    pub indirect: Option<IndirectDraw>,
+    /// What each draw rasterizes.
+    pub geometry: Geometry,
     pub cull: Cull,
     pub color_load: ColorLoad,
     pub depth_load: DepthLoad,
     /// In order; the first one's fragment entry is `Shader::fragment`.
     pub draws: Vec<Draw>,
+}
+
+/// Where a raster pass's triangles come from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Geometry {
+    /// A non-indexed triangle list of this many vertices (3 per triangle),
+    /// from the vertex entry `Shader::entry`.
+    Vertices(u64),
+    /// The same, with the vertex count an earlier pass wrote.
+    Indirect(IndirectDraw),
+    /// Mesh shaders (VK_EXT_mesh_shader): `groups` workgroups of the task
+    /// entry `task`, each launching the mesh entry `Shader::entry`.
+    MeshTasks { task: &'static str, groups: u64 },
 }
 
 /// An indirect draw's arguments: Vulkan's `VkDrawIndirectCommand` (vertex

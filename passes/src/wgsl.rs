@@ -26,8 +26,9 @@ use std::path::{Path, PathBuf};
 /// allows only `atomicMin`/`atomicMax` on storage `atomic<u64>` whose
 /// result is unused; anything else needs `SHADER_INT64_ATOMIC_ALL_OPS`
 /// (docs/architecture.md, "Shaders").
-pub const CAPABILITIES: [Capabilities; 8] = [
+pub const CAPABILITIES: [Capabilities; 9] = [
     Capabilities::EARLY_DEPTH_TEST,
+    Capabilities::MESH_SHADER,
     Capabilities::MULTISAMPLED_SHADING,
     Capabilities::SUBGROUP,
     Capabilities::SUBGROUP_BARRIER,
@@ -213,14 +214,24 @@ impl Shaders {
 
     /// Composes `source` as if it were `file`, with the loaded imports.
     pub fn module_from_source(&mut self, file: &str, source: &str) -> Result<Module, String> {
-        self.composer
-            .make_naga_module(NagaModuleDescriptor {
-                source,
-                file_path: file,
-                shader_type: ShaderType::Wgsl,
-                ..Default::default()
-            })
-            .map_err(|e| e.emit_to_string(&self.composer))
+        // naga_oil 0.23 remaps a mesh pipeline's task payload and mesh
+        // output to the wrong globals, so its own validation of such a
+        // module fails: compose without it, repair, and let the caller
+        // validate (`compose` always does).
+        let mesh = source.contains("enable wgpu_mesh_shader");
+        self.composer.validate = !mesh;
+        let made = self.composer.make_naga_module(NagaModuleDescriptor {
+            source,
+            file_path: file,
+            shader_type: ShaderType::Wgsl,
+            ..Default::default()
+        });
+        self.composer.validate = true;
+        let mut module = made.map_err(|e| e.emit_to_string(&self.composer))?;
+        if mesh {
+            repair_mesh_globals(&mut module).map_err(|e| format!("{file}: {e}"))?;
+        }
+        Ok(module)
     }
 
     /// Composes `file` and finds the capabilities it needs: each one without
@@ -246,11 +257,55 @@ impl Shaders {
     }
 }
 
-/// Validates `module` with `caps`, subgroup operations allowed in compute
-/// and fragment stages.
+/// Points every task and mesh entry point at the module's task payload
+/// (its one `var<task_payload>`) and mesh output (its one `var<workgroup>`
+/// of a struct with `@builtin(vertices)`), which naga_oil loses.
+fn repair_mesh_globals(module: &mut Module) -> Result<(), String> {
+    use naga::{AddressSpace, Binding, BuiltIn, TypeInner};
+    let unique = |what: &str, found: Vec<naga::Handle<naga::GlobalVariable>>| match found[..] {
+        [one] => Ok(one),
+        _ => Err(format!("expected one {what}, found {}", found.len())),
+    };
+    let globals = || module.global_variables.iter();
+    let payloads: Vec<_> = globals()
+        .filter(|(_, g)| g.space == AddressSpace::TaskPayload)
+        .map(|(h, _)| h)
+        .collect();
+    let outputs: Vec<_> = globals()
+        .filter(|(_, g)| {
+            g.space == AddressSpace::WorkGroup
+                && matches!(&module.types[g.ty].inner, TypeInner::Struct { members, .. }
+                    if members.iter().any(|m| m.binding == Some(Binding::BuiltIn(BuiltIn::Vertices))))
+        })
+        .map(|(h, _)| h)
+        .collect();
+    let needs_payload = module.entry_points.iter().any(|e| e.task_payload.is_some());
+    let payload = if needs_payload {
+        Some(unique("`var<task_payload>`", payloads)?)
+    } else {
+        None
+    };
+    let output = if module.entry_points.iter().any(|e| e.mesh_info.is_some()) {
+        Some(unique("mesh output (`var<workgroup>` with `@builtin(vertices)`)", outputs)?)
+    } else {
+        None
+    };
+    for ep in &mut module.entry_points {
+        if ep.task_payload.is_some() {
+            ep.task_payload = payload;
+        }
+        if let (Some(info), Some(out)) = (ep.mesh_info.as_mut(), output) {
+            info.output_variable = out;
+        }
+    }
+    Ok(())
+}
+
+/// Validates `module` with `caps`, subgroup operations allowed in compute,
+/// task, mesh and fragment stages.
 pub fn validate(module: &Module, caps: Capabilities) -> Result<naga::valid::ModuleInfo, String> {
     Validator::new(ValidationFlags::all(), caps)
-        .subgroup_stages(ShaderStages::COMPUTE | ShaderStages::FRAGMENT)
+        .subgroup_stages(ShaderStages::COMPUTE_LIKE | ShaderStages::FRAGMENT)
         .validate(module)
         .map_err(|e| format!("validation with {caps:?}: {e:?}"))
 }
@@ -356,5 +411,18 @@ mod tests {
             .err()
             .unwrap();
         assert!(err.contains("/nonexistent/shaders"), "{err}");
+    }
+}
+#[cfg(test)]
+mod scratch_mesh {
+    #[test]
+    fn mesh_composes() {
+        let mut s = super::Shaders::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders")).unwrap();
+        for f in ["hw_strands/raster.wgsl", "hw_strands/assemble.wgsl", "hw_strands/mesh.wgsl"] {
+            match s.compose(f) {
+                Ok(c) => println!("{f}: {:?}", c.needs),
+                Err(e) => panic!("{f}: {e}"),
+            }
+        }
     }
 }

@@ -13,7 +13,8 @@
 #define LIGHTS_BINDING 7
 #import strandgraph::lipp_dom::frame
 #import strandgraph::clip::transform
-#import strandgraph::lipp::{lerp_vec, safe_normalize, oct_encode, quantize, LOD_WORDS, RASTER_GROUP}
+#import strandgraph::lipp::{LOD_WORDS, RASTER_GROUP}
+#import strandgraph::hw_strands_segment::segment_bits
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, ControlPoint, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
 
 struct AssembleParams {
@@ -35,10 +36,8 @@ const VERTICES_PER_SEGMENT: u32 = 6u;
 
 var<workgroup> first_record: u32;
 
-// hw_strands::Segment::pack: both ends in clip space, then the payload bits
-// the fragment shader completes (payload::pack's layout): word 8 is the low
-// payload word at end a (tangent y, u, v, w, AO), word 9 the tangent's x
-// with end b's w (bits 8-13) and AO (bits 14-19).
+// hw_strands::Segment::words: both ends in clip space, then the payload
+// bits the fragment shader completes (hw_strands/segment.wgsl).
 fn write_segment(r: u32, a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, uv: vec2<f32>) {
     let base = r * SEGMENT_WORDS;
     let ca = transform(frame.view_proj, vec4<f32>(a.pos, 1.0));
@@ -47,15 +46,9 @@ fn write_segment(r: u32, a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: ve
         hw_segments[base + k] = bitcast<u32>(ca[k]);
         hw_segments[base + 4u + k] = bitcast<u32>(cb[k]);
     }
-    let e = oct_encode(safe_normalize(lerp_vec(ta, tb, 0.5)));
-    hw_segments[base + 8u] = (quantize(e.y * 0.5 + 0.5, 255.0) << 24u)
-        | (quantize(uv.x, 63.0) << 18u)
-        | (quantize(uv.y, 63.0) << 12u)
-        | (quantize(a.w, 63.0) << 6u)
-        | quantize(a.ao, 63.0);
-    hw_segments[base + 9u] = quantize(e.x * 0.5 + 0.5, 255.0)
-        | (quantize(b.w, 63.0) << 8u)
-        | (quantize(b.ao, 63.0) << 14u);
+    let bits = segment_bits(a, ta, b, tb, uv);
+    hw_segments[base + 8u] = bits.x;
+    hw_segments[base + 9u] = bits.y;
 }
 
 @compute @workgroup_size(32)

@@ -35,7 +35,9 @@ pub(crate) fn stages(s: Stages) -> vk::PipelineStageFlags2 {
     let mut out = V::NONE;
     for (bit, v) in [
         (Stages::DRAW_INDIRECT, V::DRAW_INDIRECT),
-        (Stages::VERTEX_SHADER, V::VERTEX_SHADER),
+        // Every stage before rasterization: vertex, and task and mesh where
+        // a pass draws with mesh shaders (hw_strands.mesh).
+        (Stages::VERTEX_SHADER, V::PRE_RASTERIZATION_SHADERS),
         (Stages::FRAGMENT_SHADER, V::FRAGMENT_SHADER),
         (Stages::EARLY_FRAGMENT_TESTS, V::EARLY_FRAGMENT_TESTS),
         (Stages::LATE_FRAGMENT_TESTS, V::LATE_FRAGMENT_TESTS),

@@ -58,6 +58,10 @@ pub(crate) struct Gpu {
     /// workgroup memory is the driver's job (as wgpu-hal does on 1.3),
     /// not a loop naga adds to every shader.
     pub zero_init_native: bool,
+    /// VK_EXT_mesh_shader's commands, where a pass draws with mesh shaders.
+    pub mesh: Option<ext::mesh_shader::Device>,
+    /// `maxTaskWorkGroupCount[0]` (0 without VK_EXT_mesh_shader).
+    pub max_task_groups: u32,
     /// Pipeline statistics, when `STRANDGRAPH_PIPELINE_STATS` asks for them.
     pub(crate) stats: Option<crate::stats::Stats>,
 }
@@ -254,13 +258,21 @@ fn create_device(
         .features(want.core)
         .push_next(&mut want12)
         .push_next(&mut want13);
+    let mut want_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default()
+        .mesh_shader(true)
+        .task_shader(true);
+    let mut extensions = Vec::new();
     if stats {
         want2 = want2.push_next(&mut want_stats);
+        extensions.push(ash::khr::pipeline_executable_properties::NAME.as_ptr());
     }
-    let extensions = [ash::khr::pipeline_executable_properties::NAME.as_ptr()];
+    if want.mesh_shader {
+        want2 = want2.push_next(&mut want_mesh);
+        extensions.push(ash::ext::mesh_shader::NAME.as_ptr());
+    }
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queue_infos)
-        .enabled_extension_names(if stats { &extensions[..] } else { &[] })
+        .enabled_extension_names(&extensions)
         .push_next(&mut want2);
     // SAFETY: the create info chain lives on this stack frame.
     let raw = unsafe { instance.create_device(physical, &info, None) }.ctx("vkCreateDevice")?;
@@ -304,6 +316,9 @@ impl Gpu {
         // SAFETY: plain query.
         let memory_props = unsafe { instance.get_physical_device_memory_properties(physical) };
         let stats = stats.then(|| crate::stats::Stats::new(&instance, &device));
+        let mesh = want
+            .mesh_shader
+            .then(|| ext::mesh_shader::Device::new(&instance, &device));
         Ok(Gpu {
             device,
             instance,
@@ -317,6 +332,8 @@ impl Gpu {
             enabled: want.names,
             spirv_caps: want.spirv_caps,
             zero_init_native: want.zero_init_workgroup_memory,
+            mesh,
+            max_task_groups: have.max_task_groups,
             stats,
         })
     }

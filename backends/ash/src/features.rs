@@ -19,6 +19,10 @@ pub(crate) struct Supported {
     pub subgroup_stages: vk::ShaderStageFlags,
     pub subgroup_ops: vk::SubgroupFeatureFlags,
     pub subgroup_size: u32,
+    /// VK_EXT_mesh_shader with both `meshShader` and `taskShader`.
+    pub mesh_shader: bool,
+    /// Its `maxTaskWorkGroupCount[0]` (0 without it).
+    pub max_task_groups: u32,
 }
 
 impl Supported {
@@ -31,6 +35,20 @@ impl Supported {
         // SAFETY: the chain lives on this stack frame.
         unsafe { instance.get_physical_device_features2(physical, &mut f2) };
         let core = f2.features;
+        let mesh_shader = has_extension(instance, physical, ash::ext::mesh_shader::NAME) && {
+            let mut mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default();
+            let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut mesh);
+            // SAFETY: the chain lives on this stack frame; the extension is
+            // supported, so its feature struct may be chained.
+            unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+            mesh.mesh_shader == vk::TRUE && mesh.task_shader == vk::TRUE
+        };
+        let mut mesh_props = vk::PhysicalDeviceMeshShaderPropertiesEXT::default();
+        if mesh_shader {
+            let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut mesh_props);
+            // SAFETY: as above.
+            unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
+        }
         let mut subgroup = vk::PhysicalDeviceSubgroupProperties::default();
         let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut subgroup);
         // SAFETY: as above.
@@ -45,8 +63,18 @@ impl Supported {
             subgroup_stages: subgroup.supported_stages,
             subgroup_ops: subgroup.supported_operations,
             subgroup_size: subgroup.subgroup_size,
+            mesh_shader,
+            max_task_groups: mesh_props.max_task_work_group_count[0],
         }
     }
+}
+
+/// Whether `physical` offers device extension `name`.
+fn has_extension(instance: &ash::Instance, physical: vk::PhysicalDevice, name: &std::ffi::CStr) -> bool {
+    // SAFETY: plain query on a live instance.
+    unsafe { instance.enumerate_device_extension_properties(physical) }
+        .map(|all| all.iter().any(|e| e.extension_name_as_c_str() == Ok(name)))
+        .unwrap_or(false)
 }
 
 /// The features to enable: exactly what the passes need, each checked
@@ -57,6 +85,8 @@ pub(crate) struct Wanted {
     pub buffer_int64_atomics: bool,
     pub dynamic_rendering: bool,
     pub zero_init_workgroup_memory: bool,
+    /// VK_EXT_mesh_shader with `meshShader` and `taskShader`.
+    pub mesh_shader: bool,
     /// For the frame notes.
     pub names: Vec<String>,
     pub spirv_caps: Vec<naga::back::spv::Capability>,
@@ -128,6 +158,20 @@ impl Wanted {
                 seen |= *cap;
                 want.enable(*cap, have)
                     .map_err(|f| missing(&f, pass, why))?;
+            }
+        }
+        // A mesh shader's subgroup operations run in the task and mesh stages.
+        let of_pass = |pass: &str, cap: Capabilities| {
+            needs.caps.iter().any(|(c, p, _)| p == pass && c.contains(cap))
+        };
+        let mesh_stages = vk::ShaderStageFlags::TASK_EXT | vk::ShaderStageFlags::MESH_EXT;
+        for (_, pass, _) in needs.caps.iter().filter(|(c, _, _)| *c == Capabilities::MESH_SHADER) {
+            if of_pass(pass, Capabilities::SUBGROUP) && !have.subgroup_stages.contains(mesh_stages) {
+                return Err(missing(
+                    "subgroup operations in task and mesh shaders",
+                    pass,
+                    "its mesh shader assembles strands with subgroup shuffles",
+                ));
             }
         }
         want.spirv_caps.sort_by_key(|c| *c as u32);
@@ -209,6 +253,14 @@ impl Wanted {
                     }
                 }
                 self.names.push(format!("subgroups ({ops:?})"));
+            }
+            Capabilities::MESH_SHADER => {
+                if !have.mesh_shader {
+                    return Err("VK_EXT_mesh_shader (meshShader and taskShader)".into());
+                }
+                self.mesh_shader = true;
+                self.names.push("VK_EXT_mesh_shader".into());
+                self.spirv_caps.push(C::MeshShadingEXT);
             }
             other => return Err(format!("naga capability {other:?}")),
         }

@@ -17,7 +17,7 @@ use ash::vk;
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::Dispatch;
-use strandgraph_passes::raster_state::RasterState;
+use strandgraph_passes::raster_state::{Geometry, RasterState};
 
 /// How a compute dispatch gets its workgroup count.
 #[derive(Debug, Clone, Copy)]
@@ -40,11 +40,19 @@ pub(crate) enum Work {
         color: Vec<usize>,
         depth: Option<usize>,
         state: RasterState,
-        vertices: u32,
-        /// The draw's arguments (physical resource, byte offset) when indirect.
-        indirect: Option<(usize, u64)>,
+        call: DrawCall,
         extent: [u32; 2],
     },
+}
+
+/// How a raster pass's draws are issued ([`Geometry`]).
+#[derive(Clone)]
+pub(crate) enum DrawCall {
+    Vertices(u32),
+    /// The arguments' physical resource and byte offset.
+    Indirect(usize, u64),
+    /// Task workgroups, with VK_EXT_mesh_shader's commands.
+    MeshTasks(u32, ash::ext::mesh_shader::Device),
 }
 
 /// One pass's pipelines and what they were made from. Fields drop in
@@ -130,6 +138,9 @@ fn build_pass(
     let pass = &cx.plan.graph.passes[prep.p];
     let mut entries = vec![prep.entry];
     if let Some(state) = &prep.raster {
+        if let Geometry::MeshTasks { task, .. } = state.geometry {
+            entries.push(task);
+        }
         entries.extend(state.draws.iter().map(|d| d.fragment));
     }
     let spirv = translate(
@@ -146,7 +157,16 @@ fn build_pass(
         unsafe { d.create_shader_module(&info, None) }
             .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?,
     );
-    let (set_layout, layout) = layouts(gpu, &spirv, prep.raster.is_some())?;
+    let stage_flags = match &prep.raster {
+        Some(state) if matches!(state.geometry, Geometry::MeshTasks { .. }) => {
+            vk::ShaderStageFlags::TASK_EXT
+                | vk::ShaderStageFlags::MESH_EXT
+                | vk::ShaderStageFlags::FRAGMENT
+        }
+        Some(_) => vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+        None => vk::ShaderStageFlags::COMPUTE,
+    };
+    let (set_layout, layout) = layouts(gpu, &spirv, stage_flags)?;
     let (work, sets) = match &prep.raster {
         Some(state) => raster_work(cx, prep, state, module.raw(), layout.raw(), index)?,
         None => compute_work(cx, prep, module.raw(), layout.raw(), index)?,
@@ -162,19 +182,14 @@ fn build_pass(
     Ok((built, sets))
 }
 
-/// The descriptor set layout of the shader's bindings, and a pipeline
-/// layout of that one set.
+/// The descriptor set layout of the shader's bindings, visible to
+/// `stage_flags`, and a pipeline layout of that one set.
 fn layouts(
     gpu: &Gpu,
     spirv: &Spirv,
-    raster: bool,
+    stage_flags: vk::ShaderStageFlags,
 ) -> Result<(Owned<vk::DescriptorSetLayout>, Owned<vk::PipelineLayout>), AshError> {
     let d = &gpu.device;
-    let stage_flags = if raster {
-        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT
-    } else {
-        vk::ShaderStageFlags::COMPUTE
-    };
     let bindings: Vec<vk::DescriptorSetLayoutBinding<'_>> = spirv
         .descriptors
         .iter()

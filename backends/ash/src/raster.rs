@@ -5,11 +5,11 @@ use crate::descriptors::SetPlan;
 use crate::error::AshError;
 use crate::memory::Res;
 use crate::owned::Owned;
-use crate::pipelines::{Context, Work, entry_name};
+use crate::pipelines::{Context, DrawCall, Work, entry_name};
 use crate::prepare::Prepared;
 use ash::vk;
 use strandgraph_graph::schema::Usage;
-use strandgraph_passes::raster_state::{Blend, Compare, Cull, Draw, RasterState};
+use strandgraph_passes::raster_state::{Blend, Compare, Cull, Draw, Geometry, RasterState};
 
 fn compare(c: Compare) -> vk::CompareOp {
     match c {
@@ -99,20 +99,7 @@ pub(crate) fn raster_work(
         .iter()
         .map(|draw| graphics_pipeline(cx, prep, state, draw, &at, module, layout))
         .collect::<Result<Vec<_>, _>>()?;
-    let vertices = u32::try_from(state.vertices)
-        .map_err(|_| cx.pass_error(prep.p, format!("{} vertices are too many", state.vertices)))?;
-    let indirect = state
-        .indirect
-        .map(|i| {
-            prep.bindings
-                .iter()
-                .find(|(n, _, _)| n == i.binding)
-                .map(|(_, r, _)| (*r, i.word as u64 * 4))
-                .ok_or_else(|| {
-                    cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding))
-                })
-        })
-        .transpose()?;
+    let call = draw_call(cx, prep, state)?;
     let bound = prep
         .bindings
         .iter()
@@ -125,8 +112,7 @@ pub(crate) fn raster_work(
         color: at.color,
         depth: at.depth,
         state: state.clone(),
-        vertices,
-        indirect,
+        call,
         extent: at.extent,
     };
     let set = SetPlan {
@@ -135,6 +121,36 @@ pub(crate) fn raster_work(
         bound,
     };
     Ok((work, vec![set]))
+}
+
+/// How the pass's geometry is drawn.
+fn draw_call(cx: &Context<'_>, prep: &Prepared<'_>, state: &RasterState) -> Result<DrawCall, AshError> {
+    let too_many = |what: &str, n: u64| cx.pass_error(prep.p, format!("{n} {what} are too many"));
+    Ok(match state.geometry {
+        Geometry::Vertices(n) => DrawCall::Vertices(u32::try_from(n).map_err(|_| too_many("vertices", n))?),
+        Geometry::Indirect(i) => {
+            let (_, r, _) = prep
+                .bindings
+                .iter()
+                .find(|(n, _, _)| n == i.binding)
+                .ok_or_else(|| cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding)))?;
+            DrawCall::Indirect(*r, i.word as u64 * 4)
+        }
+        Geometry::MeshTasks { groups, .. } => {
+            let n = u32::try_from(groups).map_err(|_| too_many("task workgroups", groups))?;
+            let max = cx.gpu.max_task_groups;
+            if n > max {
+                return Err(cx.pass_error(
+                    prep.p,
+                    format!("{n} task workgroups exceed the device's maxTaskWorkGroupCount[0] of {max}"),
+                ));
+            }
+            let loader = cx.gpu.mesh.clone().ok_or_else(|| {
+                cx.pass_error(prep.p, "draws with mesh shaders on a device without VK_EXT_mesh_shader enabled".into())
+            })?;
+            DrawCall::MeshTasks(n, loader)
+        }
+    })
 }
 
 /// Colour blending of one attachment for `draw`.
@@ -171,18 +187,30 @@ fn graphics_pipeline(
     layout: vk::PipelineLayout,
 ) -> Result<Owned<vk::Pipeline>, AshError> {
     let d = &cx.gpu.device;
-    let vs_name = entry_name(cx, prep.p, prep.entry)?;
+    let first_name = entry_name(cx, prep.p, prep.entry)?;
     let fs_name = entry_name(cx, prep.p, draw.fragment)?;
-    let stages = [
+    let task = match state.geometry {
+        Geometry::MeshTasks { task, .. } => Some(entry_name(cx, prep.p, task)?),
+        _ => None,
+    };
+    let stage = |flags, name| {
         vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::VERTEX)
+            .stage(flags)
             .module(module)
-            .name(&vs_name),
-        vk::PipelineShaderStageCreateInfo::default()
-            .stage(vk::ShaderStageFlags::FRAGMENT)
-            .module(module)
-            .name(&fs_name),
-    ];
+            .name(name)
+    };
+    // Vertex and fragment, or task, mesh and fragment.
+    let stages: Vec<vk::PipelineShaderStageCreateInfo<'_>> = match &task {
+        None => vec![
+            stage(vk::ShaderStageFlags::VERTEX, &first_name),
+            stage(vk::ShaderStageFlags::FRAGMENT, &fs_name),
+        ],
+        Some(task) => vec![
+            stage(vk::ShaderStageFlags::TASK_EXT, task),
+            stage(vk::ShaderStageFlags::MESH_EXT, &first_name),
+            stage(vk::ShaderStageFlags::FRAGMENT, &fs_name),
+        ],
+    };
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
     let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
         .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
@@ -217,10 +245,8 @@ fn graphics_pipeline(
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(&at.color_formats)
         .depth_attachment_format(at.depth_format.unwrap_or(vk::Format::UNDEFINED));
-    let info = vk::GraphicsPipelineCreateInfo::default()
+    let mut info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&assembly)
         .viewport_state(&viewport)
         .rasterization_state(&raster)
         .multisample_state(&multisample)
@@ -229,6 +255,12 @@ fn graphics_pipeline(
         .dynamic_state(&dynamic)
         .layout(layout)
         .push_next(&mut rendering);
+    // A mesh pipeline has no vertex input or input assembly.
+    if task.is_none() {
+        info = info
+            .vertex_input_state(&vertex_input)
+            .input_assembly_state(&assembly);
+    }
     // SAFETY: every pointer in `info` lives on this stack frame.
     let made = unsafe { d.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
     match made {

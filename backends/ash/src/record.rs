@@ -16,7 +16,7 @@ use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
 use crate::memory::{Memory, Res, full_range};
 use crate::owned::{Device, Owned};
-use crate::pipelines::{Built, Launch, Pipelines, Work};
+use crate::pipelines::{Built, DrawCall, Launch, Pipelines, Work};
 use crate::timing::Timestamps;
 use ash::vk;
 use std::sync::Arc;
@@ -417,8 +417,7 @@ unsafe fn record_raster(
     let Work::Raster {
         pipelines,
         set,
-        vertices,
-        indirect,
+        call,
         extent,
         ..
     } = &built.work
@@ -474,14 +473,16 @@ unsafe fn record_raster(
                 &[*set],
                 &[],
             );
-            match indirect {
-                Some((r, offset)) => {
+            match call {
+                DrawCall::Vertices(0) => {}
+                DrawCall::Vertices(n) => d.cmd_draw(cmd, *n, 1, 0, 0),
+                DrawCall::Indirect(r, offset) => {
                     if let Some(Res::Buffer { buffer, .. }) = &memory.res[*r] {
                         d.cmd_draw_indirect(cmd, buffer.raw(), *offset, 1, 16);
                     }
                 }
-                None if *vertices > 0 => d.cmd_draw(cmd, *vertices, 1, 0, 0),
-                None => {}
+                DrawCall::MeshTasks(0, _) => {}
+                DrawCall::MeshTasks(groups, mesh) => mesh.cmd_draw_mesh_tasks(cmd, *groups, 1, 1),
             }
         }
         d.cmd_end_rendering(cmd);

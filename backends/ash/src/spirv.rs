@@ -76,8 +76,13 @@ pub(crate) fn translate(
     }
     descriptors.sort_by_key(|(b, _)| *b);
 
+    // SPV_EXT_mesh_shader needs SPIR-V 1.4; everything else stays at 1.3.
+    let mesh = module
+        .entry_points
+        .iter()
+        .any(|e| matches!(e.stage, naga::ShaderStage::Task | naga::ShaderStage::Mesh));
     let options = spv::Options {
-        lang_version: (1, 3),
+        lang_version: if mesh { (1, 4) } else { (1, 3) },
         flags: spv::WriterFlags::LABEL_VARYINGS,
         fake_missing_bindings: true,
         capabilities: Some(caps.iter().copied().collect()),

@@ -12,6 +12,7 @@
 use crate::barriers::Scope;
 use crate::error::{AshError, VkContext};
 use crate::session::{Frame, Session};
+use crate::pipelines::DrawCall;
 use crate::timing::PassTiming;
 use ash::vk;
 use strandgraph_passes::upload::Upload;
@@ -227,7 +228,10 @@ impl Session {
                             crate::pipelines::Launch::Indirect(..) => 0,
                         })
                         .fold(0u32, u32::saturating_add),
-                    crate::pipelines::Work::Raster { vertices, .. } => *vertices,
+                    crate::pipelines::Work::Raster { call, .. } => match call {
+                        DrawCall::Vertices(n) | DrawCall::MeshTasks(n, _) => *n,
+                        DrawCall::Indirect(..) => 0,
+                    },
                 });
             let mut workgroups = Some(workgroups);
             if let Some(&(_, r, word)) = self.indirect.iter().find(|x| x.0 == i) {

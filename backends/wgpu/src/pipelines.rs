@@ -29,10 +29,18 @@ pub(crate) enum Built {
         color: Vec<wgpu::TextureView>,
         depth: Option<wgpu::TextureView>,
         state: Box<RasterState>,
-        vertices: u32,
-        /// The draw's arguments (physical resource, byte offset) when indirect.
-        indirect: Option<(usize, u64)>,
+        call: DrawCall,
     },
+}
+
+/// How a raster pass's draws are issued ([`Geometry`](strandgraph_passes::raster_state::Geometry)).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum DrawCall {
+    Vertices(u32),
+    /// The arguments' physical resource and byte offset.
+    Indirect(usize, u64),
+    /// Task workgroups of a mesh pipeline.
+    MeshTasks(u32),
 }
 
 /// Everything one pass needs to record, from its prepared form.

@@ -2,7 +2,7 @@
 //! each inside begin/end timestamp writes.
 
 use super::*;
-use crate::pipelines::{Built, color_op, depth_op};
+use crate::pipelines::{Built, DrawCall, color_op, depth_op};
 
 /// The query set and its resolve buffer, two timestamps per pass.
 pub(crate) struct Timestamps {
@@ -50,8 +50,7 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
                 color,
                 depth,
                 state,
-                vertices,
-                indirect,
+                call,
             } => {
                 let color_attachments: Vec<Option<wgpu::RenderPassColorAttachment<'_>>> = color
                     .iter()
@@ -94,12 +93,20 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
                     rp.set_pipeline(pipeline);
                     rp.set_bind_group(0, bind_group, &[]);
                     // No vertex buffers: the vertex shader fetches (shader headers).
-                    match indirect.and_then(|(r, offset)| Some((buffer_of(r)?, offset))) {
-                        Some((buffer, offset)) => rp.draw_indirect(buffer, offset),
-                        None => rp.draw(0..*vertices, 0..1),
+                    match *call {
+                        DrawCall::Vertices(n) => rp.draw(0..n, 0..1),
+                        DrawCall::Indirect(r, offset) => {
+                            if let Some(buffer) = buffer_of(r) {
+                                rp.draw_indirect(buffer, offset);
+                            }
+                        }
+                        DrawCall::MeshTasks(groups) => rp.draw_mesh_tasks(groups, 1, 1),
                     }
                 }
-                workgroups.push(*vertices);
+                workgroups.push(match *call {
+                    DrawCall::Vertices(n) | DrawCall::MeshTasks(n) => n,
+                    DrawCall::Indirect(..) => 0,
+                });
             }
             Built::Compute {
                 pipeline,

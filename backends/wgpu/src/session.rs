@@ -66,6 +66,7 @@ impl WgpuBackend {
             label: Some("strandgraph"),
             required_features: features,
             required_limits: adapter.limits(),
+            experimental_features: experimental(features),
             ..Default::default()
         }))
         .map_err(|e| WgpuError::Device(e.to_string()))?;
@@ -147,6 +148,22 @@ impl Session {
 
 /// Only the features the plan's passes need, each missing one named with
 /// the pass that needs it.
+/// wgpu 30 exposes mesh shaders only to a device created with its
+/// experimental-features token; ask for it only when a pass needs them.
+fn experimental(features: wgpu::Features) -> wgpu::ExperimentalFeatures {
+    if features.contains(wgpu::Features::EXPERIMENTAL_MESH_SHADER) {
+        // SAFETY: the token acknowledges that experimental APIs may have
+        // bugs; only the mesh-shader pass (`hw_strands.mesh`) uses one, and
+        // it is checked against the CPU simulator (tests/diff_hw_mesh.rs).
+        #[allow(unsafe_code)]
+        unsafe {
+            wgpu::ExperimentalFeatures::enabled()
+        }
+    } else {
+        wgpu::ExperimentalFeatures::disabled()
+    }
+}
+
 fn required_features(
     adapter: &wgpu::Adapter,
     adapter_name: &str,

@@ -9,8 +9,15 @@ use naga::valid::Capabilities;
 /// gives `FLOAT64`, `SHADER_EARLY_DEPTH_TEST` gives `EARLY_DEPTH_TEST`
 /// (`MULTISAMPLED_SHADING` is no feature: the downlevel flag of that name,
 /// which every Vulkan adapter with sampleRateShading has, gives it), `SHADER_INT64` gives `SHADER_INT64`, and the two int64
-/// atomic features give their capabilities.
-pub const CAPABILITY_FEATURES: [(Capabilities, wgpu::Features, &str); 7] = [
+/// atomic features give their capabilities; `EXPERIMENTAL_MESH_SHADER`
+/// gives `MESH_SHADER` (and needs the device's experimental-features
+/// token, `session.rs`).
+pub const CAPABILITY_FEATURES: [(Capabilities, wgpu::Features, &str); 8] = [
+    (
+        Capabilities::MESH_SHADER,
+        wgpu::Features::EXPERIMENTAL_MESH_SHADER,
+        "EXPERIMENTAL_MESH_SHADER",
+    ),
     (
         Capabilities::EARLY_DEPTH_TEST,
         wgpu::Features::SHADER_EARLY_DEPTH_TEST,

@@ -16,7 +16,7 @@ use crate::describe::PassKind;
 use crate::hardware_raster::Setup;
 use crate::kernel::{CounterValues, Ctx};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, RasterState};
+use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
@@ -125,8 +125,7 @@ pub static RASTER: PassKind<RasterBenchParams, RasterBenchGpu> = PassKind {
 /// Colour only, no depth, no culling, replacing what is there.
 fn draw(p: &RasterBenchParams, q: &Quantities) -> RasterState {
     RasterState {
-        vertices: 3 * p.triangles(q.width, q.height),
-        indirect: None,
+        geometry: Geometry::Vertices(3 * p.triangles(q.width, q.height)),
         cull: Cull::None,
         color_load: ColorLoad::Clear([0.0; 4]),
         depth_load: DepthLoad::Load,

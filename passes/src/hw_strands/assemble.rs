@@ -100,7 +100,7 @@ struct AssembleKernel(AssembleParams);
 /// The record of segment (a, b) with end tangents ta, tb (the WGSL's
 /// `write_segment`): the tangent at the middle, packed once per segment
 /// as `lipp.raster` packs it with `segment_payload` on.
-fn record(
+pub(super) fn record(
     view_proj: &[f32; 16],
     (a, ta): (&ControlPoint, [f32; 3]),
     (b, tb): (&ControlPoint, [f32; 3]),

@@ -26,6 +26,7 @@
 
 pub mod assemble;
 pub mod raster;
+pub mod mesh;
 #[cfg(test)]
 mod raster_tests;
 

@@ -32,14 +32,14 @@ use crate::kernel::{CounterValues, Ctx, Words};
 use crate::layout::{FrameData, read};
 use crate::params::{Invalid, PassParams};
 use crate::raster_state::{
-    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, IndirectDraw, RasterState,
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, IndirectDraw, RasterState,
 };
 use glam::{Vec2, Vec4};
 use std::sync::RwLock;
 use strandgraph_graph::Quantities;
 
 /// Bands of rows the CPU kernel rasterizes in parallel.
-const BANDS: u32 = 64;
+pub(super) const BANDS: u32 = 64;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -106,7 +106,7 @@ pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
         entry: "vs_main",
         fragment: Some("fs_main"),
     },
-    kernel: |p| Box::new(RasterKernel::new(*p)),
+    kernel: |p| Box::new(RasterKernel(QuadRaster::new(*p))),
     gpu: |p, q| RasterGpu {
         width_px: p.width,
         width: q.width,
@@ -120,12 +120,17 @@ pub static RASTER: PassKind<RasterParams, RasterGpu> = PassKind {
 
 /// An indirect draw of the assembled segments, early depth tests, no colour.
 fn draw(_: &RasterParams, _: &Quantities) -> RasterState {
+    quads(Geometry::Indirect(IndirectDraw {
+        binding: "hw_draw_args",
+        word: 0,
+    }))
+}
+
+/// `geometry` drawn as quads: early depth tests, no colour (shared with
+/// `hw_strands.mesh`).
+pub(super) fn quads(geometry: Geometry) -> RasterState {
     RasterState {
-        vertices: 0,
-        indirect: Some(IndirectDraw {
-            binding: "hw_draw_args",
-            word: 0,
-        }),
+        geometry,
         cull: Cull::None,
         color_load: ColorLoad::Load,
         depth_load: DepthLoad::Load,
@@ -146,7 +151,26 @@ struct Triangle {
     segment: Segment,
 }
 
-struct RasterKernel {
+struct RasterKernel(QuadRaster);
+
+impl CpuKernel for RasterKernel {
+    fn prologue(&self, ctx: &Ctx<'_>) {
+        let (records, args) = (ctx.words("hw_segments"), ctx.words("hw_draw_args"));
+        let count = (args.load(0) / VERTICES_PER_SEGMENT) as usize;
+        let count = count.min(records.len() / SEGMENT_WORDS);
+        self.0.bin(ctx, count, |i| load_segment(&records, i));
+    }
+
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let records = ctx.words("hw_segments");
+        self.0.draw_band(group, ctx, |i| load_segment(&records, i));
+    }
+}
+
+/// The hardware rasterizer's work on the CPU, shared with `hw_strands.mesh`:
+/// the quads of segments `0..count` (fetched by index), drawn in index order
+/// in [`BANDS`] bands of rows.
+pub(super) struct QuadRaster {
     p: RasterParams,
     /// Per band of rows, the segments whose quads may reach it, in draw
     /// order: the prologue's work, redone every frame. Bands set their
@@ -154,11 +178,68 @@ struct RasterKernel {
     bands: RwLock<Vec<Vec<u32>>>,
 }
 
-impl RasterKernel {
-    fn new(p: RasterParams) -> Self {
+impl QuadRaster {
+    pub(super) fn new(p: RasterParams) -> Self {
         Self {
             p,
             bands: RwLock::new(Vec::new()),
+        }
+    }
+
+    fn view(&self, ctx: &Ctx<'_>) -> View {
+        let f: FrameData = read(&ctx.words("frame"), 0);
+        View {
+            near: f.near,
+            half: 0.5 * self.p.width,
+            width: ctx.quantities.width,
+            height: ctx.quantities.height,
+        }
+    }
+
+    /// The prologue: which bands each of segments `0..count` may reach.
+    pub(super) fn bin(&self, ctx: &Ctx<'_>, count: usize, segment: impl Fn(usize) -> Segment + Sync) {
+        use rayon::prelude::*;
+        let view = self.view(ctx);
+        let rows: Vec<Option<(u32, u32)>> = (0..count)
+            .into_par_iter()
+            .map(|i| view.rows(&segment(i)))
+            .collect();
+        let per_band = view.height.div_ceil(BANDS).max(1);
+        let mut bands = vec![Vec::new(); BANDS as usize];
+        for (i, r) in rows.iter().enumerate() {
+            if let Some((y0, y1)) = r {
+                for band in &mut bands[(y0 / per_band) as usize..=(y1 / per_band) as usize] {
+                    band.push(i as u32);
+                }
+            }
+        }
+        *self.bands.write().unwrap_or_else(|e| e.into_inner()) = bands;
+    }
+
+    /// Workgroup `group`: its band's rows of every binned quad.
+    pub(super) fn draw_band(&self, group: u32, ctx: &Ctx<'_>, segment: impl Fn(usize) -> Segment) {
+        let bands = self.bands.read().unwrap_or_else(|e| e.into_inner());
+        let view = self.view(ctx);
+        let rows = view.height.div_ceil(BANDS);
+        let (first, last) = (group * rows, ((group + 1) * rows).min(view.height));
+        let Some(list) = bands.get(group as usize) else {
+            return;
+        };
+        if first >= last {
+            return;
+        }
+        let band = Band::load(ctx, &self.p);
+        let samples = standard_samples(band.samples);
+        let mut counters = CounterValues::default();
+        for &i in list {
+            for tri in view.triangles(&segment(i as usize)) {
+                tri.setup.rasterize_samples(first, last - 1, &samples, |f| {
+                    band.fragment(&tri, &f, &mut counters);
+                });
+            }
+        }
+        if ctx.instrument {
+            ctx.counters.add(&counters);
         }
     }
 }
@@ -218,69 +299,6 @@ impl View {
 fn load_segment(records: &Words<'_>, i: usize) -> Segment {
     let words: [u32; SEGMENT_WORDS] = std::array::from_fn(|k| records.load(i * SEGMENT_WORDS + k));
     Segment::from_words(&words)
-}
-
-impl RasterKernel {
-    fn view(&self, ctx: &Ctx<'_>) -> View {
-        let f: FrameData = read(&ctx.words("frame"), 0);
-        View {
-            near: f.near,
-            half: 0.5 * self.p.width,
-            width: ctx.quantities.width,
-            height: ctx.quantities.height,
-        }
-    }
-}
-
-impl CpuKernel for RasterKernel {
-    fn prologue(&self, ctx: &Ctx<'_>) {
-        use rayon::prelude::*;
-        let view = self.view(ctx);
-        let (records, args) = (ctx.words("hw_segments"), ctx.words("hw_draw_args"));
-        let count = (args.load(0) / VERTICES_PER_SEGMENT) as usize;
-        let count = count.min(records.len() / SEGMENT_WORDS);
-        let rows: Vec<Option<(u32, u32)>> = (0..count)
-            .into_par_iter()
-            .map(|i| view.rows(&load_segment(&records, i)))
-            .collect();
-        let per_band = view.height.div_ceil(BANDS).max(1);
-        let mut bands = vec![Vec::new(); BANDS as usize];
-        for (i, r) in rows.iter().enumerate() {
-            if let Some((y0, y1)) = r {
-                for band in &mut bands[(y0 / per_band) as usize..=(y1 / per_band) as usize] {
-                    band.push(i as u32);
-                }
-            }
-        }
-        *self.bands.write().unwrap_or_else(|e| e.into_inner()) = bands;
-    }
-
-    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let bands = self.bands.read().unwrap_or_else(|e| e.into_inner());
-        let view = self.view(ctx);
-        let rows = view.height.div_ceil(BANDS);
-        let (first, last) = (group * rows, ((group + 1) * rows).min(view.height));
-        let Some(list) = bands.get(group as usize) else {
-            return;
-        };
-        if first >= last {
-            return;
-        }
-        let records = ctx.words("hw_segments");
-        let band = Band::load(ctx, &self.p);
-        let samples = standard_samples(band.samples);
-        let mut counters = CounterValues::default();
-        for &i in list {
-            for tri in view.triangles(&load_segment(&records, i as usize)) {
-                tri.setup.rasterize_samples(first, last - 1, &samples, |f| {
-                    band.fragment(&tri, &f, &mut counters);
-                });
-            }
-        }
-        if ctx.instrument {
-            ctx.counters.add(&counters);
-        }
-    }
 }
 
 /// What every fragment of a band reads and writes.

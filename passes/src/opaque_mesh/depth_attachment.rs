@@ -13,7 +13,7 @@ use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::params::NoParams;
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, RasterState};
+use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
 use strandgraph_graph::Quantities;
 
 crate::gpu_block! {
@@ -43,8 +43,7 @@ pub static DEPTH_ATTACHMENT: PassKind<NoParams, DepthAttachmentGpu> = PassKind {
 /// One full-screen triangle writing `frag_depth` wherever it lands.
 fn draw(_: &NoParams, _: &Quantities) -> RasterState {
     RasterState {
-        vertices: 3,
-        indirect: None,
+        geometry: Geometry::Vertices(3),
         cull: Cull::None,
         color_load: ColorLoad::Load,
         depth_load: DepthLoad::Clear(1.0),

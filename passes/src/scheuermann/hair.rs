@@ -28,7 +28,7 @@ use super::shading::Shading;
 use crate::contract::{Binding, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, RasterState};
+use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
 use glam::Vec3;
 use strandgraph_assets::hairpatch::PATCH_SEGMENTS;
 use strandgraph_graph::Quantities;
@@ -280,8 +280,7 @@ pub(super) fn stage_state(stage: Stage, p: &HairParams, q: &Quantities) -> Raste
         ),
     };
     RasterState {
-        vertices: if p.enabled { 3 * triangles(q) } else { 0 },
-        indirect: None,
+        geometry: Geometry::Vertices(if p.enabled { 3 * triangles(q) } else { 0 }),
         cull,
         color_load: ColorLoad::Load,
         depth_load: DepthLoad::Load,

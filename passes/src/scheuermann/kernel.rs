@@ -17,7 +17,7 @@ use crate::kernel::{CounterValues, Ctx, Words};
 use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::kulikov::transform;
 use crate::layout::{FrameData, LightData, ModelData, read};
-use crate::raster_state::{Blend, Compare, Draw};
+use crate::raster_state::{Blend, Compare, Draw, Geometry};
 use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 use std::sync::RwLock;
@@ -111,7 +111,11 @@ impl CpuKernel for HairKernel {
         let (vertices, models) = (ctx.words("patches.vertices"), ctx.words("patches.models"));
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let state = stage_state(self.stage, &self.p, &ctx.quantities);
-        let list = (0..(state.vertices / 3) as u32)
+        let vertices_drawn = match state.geometry {
+            Geometry::Vertices(n) => n,
+            _ => 0,
+        };
+        let list = (0..(vertices_drawn / 3) as u32)
             .into_par_iter()
             .filter_map(|t| {
                 let corners =

@@ -2,7 +2,9 @@
 //! and the translation of the pass's draw state into wgpu's.
 
 use super::*;
-use strandgraph_passes::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw};
+use strandgraph_passes::raster_state::{
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry,
+};
 
 /// Which of a raster pass's bindings are attachments, and which are bound.
 struct Attachments {
@@ -52,8 +54,24 @@ pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<
         let bind_group = cx.bind_group(&pipeline.get_bind_group_layout(0), &entries);
         draws.push((pipeline, bind_group));
     }
-    let vertices = u32::try_from(state.vertices)
-        .map_err(|_| cx.error(format!("{} vertices are too many", state.vertices)))?;
+    let call = match state.geometry {
+        Geometry::Vertices(n) => DrawCall::Vertices(
+            u32::try_from(n).map_err(|_| cx.error(format!("{n} vertices are too many")))?,
+        ),
+        Geometry::Indirect(i) => {
+            let (_, r) = cx
+                .prep
+                .bindings
+                .iter()
+                .find(|(n, _)| n == i.binding)
+                .ok_or_else(|| cx.error(format!("indirect `{}` is not bound", i.binding)))?;
+            DrawCall::Indirect(*r, i.word as u64 * 4)
+        }
+        Geometry::MeshTasks { groups, .. } => DrawCall::MeshTasks(
+            u32::try_from(groups)
+                .map_err(|_| cx.error(format!("{groups} task workgroups are too many")))?,
+        ),
+    };
     Ok(Built::Raster {
         draws,
         color: at
@@ -63,18 +81,7 @@ pub(super) fn build_raster(cx: &PassContext<'_>, state: &RasterState) -> Result<
             .collect::<Result<_, _>>()?,
         depth: at.depth.map(|b| attachment_view(cx, b)).transpose()?,
         state: Box::new(state.clone()),
-        vertices,
-        indirect: state
-            .indirect
-            .map(|i| {
-                cx.prep
-                    .bindings
-                    .iter()
-                    .find(|(n, _)| n == i.binding)
-                    .map(|(_, r)| (*r, i.word as u64 * 4))
-                    .ok_or_else(|| cx.error(format!("indirect `{}` is not bound", i.binding)))
-            })
-            .transpose()?,
+        call,
     })
 }
 
@@ -95,6 +102,48 @@ fn render_pipeline(
         Some(b) => Some(depth_state(attachment_format(cx, b)?, d)),
         None => None,
     };
+    let primitive = wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: match state.cull {
+                    Cull::None => None,
+                    Cull::Back => Some(wgpu::Face::Back),
+                    Cull::Front => Some(wgpu::Face::Front),
+                },
+                ..Default::default()
+            };
+    let multisample = wgpu::MultisampleState {
+        count: at.samples,
+        ..Default::default()
+    };
+    let fragment = Some(wgpu::FragmentState {
+        module: &cx.module,
+        entry_point: Some(d.fragment),
+        compilation_options: Default::default(),
+        targets: &targets,
+    });
+    if let Geometry::MeshTasks { task, .. } = state.geometry {
+        return Ok(cx.device.create_mesh_pipeline(&wgpu::MeshPipelineDescriptor {
+            label: Some(cx.name),
+            layout: None,
+            task: Some(wgpu::TaskState {
+                module: &cx.module,
+                entry_point: Some(task),
+                compilation_options: Default::default(),
+            }),
+            mesh: wgpu::MeshState {
+                module: &cx.module,
+                entry_point: Some(cx.prep.entry),
+                compilation_options: Default::default(),
+            },
+            primitive,
+            depth_stencil,
+            multisample,
+            fragment,
+            multiview: None,
+            cache: None,
+        }));
+    }
     Ok(cx
         .device
         .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -106,27 +155,10 @@ fn render_pipeline(
                 compilation_options: Default::default(),
                 buffers: &[],
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: match state.cull {
-                    Cull::None => None,
-                    Cull::Back => Some(wgpu::Face::Back),
-                    Cull::Front => Some(wgpu::Face::Front),
-                },
-                ..Default::default()
-            },
+            primitive,
             depth_stencil,
-            multisample: wgpu::MultisampleState {
-                count: at.samples,
-                ..Default::default()
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &cx.module,
-                entry_point: Some(d.fragment),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
+            multisample,
+            fragment,
             multiview_mask: None,
             cache: None,
         }))
