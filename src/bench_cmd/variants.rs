@@ -324,12 +324,80 @@ pub const VARIANTS: &[Variant] = &[
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
     },
+    // The same quads from mesh shaders (scenes/graphs/hw_mesh.ron): a task
+    // workgroup per bundle applying the LOD, strands assembled in mesh
+    // workgroups, Bhokare et al.'s pipeline shape. Skipped where the device
+    // has no mesh shaders.
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 1",
+        graph: HW_MESH,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=1",
+            "filter.msaa=1",
+        ],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 4",
+        graph: HW_MESH,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=4",
+            "filter.msaa=4",
+        ],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 8",
+        graph: HW_MESH,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "strand_depth.samples=8",
+            "filter.msaa=8",
+        ],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 1+L",
+        graph: HW_MESH,
+        overrides: &["strand_depth.samples=1", "filter.msaa=1"],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 4+L",
+        graph: HW_MESH,
+        overrides: &["strand_depth.samples=4", "filter.msaa=4"],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
+    Variant {
+        pipeline: "HW mesh",
+        name: "MS 8+L",
+        graph: HW_MESH,
+        overrides: &["strand_depth.samples=8", "filter.msaa=8"],
+        raster: &["mesh"],
+        ceiling: "fragments",
+    },
 ];
 
 const LIPP: &str = "scenes/graphs/lipp.ron";
 const LIPP_MSAA: &str = "scenes/graphs/lipp_msaa.ron";
 const SCHEUERMANN: &str = "scenes/graphs/scheuermann.ron";
 const HW_STRANDS: &str = "scenes/graphs/hw_strands.ron";
+const HW_MESH: &str = "scenes/graphs/hw_mesh.ron";
 /// Strand generation and rasterization, as Lipp's raster column counts both.
 const HW_STRANDS_PASSES: [&str; 2] = ["assemble", "raster"];
 /// Its hair passes, all hardware raster.

@@ -203,6 +203,42 @@ mod tests {
     }
 
     #[test]
+    fn mesh_shaders_translate_to_spirv_1_4_with_mesh_shading() {
+        use spv::Capability as C;
+        let mut shaders = Shaders::embedded().unwrap();
+        let composed = shaders.compose("hw_strands/mesh.wgsl").unwrap();
+        let caps = [
+            C::Shader,
+            C::ImageQuery,
+            C::MeshShadingEXT,
+            C::SampleRateShading,
+            C::Int64,
+            C::Int64Atomics,
+            C::GroupNonUniform,
+            C::GroupNonUniformShuffle,
+            C::GroupNonUniformShuffleRelative,
+        ];
+        let s = translate(
+            &composed,
+            &["ms_main", "ts_main", "fs_main"],
+            &caps,
+            false,
+            "mesh",
+            "test",
+        )
+        .unwrap();
+        assert_eq!(s.words[1], 0x0001_0400, "SPIR-V 1.4");
+        assert!(declared_capabilities(&s.words).contains(&(C::MeshShadingEXT as u32)));
+        // Without the capability, the error names it and the pass.
+        let without: Vec<C> = caps.into_iter().filter(|c| *c != C::MeshShadingEXT).collect();
+        let text = translate(&composed, &["ms_main"], &without, false, "mesh", "test")
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(text.contains("`mesh`") && text.contains("MeshShading"), "{text}");
+    }
+
+    #[test]
     fn a_capability_the_device_lacks_names_the_pass() {
         let mut shaders = Shaders::embedded().unwrap();
         let composed = shaders.compose("kulikov/lod.wgsl").unwrap();
