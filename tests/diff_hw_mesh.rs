@@ -25,7 +25,11 @@ const H: u32 = 120;
 
 fn prepared(test: &str, graph: &str, overrides: &[&str]) -> Prepared {
     // One scene file per graph and test: the tests run in parallel.
-    let stem = graph.rsplit('/').next().unwrap_or(graph).trim_end_matches(".ron");
+    let stem = graph
+        .rsplit('/')
+        .next()
+        .unwrap_or(graph)
+        .trim_end_matches(".ron");
     let scene: PathBuf = two_grooms(&format!("diff_hw_mesh/{test}_{stem}"), graph, W, H);
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     prepare_with(&scene, None, Some((W, H)), &overrides).unwrap_or_else(|e| panic!("{e:?}"))
@@ -33,7 +37,10 @@ fn prepared(test: &str, graph: &str, overrides: &[&str]) -> Prepared {
 
 /// G-buffer words of both grooms (none of the runs aliases memory).
 fn gbuffers(read: &dyn Fn(&str) -> Vec<u32>) -> Vec<u32> {
-    ["gbuffer", "gbuffer[1]"].iter().flat_map(|g| read(g)).collect()
+    ["gbuffer", "gbuffer[1]"]
+        .iter()
+        .flat_map(|g| read(g))
+        .collect()
 }
 
 /// Samples holding a strand: pairs of words not both `u32::MAX`.
@@ -66,7 +73,14 @@ fn on_the_cpu_mesh_shaders_draw_the_quads_the_indirect_draw_does() {
     );
     let out = a.read(&mesh.plan, "output").unwrap();
     let reference = b.read(&records.plan, "output").unwrap();
-    check_flip(&mesh, "diff_hw_mesh", "mesh-vs-records", &reference, &out, 0.001);
+    check_flip(
+        &mesh,
+        "diff_hw_mesh",
+        "mesh-vs-records",
+        &reference,
+        &out,
+        0.001,
+    );
 }
 
 /// One GPU backend's result: agreement with the CPU where it ran, the
@@ -117,7 +131,14 @@ fn gpu_backends(overrides: &[&str]) {
         let read = |g: &str| s.read(g).unwrap().unwrap();
         (gbuffers(&read), read("output"))
     });
-    check_gpu(&p, "ash", ash, "VK_EXT_mesh_shader", &cpu_image, cpu_covered);
+    check_gpu(
+        &p,
+        "ash",
+        ash,
+        "VK_EXT_mesh_shader",
+        &cpu_image,
+        cpu_covered,
+    );
 
     let wgpu = strandgraph_wgpu::WgpuBackend::default()
         .execute(&p.plan, &p.instance, &p.upload)
@@ -126,7 +147,14 @@ fn gpu_backends(overrides: &[&str]) {
             let read = |g: &str| f.read(&p.plan, g).unwrap().unwrap();
             (gbuffers(&read), read("output"))
         });
-    check_gpu(&p, "wgpu", wgpu, "EXPERIMENTAL_MESH_SHADER", &cpu_image, cpu_covered);
+    check_gpu(
+        &p,
+        "wgpu",
+        wgpu,
+        "EXPERIMENTAL_MESH_SHADER",
+        &cpu_image,
+        cpu_covered,
+    );
 }
 
 #[test]

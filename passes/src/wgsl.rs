@@ -286,7 +286,10 @@ fn repair_mesh_globals(module: &mut Module) -> Result<(), String> {
         None
     };
     let output = if module.entry_points.iter().any(|e| e.mesh_info.is_some()) {
-        Some(unique("mesh output (`var<workgroup>` with `@builtin(vertices)`)", outputs)?)
+        Some(unique(
+            "mesh output (`var<workgroup>` with `@builtin(vertices)`)",
+            outputs,
+        )?)
     } else {
         None
     };
@@ -411,18 +414,5 @@ mod tests {
             .err()
             .unwrap();
         assert!(err.contains("/nonexistent/shaders"), "{err}");
-    }
-}
-#[cfg(test)]
-mod scratch_mesh {
-    #[test]
-    fn mesh_composes() {
-        let mut s = super::Shaders::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders")).unwrap();
-        for f in ["hw_strands/raster.wgsl", "hw_strands/assemble.wgsl", "hw_strands/mesh.wgsl"] {
-            match s.compose(f) {
-                Ok(c) => println!("{f}: {:?}", c.needs),
-                Err(e) => panic!("{f}: {e}"),
-            }
-        }
     }
 }

@@ -70,7 +70,11 @@ impl Supported {
 }
 
 /// Whether `physical` offers device extension `name`.
-fn has_extension(instance: &ash::Instance, physical: vk::PhysicalDevice, name: &std::ffi::CStr) -> bool {
+fn has_extension(
+    instance: &ash::Instance,
+    physical: vk::PhysicalDevice,
+    name: &std::ffi::CStr,
+) -> bool {
     // SAFETY: plain query on a live instance.
     unsafe { instance.enumerate_device_extension_properties(physical) }
         .map(|all| all.iter().any(|e| e.extension_name_as_c_str() == Ok(name)))
@@ -162,11 +166,19 @@ impl Wanted {
         }
         // A mesh shader's subgroup operations run in the task and mesh stages.
         let of_pass = |pass: &str, cap: Capabilities| {
-            needs.caps.iter().any(|(c, p, _)| p == pass && c.contains(cap))
+            needs
+                .caps
+                .iter()
+                .any(|(c, p, _)| p == pass && c.contains(cap))
         };
         let mesh_stages = vk::ShaderStageFlags::TASK_EXT | vk::ShaderStageFlags::MESH_EXT;
-        for (_, pass, _) in needs.caps.iter().filter(|(c, _, _)| *c == Capabilities::MESH_SHADER) {
-            if of_pass(pass, Capabilities::SUBGROUP) && !have.subgroup_stages.contains(mesh_stages) {
+        for (_, pass, _) in needs
+            .caps
+            .iter()
+            .filter(|(c, _, _)| *c == Capabilities::MESH_SHADER)
+        {
+            if of_pass(pass, Capabilities::SUBGROUP) && !have.subgroup_stages.contains(mesh_stages)
+            {
                 return Err(missing(
                     "subgroup operations in task and mesh shaders",
                     pass,

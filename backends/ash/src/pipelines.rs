@@ -56,13 +56,13 @@ pub(crate) enum DrawCall {
 }
 
 /// One pass's pipelines and what they were made from. Fields drop in
-/// order: pipelines before their layouts, layouts before the module.
+/// order: pipelines before their layouts, layouts before the modules.
 pub(crate) struct Built {
     pub p: PassId,
     pub work: Work,
     pub layout: Owned<vk::PipelineLayout>,
     pub set_layout: Owned<vk::DescriptorSetLayout>,
-    _module: Owned<vk::ShaderModule>,
+    _modules: Modules,
     /// `(binding, type)` the shader declares, for its descriptor sets.
     pub descriptors: Vec<(u32, vk::DescriptorType)>,
 }
@@ -126,7 +126,19 @@ pub(crate) fn entry_name(
     std::ffi::CString::new(name).map_err(|_| cx.pass_error(p, "entry name has a NUL".into()))
 }
 
-/// The shader module, layouts and pipelines of one pass (the `index`-th
+/// A pass's shader modules: one for every entry point (named ""), or one
+/// per entry point.
+pub(crate) struct Modules(Vec<(String, Owned<vk::ShaderModule>)>);
+
+impl Modules {
+    /// The module holding entry point `entry`.
+    pub fn of(&self, entry: &str) -> vk::ShaderModule {
+        let found = self.0.iter().find(|(e, _)| e.is_empty() || e == entry);
+        found.map_or(vk::ShaderModule::null(), |(_, m)| m.raw())
+    }
+}
+
+/// The shader modules, layouts and pipelines of one pass (the `index`-th
 /// built), and the descriptor sets it needs.
 fn build_pass(
     cx: &Context<'_>,
@@ -143,20 +155,41 @@ fn build_pass(
         }
         entries.extend(state.draws.iter().map(|d| d.fragment));
     }
-    let spirv = translate(
-        &prep.composed,
-        &entries,
-        &gpu.spirv_caps,
-        gpu.zero_init_native,
-        &pass.name,
-        &gpu.name,
-    )?;
-    let info = vk::ShaderModuleCreateInfo::default().code(&spirv.words);
-    // SAFETY: valid SPIR-V words from naga.
-    let module = d.own(
-        unsafe { d.create_shader_module(&info, None) }
-            .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?,
-    );
+    let mesh = matches!(&prep.raster, Some(s) if matches!(s.geometry, Geometry::MeshTasks { .. }));
+    let spirv_of = |only: Option<&&str>| {
+        let entries = only.map_or(&entries[..], std::slice::from_ref);
+        translate(
+            &prep.composed,
+            entries,
+            only.copied(),
+            &gpu.spirv_caps,
+            gpu.zero_init_native,
+            &pass.name,
+            &gpu.name,
+        )
+    };
+    let spirv = spirv_of(None)?;
+    let module_of = |words: &[u32]| -> Result<Owned<vk::ShaderModule>, AshError> {
+        let info = vk::ShaderModuleCreateInfo::default().code(words);
+        // SAFETY: valid SPIR-V words from naga.
+        Ok(d.own(
+            unsafe { d.create_shader_module(&info, None) }
+                .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?,
+        ))
+    };
+    // A mesh pipeline gets one module per stage, each holding only its
+    // entry point, as wgpu-hal builds them; every other pass one module.
+    // On the H100 (driver 580.159.04) one module holding the task, mesh and
+    // fragment entry points passed spirv-val, but its first draw never
+    // completed; the same stages as three modules render.
+    let modules = if mesh {
+        let per_entry = entries
+            .iter()
+            .map(|&e| Ok((e.to_string(), module_of(&spirv_of(Some(&e))?.words)?)));
+        Modules(per_entry.collect::<Result<_, AshError>>()?)
+    } else {
+        Modules(vec![(String::new(), module_of(&spirv.words)?)])
+    };
     let stage_flags = match &prep.raster {
         Some(state) if matches!(state.geometry, Geometry::MeshTasks { .. }) => {
             vk::ShaderStageFlags::TASK_EXT
@@ -168,15 +201,15 @@ fn build_pass(
     };
     let (set_layout, layout) = layouts(gpu, &spirv, stage_flags)?;
     let (work, sets) = match &prep.raster {
-        Some(state) => raster_work(cx, prep, state, module.raw(), layout.raw(), index)?,
-        None => compute_work(cx, prep, module.raw(), layout.raw(), index)?,
+        Some(state) => raster_work(cx, prep, state, &modules, layout.raw(), index)?,
+        None => compute_work(cx, prep, modules.of(prep.entry), layout.raw(), index)?,
     };
     let built = Built {
         p: prep.p,
         work,
         layout,
         set_layout,
-        _module: module,
+        _modules: modules,
         descriptors: spirv.descriptors,
     };
     Ok((built, sets))

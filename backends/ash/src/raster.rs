@@ -5,7 +5,7 @@ use crate::descriptors::SetPlan;
 use crate::error::AshError;
 use crate::memory::Res;
 use crate::owned::Owned;
-use crate::pipelines::{Context, DrawCall, Work, entry_name};
+use crate::pipelines::{Context, DrawCall, Modules, Work, entry_name};
 use crate::prepare::Prepared;
 use ash::vk;
 use strandgraph_graph::schema::Usage;
@@ -89,7 +89,7 @@ pub(crate) fn raster_work(
     cx: &Context<'_>,
     prep: &Prepared<'_>,
     state: &RasterState,
-    module: vk::ShaderModule,
+    modules: &Modules,
     layout: vk::PipelineLayout,
     index: usize,
 ) -> Result<(Work, Vec<SetPlan>), AshError> {
@@ -97,7 +97,7 @@ pub(crate) fn raster_work(
     let pipelines = state
         .draws
         .iter()
-        .map(|draw| graphics_pipeline(cx, prep, state, draw, &at, module, layout))
+        .map(|draw| graphics_pipeline(cx, prep, state, draw, &at, modules, layout))
         .collect::<Result<Vec<_>, _>>()?;
     let call = draw_call(cx, prep, state)?;
     let bound = prep
@@ -124,16 +124,24 @@ pub(crate) fn raster_work(
 }
 
 /// How the pass's geometry is drawn.
-fn draw_call(cx: &Context<'_>, prep: &Prepared<'_>, state: &RasterState) -> Result<DrawCall, AshError> {
+fn draw_call(
+    cx: &Context<'_>,
+    prep: &Prepared<'_>,
+    state: &RasterState,
+) -> Result<DrawCall, AshError> {
     let too_many = |what: &str, n: u64| cx.pass_error(prep.p, format!("{n} {what} are too many"));
     Ok(match state.geometry {
-        Geometry::Vertices(n) => DrawCall::Vertices(u32::try_from(n).map_err(|_| too_many("vertices", n))?),
+        Geometry::Vertices(n) => {
+            DrawCall::Vertices(u32::try_from(n).map_err(|_| too_many("vertices", n))?)
+        }
         Geometry::Indirect(i) => {
             let (_, r, _) = prep
                 .bindings
                 .iter()
                 .find(|(n, _, _)| n == i.binding)
-                .ok_or_else(|| cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding)))?;
+                .ok_or_else(|| {
+                    cx.pass_error(prep.p, format!("indirect `{}` is not bound", i.binding))
+                })?;
             DrawCall::Indirect(*r, i.word as u64 * 4)
         }
         Geometry::MeshTasks { groups, .. } => {
@@ -142,11 +150,16 @@ fn draw_call(cx: &Context<'_>, prep: &Prepared<'_>, state: &RasterState) -> Resu
             if n > max {
                 return Err(cx.pass_error(
                     prep.p,
-                    format!("{n} task workgroups exceed the device's maxTaskWorkGroupCount[0] of {max}"),
+                    format!(
+                        "{n} task workgroups exceed the device's maxTaskWorkGroupCount[0] of {max}"
+                    ),
                 ));
             }
             let loader = cx.gpu.mesh.clone().ok_or_else(|| {
-                cx.pass_error(prep.p, "draws with mesh shaders on a device without VK_EXT_mesh_shader enabled".into())
+                cx.pass_error(
+                    prep.p,
+                    "draws with mesh shaders on a device without VK_EXT_mesh_shader enabled".into(),
+                )
             })?;
             DrawCall::MeshTasks(n, loader)
         }
@@ -183,7 +196,7 @@ fn graphics_pipeline(
     state: &RasterState,
     draw: &Draw,
     at: &Attachments,
-    module: vk::ShaderModule,
+    modules: &Modules,
     layout: vk::PipelineLayout,
 ) -> Result<Owned<vk::Pipeline>, AshError> {
     let d = &cx.gpu.device;
@@ -193,22 +206,22 @@ fn graphics_pipeline(
         Geometry::MeshTasks { task, .. } => Some(entry_name(cx, prep.p, task)?),
         _ => None,
     };
-    let stage = |flags, name| {
+    let stage = |flags, entry: &str, name| {
         vk::PipelineShaderStageCreateInfo::default()
             .stage(flags)
-            .module(module)
+            .module(modules.of(entry))
             .name(name)
     };
     // Vertex and fragment, or task, mesh and fragment.
-    let stages: Vec<vk::PipelineShaderStageCreateInfo<'_>> = match &task {
-        None => vec![
-            stage(vk::ShaderStageFlags::VERTEX, &first_name),
-            stage(vk::ShaderStageFlags::FRAGMENT, &fs_name),
+    let stages: Vec<vk::PipelineShaderStageCreateInfo<'_>> = match (&task, state.geometry) {
+        (Some(task), Geometry::MeshTasks { task: t, .. }) => vec![
+            stage(vk::ShaderStageFlags::TASK_EXT, t, task),
+            stage(vk::ShaderStageFlags::MESH_EXT, prep.entry, &first_name),
+            stage(vk::ShaderStageFlags::FRAGMENT, draw.fragment, &fs_name),
         ],
-        Some(task) => vec![
-            stage(vk::ShaderStageFlags::TASK_EXT, task),
-            stage(vk::ShaderStageFlags::MESH_EXT, &first_name),
-            stage(vk::ShaderStageFlags::FRAGMENT, &fs_name),
+        _ => vec![
+            stage(vk::ShaderStageFlags::VERTEX, prep.entry, &first_name),
+            stage(vk::ShaderStageFlags::FRAGMENT, draw.fragment, &fs_name),
         ],
     };
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();

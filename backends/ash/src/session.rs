@@ -171,7 +171,13 @@ impl Session {
                 aliases: &memory.aliases,
             },
         );
+        let t0 = std::time::Instant::now();
         let pipelines = build(&gpu, plan, instance, &prepared, &memory, &sync)?;
+        tracing::debug!(
+            ms = t0.elapsed().as_secs_f64() * 1e3,
+            passes = prepared.len(),
+            "pipelines built"
+        );
         let per_queue: Vec<usize> = (0..gpu.queues.len())
             .map(|q| {
                 let on_q = lanes.lanes.iter().filter(|l| l.queue == q);

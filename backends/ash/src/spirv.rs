@@ -21,10 +21,12 @@ pub(crate) struct Spirv {
 }
 
 /// Translates `composed` for the entry points `entries` (compute, or vertex
-/// and fragments); `pass` names the pass in errors.
+/// and fragments), every entry point of the module or `only` that one;
+/// `pass` names the pass in errors.
 pub(crate) fn translate(
     composed: &Composed,
     entries: &[&str],
+    only: Option<&str>,
     caps: &[spv::Capability],
     zero_init_native: bool,
     pass: &str,
@@ -103,15 +105,26 @@ pub(crate) fn translate(
         },
         ..Default::default()
     };
-    let mut words = spv::write_vec(module, &info, &options, None).map_err(|e| match e {
-        spv::Error::MissingCapabilities(what, missing) => AshError::MissingFeature {
-            device: device.to_string(),
-            feature: format!("SPIR-V capability {missing:?}"),
-            pass: pass.to_string(),
-            why: format!("the shader uses {what}"),
-        },
-        e => AshError::Shader(format!("pass `{pass}`: SPIR-V: {e}")),
-    })?;
+    let pipeline = only
+        .map(|name| {
+            let ep = module.entry_points.iter().find(|e| e.name == name);
+            ep.map(|ep| spv::PipelineOptions {
+                shader_stage: ep.stage,
+                entry_point: name.to_string(),
+            })
+            .ok_or_else(|| AshError::Shader(format!("pass `{pass}`: no entry point `{name}`")))
+        })
+        .transpose()?;
+    let mut words =
+        spv::write_vec(module, &info, &options, pipeline.as_ref()).map_err(|e| match e {
+            spv::Error::MissingCapabilities(what, missing) => AshError::MissingFeature {
+                device: device.to_string(),
+                feature: format!("SPIR-V capability {missing:?}"),
+                pass: pass.to_string(),
+                why: format!("the shader uses {what}"),
+            },
+            e => AshError::Shader(format!("pass `{pass}`: SPIR-V: {e}")),
+        })?;
     // Round every float operation as written, as the CPU simulator does
     // (strandgraph_passes::spirv says why).
     if !strandgraph_passes::spirv::contraction_allowed() {
@@ -186,6 +199,7 @@ mod tests {
         let s = translate(
             &composed,
             &[&entry],
+            None,
             &[spv::Capability::Shader],
             false,
             "clear",
@@ -200,6 +214,17 @@ mod tests {
                 (1, vk::DescriptorType::STORAGE_BUFFER)
             ]
         );
+    }
+
+    /// `OpEntryPoint` (opcode 15) instructions in a module.
+    fn entry_points(words: &[u32]) -> usize {
+        let mut i = 5;
+        let mut n = 0;
+        while i < words.len() && words[i] >> 16 != 0 {
+            n += usize::from(words[i] & 0xFFFF == 15);
+            i += (words[i] >> 16) as usize;
+        }
+        n
     }
 
     #[test]
@@ -221,6 +246,7 @@ mod tests {
         let s = translate(
             &composed,
             &["ms_main", "ts_main", "fs_main"],
+            None,
             &caps,
             false,
             "mesh",
@@ -228,14 +254,33 @@ mod tests {
         )
         .unwrap();
         assert_eq!(s.words[1], 0x0001_0400, "SPIR-V 1.4");
+        // One entry point per module, as the backend builds mesh pipelines.
+        for e in ["ms_main", "ts_main", "fs_main"] {
+            let one = translate(&composed, &[e], Some(e), &caps, true, "mesh", "test").unwrap();
+            assert_eq!(entry_points(&one.words), 1, "{e}");
+        }
         assert!(declared_capabilities(&s.words).contains(&(C::MeshShadingEXT as u32)));
         // Without the capability, the error names it and the pass.
-        let without: Vec<C> = caps.into_iter().filter(|c| *c != C::MeshShadingEXT).collect();
-        let text = translate(&composed, &["ms_main"], &without, false, "mesh", "test")
-            .err()
-            .unwrap()
-            .to_string();
-        assert!(text.contains("`mesh`") && text.contains("MeshShading"), "{text}");
+        let without: Vec<C> = caps
+            .into_iter()
+            .filter(|c| *c != C::MeshShadingEXT)
+            .collect();
+        let text = translate(
+            &composed,
+            &["ms_main"],
+            Some("ms_main"),
+            &without,
+            false,
+            "mesh",
+            "test",
+        )
+        .err()
+        .unwrap()
+        .to_string();
+        assert!(
+            text.contains("`mesh`") && text.contains("MeshShading"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -247,6 +292,7 @@ mod tests {
         let err = translate(
             &composed,
             &[&entry],
+            None,
             &[spv::Capability::Shader],
             false,
             "lod",

@@ -11,8 +11,8 @@
 
 use crate::barriers::Scope;
 use crate::error::{AshError, VkContext};
-use crate::session::{Frame, Session};
 use crate::pipelines::DrawCall;
+use crate::session::{Frame, Session};
 use crate::timing::PassTiming;
 use ash::vk;
 use strandgraph_passes::upload::Upload;

@@ -16,7 +16,9 @@ use crate::describe::PassKind;
 use crate::hardware_raster::Setup;
 use crate::kernel::{CounterValues, Ctx};
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
+use crate::raster_state::{
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState,
+};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 

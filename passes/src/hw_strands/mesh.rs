@@ -27,9 +27,9 @@
 //! (every bundle's kept strands, assembled by the same code, in launch
 //! order) and rasterizes the quads with `hw_strands.raster`'s kernel.
 
+use super::Segment;
 use super::assemble::record;
 use super::raster::{BANDS, QuadRaster, RasterParams, quads};
-use super::Segment;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;

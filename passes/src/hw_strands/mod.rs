@@ -25,8 +25,8 @@
 //! [`crate::hardware_raster`] at the standard sample locations.
 
 pub mod assemble;
-pub mod raster;
 pub mod mesh;
+pub mod raster;
 #[cfg(test)]
 mod raster_tests;
 

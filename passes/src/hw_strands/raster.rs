@@ -197,7 +197,12 @@ impl QuadRaster {
     }
 
     /// The prologue: which bands each of segments `0..count` may reach.
-    pub(super) fn bin(&self, ctx: &Ctx<'_>, count: usize, segment: impl Fn(usize) -> Segment + Sync) {
+    pub(super) fn bin(
+        &self,
+        ctx: &Ctx<'_>,
+        count: usize,
+        segment: impl Fn(usize) -> Segment + Sync,
+    ) {
         use rayon::prelude::*;
         let view = self.view(ctx);
         let rows: Vec<Option<(u32, u32)>> = (0..count)

@@ -13,7 +13,9 @@ use crate::contract::{Binding, CpuKernel, Shader};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::params::NoParams;
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
+use crate::raster_state::{
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState,
+};
 use strandgraph_graph::Quantities;
 
 crate::gpu_block! {

@@ -28,7 +28,9 @@ use super::shading::Shading;
 use crate::contract::{Binding, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::params::{Invalid, PassParams, in_range};
-use crate::raster_state::{Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState};
+use crate::raster_state::{
+    Blend, ColorLoad, Compare, Cull, DepthLoad, Draw, Geometry, RasterState,
+};
 use glam::Vec3;
 use strandgraph_assets::hairpatch::PATCH_SEGMENTS;
 use strandgraph_graph::Quantities;

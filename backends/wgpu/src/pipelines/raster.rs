@@ -103,15 +103,15 @@ fn render_pipeline(
         None => None,
     };
     let primitive = wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: match state.cull {
-                    Cull::None => None,
-                    Cull::Back => Some(wgpu::Face::Back),
-                    Cull::Front => Some(wgpu::Face::Front),
-                },
-                ..Default::default()
-            };
+        topology: wgpu::PrimitiveTopology::TriangleList,
+        front_face: wgpu::FrontFace::Ccw,
+        cull_mode: match state.cull {
+            Cull::None => None,
+            Cull::Back => Some(wgpu::Face::Back),
+            Cull::Front => Some(wgpu::Face::Front),
+        },
+        ..Default::default()
+    };
     let multisample = wgpu::MultisampleState {
         count: at.samples,
         ..Default::default()
@@ -123,26 +123,28 @@ fn render_pipeline(
         targets: &targets,
     });
     if let Geometry::MeshTasks { task, .. } = state.geometry {
-        return Ok(cx.device.create_mesh_pipeline(&wgpu::MeshPipelineDescriptor {
-            label: Some(cx.name),
-            layout: None,
-            task: Some(wgpu::TaskState {
-                module: &cx.module,
-                entry_point: Some(task),
-                compilation_options: Default::default(),
-            }),
-            mesh: wgpu::MeshState {
-                module: &cx.module,
-                entry_point: Some(cx.prep.entry),
-                compilation_options: Default::default(),
-            },
-            primitive,
-            depth_stencil,
-            multisample,
-            fragment,
-            multiview: None,
-            cache: None,
-        }));
+        return Ok(cx
+            .device
+            .create_mesh_pipeline(&wgpu::MeshPipelineDescriptor {
+                label: Some(cx.name),
+                layout: None,
+                task: Some(wgpu::TaskState {
+                    module: &cx.module,
+                    entry_point: Some(task),
+                    compilation_options: Default::default(),
+                }),
+                mesh: wgpu::MeshState {
+                    module: &cx.module,
+                    entry_point: Some(cx.prep.entry),
+                    compilation_options: Default::default(),
+                },
+                primitive,
+                depth_stencil,
+                multisample,
+                fragment,
+                multiview: None,
+                cache: None,
+            }));
     }
     Ok(cx
         .device
