@@ -28,6 +28,7 @@ use naga::{EntryPoint, Module, ShaderStage};
 use naga_oil::compose::Composer;
 use std::collections::BTreeMap;
 use strandgraph_graph::AccessMode;
+use strandgraph_passes::raster_state::Geometry;
 use strandgraph_passes::wgsl::Shaders;
 use strandgraph_passes::{PASSES, PassDef, Shader};
 use wgsl::reflect::{Kind, Reflected, access_matches, reflect};
@@ -54,6 +55,14 @@ fn capabilities_of(file: &str) -> Capabilities {
                 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
                 | Capabilities::EARLY_DEPTH_TEST
                 | Capabilities::MULTISAMPLED_SHADING
+        }
+        // The same fragment behind task and mesh shaders (VK_EXT_mesh_shader).
+        "hw_strands/mesh.wgsl" => {
+            BASE | Capabilities::SHADER_INT64
+                | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
+                | Capabilities::EARLY_DEPTH_TEST
+                | Capabilities::MULTISAMPLED_SHADING
+                | Capabilities::MESH_SHADER
         }
         _ => BASE,
     }
@@ -96,7 +105,7 @@ fn find<'m>(module: &'m Module, name: &str) -> Option<&'m EntryPoint> {
 }
 
 /// The entry points `def` runs, checked for stage and workgroup size: its
-/// compute entry, or its vertex and fragment entries.
+/// compute entry, or its vertex (or task and mesh) and fragment entries.
 fn entry_points(module: &Module, def: &dyn PassDef) -> Result<Vec<&'static str>, String> {
     let shader = def.shader();
     let entry =
@@ -119,11 +128,32 @@ fn entry_points(module: &Module, def: &dyn PassDef) -> Result<Vec<&'static str>,
             }
         }
         Some(fragment) => {
-            if entry.stage != ShaderStage::Vertex {
+            let defaults = ron::Value::Map(Default::default());
+            let raster = def
+                .raster(&defaults, &strandgraph_graph::Quantities::example())
+                .map_err(|e| e.to_string())?;
+            // A mesh pass's entry is its mesh entry, launched by its task entry.
+            let task = match raster.map(|r| r.geometry) {
+                Some(Geometry::MeshTasks { task, .. }) => Some(task),
+                _ => None,
+            };
+            let expected = if task.is_some() {
+                ShaderStage::Mesh
+            } else {
+                ShaderStage::Vertex
+            };
+            if entry.stage != expected {
                 return Err(format!(
-                    "`{}` is {:?}, expected a vertex entry",
+                    "`{}` is {:?}, expected a {expected:?} entry",
                     shader.entry, entry.stage
                 ));
+            }
+            if let Some(task) = task {
+                let ep = find(module, task).ok_or_else(|| format!("no task entry `{task}`"))?;
+                if ep.stage != ShaderStage::Task {
+                    return Err(format!("`{task}` is {:?}, expected a task entry", ep.stage));
+                }
+                entries.push(task);
             }
             let frag =
                 find(module, fragment).ok_or_else(|| format!("no fragment entry `{fragment}`"))?;

@@ -6,7 +6,7 @@
 //   #define SCENE_DEPTH_BINDING 4
 //   #define HAIR_DEPTH_BINDING 5
 //   #define GBUFFER_BINDING 6
-//   #import strandgraph::hw_strands_quad::{QuadVertex, quad_vertex, write_sample, ...}
+//   #import strandgraph::hw_strands_quad::{corner_position, write_sample, ...}
 // Each pass numbers its bindings in the order of its definition's bindings()
 // (passes/tests/wgsl_bindings.rs checks it); the defines say where these sit.
 #define_import_path strandgraph::hw_strands_quad
@@ -22,8 +22,11 @@
 // (a+, b-, b+). An indexed quad uses corners 0-3 with these as indices.
 const CORNERS: array<u32, 6> = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
 
-// One quad corner as the rasterizer receives it. The payload bits are the
-// segment's (Segment::bits_a, bits_b), flat across the quad.
+// One quad corner as hw_strands.mesh emits it, the segment's payload bits
+// (Segment::bits_a, bits_b) flat across the quad. hw_strands.raster passes
+// the segment's index instead and its fragment shader loads the bits: on the
+// H100 two more flat varyings per vertex cost that draw 27% at the close
+// view (80.9 against 63.9 ms), where mesh shaders have no record to load.
 struct QuadVertex {
     @builtin(position) position: vec4<f32>,
     // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t.
@@ -53,20 +56,15 @@ fn quad_corner(a: vec4<f32>, b: vec4<f32>, corner: u32, half: f32, size: vec2<f3
     return vec4<f32>(c.xy + ndc * c.w, c.z, c.w);
 }
 
-// Corner `corner` of the quad of segment (a, b) with payload bits
-// (bits_a, bits_b), `width_px` wide. lipp.raster drops a segment with an
-// end at or behind the near plane: such a quad's corners all lie outside
-// the clip volume at one point, so nothing is drawn.
-fn quad_vertex(a: vec4<f32>, b: vec4<f32>, bits_a: u32, bits_b: u32, corner: u32, width_px: f32, size: vec2<f32>, near: f32) -> QuadVertex {
-    var out: QuadVertex;
-    out.t = f32(corner & 1u);
-    out.bits_a = bits_a;
-    out.bits_b = bits_b;
-    out.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+// Where corner `corner` of the quad of segment (a, b), `width_px` wide,
+// goes. lipp.raster drops a segment with an end at or behind the near
+// plane: such a quad's corners all lie outside the clip volume at one
+// point, so nothing is drawn.
+fn corner_position(a: vec4<f32>, b: vec4<f32>, corner: u32, width_px: f32, size: vec2<f32>, near: f32) -> vec4<f32> {
     if a.w > near && b.w > near {
-        out.position = quad_corner(a, b, corner, 0.5 * width_px, size);
+        return quad_corner(a, b, corner, 0.5 * width_px, size);
     }
-    return out;
+    return vec4<f32>(2.0, 2.0, 2.0, 1.0);
 }
 
 // Segment::payload's 6-bit interpolation, operation for operation.
@@ -77,12 +75,13 @@ fn lerp6(a: u32, b: u32, t: f32) -> u32 {
 }
 
 // Lipp's write_sample for one covered sample of a quad: position and t are
-// the sample's. Tested as lipp.raster tests: against scene.depth and, after
-// the first groom (model_index > 0), against hair_depth.
-fn write_sample(v: QuadVertex, sample: u32, width: u32, height: u32, model_index: u32) {
-    let x = u32(v.position.x);
-    let y = u32(v.position.y);
-    let z = v.position.z;
+// the sample's, bits_a and bits_b the segment's. Tested as lipp.raster
+// tests: against scene.depth and, after the first groom (model_index > 0),
+// against hair_depth.
+fn write_sample(position: vec4<f32>, t_in: f32, bits_a: u32, bits_b: u32, sample: u32, width: u32, height: u32, model_index: u32) {
+    let x = u32(position.x);
+    let y = u32(position.y);
+    let z = position.z;
     if x >= width || y >= height || !(z >= 0.0 && z < 1.0) {
         return;
     }
@@ -93,11 +92,11 @@ fn write_sample(v: QuadVertex, sample: u32, width: u32, height: u32, model_index
     if model_index > 0u && z >= bitcast<f32>(hair_depth[pixel]) {
         return;
     }
-    let t = clamp(v.t, 0.0, 1.0);
-    let w = lerp6(v.bits_a >> 6u, v.bits_b >> 8u, t);
-    let ao = lerp6(v.bits_a, v.bits_b >> 14u, t);
-    let lo = (v.bits_a & 0xFFFFF000u) | (w << 6u) | ao;
-    let hi = (depth_bits(z) << 8u) | (v.bits_b & 255u);
+    let t = clamp(t_in, 0.0, 1.0);
+    let w = lerp6(bits_a >> 6u, bits_b >> 8u, t);
+    let ao = lerp6(bits_a, bits_b >> 14u, t);
+    let lo = (bits_a & 0xFFFFF000u) | (w << 6u) | ao;
+    let hi = (depth_bits(z) << 8u) | (bits_b & 255u);
     let payload = (u64(hi) << 32u) | u64(lo);
     let pixels = width * height;
     if sample < min(8u, arrayLength(&gbuffer) / max(pixels, 1u)) {

@@ -16,7 +16,7 @@
 #define HAIR_DEPTH_BINDING 5
 #define GBUFFER_BINDING 6
 #import strandgraph::layout::FrameData
-#import strandgraph::hw_strands_quad::{QuadVertex, quad_vertex, write_sample, CORNERS}
+#import strandgraph::hw_strands_quad::{corner_position, write_sample, CORNERS}
 
 struct RasterParams {
     // Quad width in pixels (lipp.raster's centre_diameter).
@@ -39,6 +39,15 @@ const VERTICES_PER_SEGMENT: u32 = 6u;
 @group(0) @binding(2) var<storage, read> hw_segments: array<u32>;
 @group(0) @binding(3) var<storage, read> hw_draw_args: array<u32>;
 
+struct Varyings {
+    @builtin(position) position: vec4<f32>,
+    // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t.
+    @location(0) @interpolate(linear, sample) t: f32,
+    // The fragment shader loads the segment's payload bits (quad.wgsl's
+    // QuadVertex says why).
+    @location(1) @interpolate(flat) segment: u32,
+}
+
 fn clip_at(base: u32) -> vec4<f32> {
     return vec4<f32>(
         bitcast<f32>(hw_segments[base]),
@@ -49,22 +58,26 @@ fn clip_at(base: u32) -> vec4<f32> {
 }
 
 @vertex
-fn vs_main(@builtin(vertex_index) vertex: u32) -> QuadVertex {
+fn vs_main(@builtin(vertex_index) vertex: u32) -> Varyings {
     let segment = vertex / VERTICES_PER_SEGMENT;
     let corner = CORNERS[vertex % VERTICES_PER_SEGMENT];
+    var out: Varyings;
+    out.t = f32(corner & 1u);
+    out.segment = segment;
+    // Outside the clip volume, every vertex the same: nothing is drawn.
+    out.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
     if segment >= min(params.capacity, hw_draw_args[0] / VERTICES_PER_SEGMENT) {
-        // Outside the clip volume, every vertex the same: nothing is drawn.
-        var none: QuadVertex;
-        none.position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return none;
+        return out;
     }
     let base = segment * SEGMENT_WORDS;
     let size = vec2<f32>(f32(params.width), f32(params.height));
-    return quad_vertex(clip_at(base), clip_at(base + 4u), hw_segments[base + 8u], hw_segments[base + 9u], corner, params.width_px, size, frame.near);
+    out.position = corner_position(clip_at(base), clip_at(base + 4u), corner, params.width_px, size, frame.near);
+    return out;
 }
 
 @fragment
 @early_depth_test(force)
-fn fs_main(v: QuadVertex, @builtin(sample_index) sample: u32) {
-    write_sample(v, sample, params.width, params.height, params.model_index);
+fn fs_main(in: Varyings, @builtin(sample_index) sample: u32) {
+    let base = in.segment * SEGMENT_WORDS;
+    write_sample(in.position, in.t, hw_segments[base + 8u], hw_segments[base + 9u], sample, params.width, params.height, params.model_index);
 }
