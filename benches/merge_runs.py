@@ -5,19 +5,40 @@ backends runs past the device tool's 10-minute limit, so each backend runs
 in its own call (benches/device.sh).
 
     python3 benches/merge_runs.py ash/bench.json wgpu/bench.json > benches/results/h100.json
+
+With `--add PIPELINE`, the first file is an already merged result and the
+cells of PIPELINE's rows (say, "HW mesh") from the later runs of the same
+device are added to it, replacing any it had; the notes say which runs.
+
+    python3 benches/merge_runs.py --add "HW mesh" benches/results/h100.json ash/bench.json wgpu/bench.json
 """
 import json
 import sys
 
-runs = [json.load(open(p)) for p in sys.argv[1:]]
-out = dict(runs[0])
-for key in ("cells", "devices", "roofline", "notes"):
-    out[key] = [x for r in runs for x in r[key]]
+args = sys.argv[1:]
+add = None
+if args[:1] == ["--add"]:
+    add, args = args[1], args[2:]
+runs = [json.load(open(p)) for p in args]
 for key in ("frames", "warmup", "size", "cpu_subgroup_width"):
-    if any(r[key] != out[key] for r in runs):
+    if any(r[key] != runs[0][key] for r in runs):
         sys.exit(f"runs differ in {key}: {[r[key] for r in runs]}")
-out["elapsed_s"] = sum(r["elapsed_s"] for r in runs)
-backends = ", ".join(f"{d['backend']} ({r['elapsed_s']:.0f} s)" for r in runs for d in r["devices"])
-out["notes"].append(f"merged from one run per backend (benches/merge_runs.py): {backends}")
+devices = {d["device"].split(" (")[0] for r in runs for d in r["devices"]}
+if len(devices) != 1:
+    sys.exit(f"runs of different devices: {sorted(devices)}")
+out = dict(runs[0])
+backends = ", ".join(f"{d['backend']} ({r['elapsed_s']:.0f} s)" for r in runs[1 if add else 0:] for d in r["devices"])
+if add is None:
+    for key in ("cells", "devices", "roofline", "notes"):
+        out[key] = [x for r in runs for x in r[key]]
+    out["elapsed_s"] = sum(r["elapsed_s"] for r in runs)
+    out["notes"].append(f"merged from one run per backend (benches/merge_runs.py): {backends}")
+else:
+    added = [c for r in runs[1:] for c in r["cells"] if c["pipeline"] == add]
+    if not added:
+        sys.exit(f"no `{add}` cells in the added runs")
+    out["cells"] = [c for c in out["cells"] if c["pipeline"] != add] + added
+    out["elapsed_s"] = out["elapsed_s"] + sum(r["elapsed_s"] for r in runs[1:])
+    out["notes"] = out["notes"] + [f"`{add}` rows added from later runs on the same device (benches/merge_runs.py --add): {backends}"]
 json.dump(out, sys.stdout, indent=2, sort_keys=True)
 print()

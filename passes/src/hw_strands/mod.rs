@@ -17,12 +17,14 @@
 //!   depth tests; the fragment shader writes each covered sample's G-buffer
 //!   layer with 64-bit `atomicMin`, as Lipp's MSAA reference mode does.
 //!
-//! Deviation: Bhokare et al. generate strands in mesh shaders and shade
-//! them forward; we assemble them in compute (the same code Lipp's
-//! rasterizer runs) and draw from a buffer, so the pair measures the
-//! rasterizer (hardware quads against software lines), not the strand
-//! generation. The CPU kernels emulate the hardware with
-//! [`crate::hardware_raster`] at the standard sample locations.
+//! - [`mesh`]: the same quads generated in mesh shaders (a task workgroup
+//!   per bundle applying its LOD, strands assembled in mesh workgroups),
+//!   the pipeline shape of Bhokare et al. 2024 (`hw_mesh.ron`).
+//!
+//! Deviation: Bhokare et al. shade forward; both paths here write Lipp's
+//! G-buffer, so only visibility differs from Lipp's pipeline. The CPU
+//! kernels emulate the hardware with [`crate::hardware_raster`] at the
+//! standard sample locations.
 
 pub mod assemble;
 pub mod mesh;
