@@ -172,9 +172,9 @@ fn prepare_graph(
 
 /// The rows `--quick` times unless `--row` picks others: each pipeline as
 /// published and one ablation of each, so CI exercises both without the
-/// multi-sample rows (minutes on lavapipe). Lavapipe (Mesa 22.3, CI's) has
-/// no mesh shaders:
-/// its wgpu and ash cells of the mesh row are skipped, the CPU's run.
+/// multi-sample rows (minutes on lavapipe). CI's lavapipe (Mesa 22.3) has
+/// no mesh shaders: its wgpu and ash cells of the mesh row are skipped, the
+/// CPU's runs.
 const QUICK_ROWS: &[&str] = &[
     "Kulikov: all optimisations",
     "Kulikov: no loop flattening",

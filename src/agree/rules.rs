@@ -269,6 +269,22 @@ static EXCEPTIONS: &[Exception] = &[
         why: "the vertex stage expands each segment into a quad with the GPU's own square root and division, and the rasterizer interpolates depth with its own arithmetic: a sample on a half-pixel-wide quad's edge is covered on one side only, or its 24-bit depth differs in the last bit (lavapipe, two grooms at 160x90: 930 of 230,400 words)",
     },
     Exception {
+        kind: "hw_strands.mesh",
+        binding: "gbuffer",
+        on: On::Every,
+        rule: Rule::Exact,
+        outliers: 0.006,
+        why: "hw_strands.raster's quads and fragment shader, emitted by mesh shaders: the same GPU square root, division and depth interpolation decide a quad edge's samples",
+    },
+    Exception {
+        kind: "hw_strands.mesh",
+        binding: "strand_depth",
+        on: On::Every,
+        rule: Rule::F32 { ulps: 4, abs: 1e-6 },
+        outliers: 0.001,
+        why: "as hw_strands.raster's: a sample on a quad's edge is written on one side only",
+    },
+    Exception {
         kind: "hw_strands.raster",
         binding: "strand_depth",
         on: On::Every,

@@ -16,13 +16,10 @@ use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::layout::FrameData;
-use crate::lipp::assemble::{Assembly, assemble};
+use crate::lipp::assemble::{Assembly, Strands, assemble};
 use crate::lipp::payload::quantize;
 use crate::lipp::strand::{ControlPoint, strand_uv};
-use crate::lipp::{
-    BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, frame, mix,
-    normalize, oct_encode, transform,
-};
+use crate::lipp::{RASTER_GROUP, frame, mix, normalize, oct_encode, transform};
 use crate::params::{Invalid, PassParams};
 use glam::Vec4;
 
@@ -133,39 +130,33 @@ impl CpuKernel for AssembleKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f: FrameData = frame(ctx);
         let view_proj = f.view_proj;
-        let (lods, bundles, layers) = (
-            ctx.words("bundle_lod"),
-            ctx.words("hairmesh.bundles"),
-            ctx.words("hairmesh.layers"),
-        );
+        let strands = Strands::load(ctx);
         let (out, args) = (ctx.words("hw_segments"), ctx.words("hw_draw_args"));
         let capacity = out.len() / SEGMENT_WORDS;
         if group == 0 {
             args.fetch_max(1, 1);
         }
-        let total = ctx.words("raster_args").load(3);
-        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
-        let opts = Assembly {
-            width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
-            cooperative: self.0.cooperative_assembly,
-            styling: self.0.styling,
-        };
+        let opts = Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling);
         let mut s = group;
-        while s < total {
-            let b = bundle_of_strand(|i| lods.load(i * LOD_WORDS + 2), count, s);
-            let lod = BundleLod::load(&lods, b);
-            let rec = BundleRecord::load(&bundles, b);
-            let k = s - lod.first_strand;
+        while s < strands.total {
+            let (lod, rec, k) = strands.strand(s);
             let c = lod.control_points.clamp(2, crate::lipp::MAX_CONTROL_POINTS);
             let first = args.fetch_add(0, (c - 1) * VERTICES_PER_SEGMENT) / VERTICES_PER_SEGMENT;
             let uv = strand_uv(k);
             let mut next = first as usize;
-            assemble(&layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
-                if next < capacity {
-                    store(&out, next, &record(&view_proj, (a, ta), (b, tb), uv));
-                }
-                next += 1;
-            });
+            assemble(
+                &strands.layers,
+                &rec,
+                &lod,
+                k,
+                &opts,
+                &mut |a, ta, b, tb| {
+                    if next < capacity {
+                        store(&out, next, &record(&view_proj, (a, ta), (b, tb), uv));
+                    }
+                    next += 1;
+                },
+            );
             s += ctx.workgroups.max(1);
         }
     }

@@ -33,9 +33,9 @@ use super::raster::{BANDS, QuadRaster, RasterParams, quads};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
-use crate::lipp::assemble::{Assembly, assemble};
+use crate::lipp::assemble::{Assembly, Strands, assemble};
 use crate::lipp::strand::strand_uv;
-use crate::lipp::{BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, frame};
+use crate::lipp::{BundleLod, BundleRecord, frame};
 use crate::params::{Invalid, PassParams};
 use crate::raster_state::{Geometry, RasterState};
 use rayon::prelude::*;
@@ -168,30 +168,27 @@ impl MeshKernel {
     /// each assembled and projected into segments.
     fn generate(&self, ctx: &Ctx<'_>) -> Vec<Segment> {
         let view_proj = frame(ctx).view_proj;
-        let (lods, bundles, layers) = (
-            ctx.words("bundle_lod"),
-            ctx.words("hairmesh.bundles"),
-            ctx.words("hairmesh.layers"),
-        );
-        let total = ctx.words("raster_args").load(3);
-        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
-        let opts = Assembly {
-            width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
-            cooperative: self.p.cooperative_assembly,
-            styling: self.p.styling,
-        };
-        let per_bundle: Vec<Vec<Segment>> = (0..count)
+        let strands = Strands::load(ctx);
+        let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
+        let per_bundle: Vec<Vec<Segment>> = (0..strands.count)
             .into_par_iter()
             .map(|b| {
-                let lod = BundleLod::load(&lods, b);
-                let rec = BundleRecord::load(&bundles, b);
+                let lod = BundleLod::load(&strands.lods, b);
+                let rec = BundleRecord::load(&strands.bundles, b);
                 let mut out = Vec::new();
-                let kept = (0..lod.strands).take_while(|k| lod.first_strand + k < total);
+                let kept = (0..lod.strands).take_while(|k| lod.first_strand + k < strands.total);
                 for k in kept {
                     let uv = strand_uv(k);
-                    assemble(&layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
-                        out.push(record(&view_proj, (a, ta), (b, tb), uv));
-                    });
+                    assemble(
+                        &strands.layers,
+                        &rec,
+                        &lod,
+                        k,
+                        &opts,
+                        &mut |a, ta, b, tb| {
+                            out.push(record(&view_proj, (a, ta), (b, tb), uv));
+                        },
+                    );
                 }
                 out
             })

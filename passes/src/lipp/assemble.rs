@@ -11,8 +11,11 @@ use super::strand::{
     ControlPoint, LayerPoint, calc_tangent, eval_cp, layer_point, shuffle_down, shuffle_up,
     strand_id, strand_uv,
 };
-use super::{BundleLod, BundleRecord, MAX_CONTROL_POINTS, RASTER_GROUP};
-use crate::kernel::Words;
+use super::{
+    BundleLod, BundleRecord, LOD_WORDS, MAX_CONTROL_POINTS, RASTER_GROUP, bundle_count,
+    bundle_of_strand,
+};
+use crate::kernel::{Ctx, Words};
 
 /// What receives each segment: both ends and their tangents.
 pub type DrawSegment<'a> = dyn FnMut(&ControlPoint, [f32; 3], &ControlPoint, [f32; 3]) + 'a;
@@ -25,6 +28,52 @@ pub struct Assembly {
     /// Shuffle neighbours (Code 1) rather than recompute them.
     pub cooperative: bool,
     pub styling: bool,
+}
+
+impl Assembly {
+    /// At `ctx`'s emulated subgroup width, with a pass's two switches.
+    pub fn new(ctx: &Ctx<'_>, cooperative: bool, styling: bool) -> Self {
+        Self {
+            width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
+            cooperative,
+            styling,
+        }
+    }
+}
+
+/// What Code 1 reads, bound the same way by every pass that assembles
+/// strands: the LOD records (`bundle_lod`), the bundles and their layers,
+/// and how many strands the LOD keeps (`raster_args` word 3).
+pub struct Strands<'a> {
+    pub lods: Words<'a>,
+    pub bundles: Words<'a>,
+    pub layers: Words<'a>,
+    /// Strands the LOD keeps, numbered across bundles.
+    pub total: u32,
+    /// Bundles with an LOD record.
+    pub count: usize,
+}
+
+impl<'a> Strands<'a> {
+    pub fn load(ctx: &Ctx<'a>) -> Self {
+        let lods = ctx.words("bundle_lod");
+        Self {
+            count: bundle_count(ctx).min(lods.len() / LOD_WORDS),
+            lods,
+            bundles: ctx.words("hairmesh.bundles"),
+            layers: ctx.words("hairmesh.layers"),
+            total: ctx.words("raster_args").load(3),
+        }
+    }
+
+    /// Kept strand `s`: its bundle's LOD and record, and its index `k` in
+    /// the bundle.
+    pub fn strand(&self, s: u32) -> (BundleLod, BundleRecord, u32) {
+        let b = bundle_of_strand(|i| self.lods.load(i * LOD_WORDS + 2), self.count, s);
+        let lod = BundleLod::load(&self.lods, b);
+        let k = s - lod.first_strand;
+        (lod, BundleRecord::load(&self.bundles, b), k)
+    }
 }
 
 /// Lipp Code 1 for strand `k` of bundle `rec`, lanes emulated as arrays:

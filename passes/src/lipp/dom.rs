@@ -25,13 +25,10 @@
 //! expectation and the maps stand for the full geometry set, as the paper's
 //! do, at a fraction of the strands.
 
-use super::assemble::{Assembly, assemble};
+use super::assemble::{Assembly, Strands, assemble};
 use super::strand::ControlPoint;
 use super::walk::Dda;
-use super::{
-    BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, cross, dot,
-    frame, normalize, scale, sub,
-};
+use super::{RASTER_GROUP, cross, dot, frame, normalize, scale, sub};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -404,24 +401,12 @@ impl CpuKernel for DomKernel {
         if lights.is_empty() {
             return;
         }
-        let (lods, bundles, layers) = (
-            ctx.words("bundle_lod"),
-            ctx.words("hairmesh.bundles"),
-            ctx.words("hairmesh.layers"),
-        );
-        let total = ctx.words("raster_args").load(3);
-        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
-        let opts = Assembly {
-            width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
-            cooperative: self.p.cooperative_assembly,
-            styling: self.p.styling,
-        };
+        let strands = Strands::load(ctx);
+        let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
         let stride = ctx.workgroups.max(1);
         let mut s = group;
-        while s < total {
-            let b = bundle_of_strand(|i| lods.load(i * LOD_WORDS + 2), count, s);
-            let lod = BundleLod::load(&lods, b);
-            let rec = BundleRecord::load(&bundles, b);
+        while s < strands.total {
+            let (lod, rec, k) = strands.strand(s);
             let thinning = if self.p.density_compensation {
                 rec.strands as f32 / lod.strands.max(1) as f32
             } else {
@@ -439,7 +424,7 @@ impl CpuKernel for DomKernel {
                     });
                 }
             };
-            assemble(&layers, &rec, &lod, s - lod.first_strand, &opts, &mut draw);
+            assemble(&strands.layers, &rec, &lod, k, &opts, &mut draw);
             s += stride;
         }
     }

@@ -38,14 +38,11 @@
 //! no conservative layer. The graph must size the G-buffer for N layers
 //! (`scenes/graphs/lipp_msaa.ron`); samples beyond its layers are dropped.
 
-use super::assemble::{Assembly, assemble};
+use super::assemble::{Assembly, Strands, assemble};
 use super::payload::{Sample, pack};
 use super::strand::{ControlPoint, strand_uv};
 use super::walk::Dda;
-use super::{
-    BundleLod, BundleRecord, LOD_WORDS, RASTER_GROUP, bundle_count, bundle_of_strand, frame, mix,
-    normalize, transform,
-};
+use super::{RASTER_GROUP, frame, mix, normalize, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
@@ -355,13 +352,7 @@ fn walk_pixels(a: &End, b: &End, width: u32, height: u32, visit: &mut dyn FnMut(
 impl CpuKernel for RasterKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
-        let (lods, bundles, layers) = (
-            ctx.words("bundle_lod"),
-            ctx.words("hairmesh.bundles"),
-            ctx.words("hairmesh.layers"),
-        );
-        let total = ctx.words("raster_args").load(3);
-        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
+        let strands = Strands::load(ctx);
         let mut local = CounterValues::default();
         let mut target = Target {
             f: &f,
@@ -376,20 +367,13 @@ impl CpuKernel for RasterKernel {
             local: &mut local,
         };
         let stride = ctx.workgroups.max(1);
-        let width = (ctx.subgroup_width.clamp(1, RASTER_GROUP)) as usize;
+        let opts = Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling);
         let mut s = group;
-        while s < total {
-            let b = bundle_of_strand(|i| lods.load(i * LOD_WORDS + 2), count, s);
-            let lod = BundleLod::load(&lods, b);
-            let rec = BundleRecord::load(&bundles, b);
-            let k = s - lod.first_strand;
+        while s < strands.total {
+            let (lod, rec, k) = strands.strand(s);
             target.uv = strand_uv(k);
-            let opts = Assembly {
-                width,
-                cooperative: self.0.cooperative_assembly,
-                styling: self.0.styling,
-            };
-            let (active, lanes) = assemble(&layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
+            let layers = &strands.layers;
+            let (active, lanes) = assemble(layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
                 if let (Some(pa), Some(pb)) = (target.project(a, ta), target.project(b, tb)) {
                     target.segment(&pa, &pb);
                 }
