@@ -5,6 +5,7 @@ use super::*;
 use crate::contract::PassDef;
 use crate::kernel::harness::Harness;
 use crate::layout::words_of;
+use crate::lipp::BundleRecord;
 use crate::lipp::lod::{LOD, LOD_GROUP, scan::LOD_SCAN, scan::SCAN_GROUP};
 use crate::lipp::payload::{EMPTY, unpack};
 use bytemuck::Zeroable;
