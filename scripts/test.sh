@@ -35,3 +35,13 @@ cargo test --workspace --release --locked
 target/release/strandgraph bench --quick --backend all
 # Benches report, they do not assert; --quick keeps this to seconds.
 cargo bench --locked --bench graph_compile -- --quick
+# An installed binary renders from any directory: `cargo install` into a
+# scratch root (reusing this build's artifacts), then the built-in demo
+# scene from an empty directory (the binary holds its shaders, the scene
+# and the graph).
+install_root=$(mktemp -d)
+empty_dir=$(mktemp -d)
+cargo install --path . --root "$install_root" --locked --target-dir target --quiet
+(cd "$empty_dir" && "$install_root/bin/strandgraph" render --demo --size 320x180 -o demo.png && test -s demo.png)
+rm -rf "$install_root" "$empty_dir"
+echo "installed binary: rendered the demo scene from an empty directory"

@@ -8,6 +8,9 @@ use strandgraph::frame::{parse_size, prepare_with};
 use strandgraph::runner::Backend;
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph agree scenes/showcase.ron
+  strandgraph agree scenes/showcase.ron --graph scenes/graphs/lipp.ron --pass raster --backend ash")]
 pub struct Args {
     /// The scene (RON), e.g. scenes/showcase.ron.
     #[arg(required_unless_present = "summarize")]

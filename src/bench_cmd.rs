@@ -48,6 +48,10 @@ pub enum Choice {
 }
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph bench --quick
+  strandgraph bench --backend ash --row \"Lipp\" --out bench/
+  strandgraph bench scenes/showcase.ron --backend wgpu,ash --row \"HW mesh\"")]
 pub struct Args {
     /// Scenes, one column each (default: scenes/distances/{close,mid,far}.ron,
     /// then scenes/showcase.ron and scenes/crowd.ron unless --quick).

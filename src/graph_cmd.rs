@@ -7,6 +7,9 @@ use strandgraph_graph::{Quantities, compile_file, export, report};
 use strandgraph_passes::Registry;
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph graph scenes/graphs/kulikov.ron
+  strandgraph graph scenes/graphs/lipp.ron --dot lipp.dot")]
 pub struct Args {
     /// The graph file (RON), e.g. scenes/graphs/kulikov.ron. Defaults to the
     /// graph named by `--scene`.

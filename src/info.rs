@@ -9,6 +9,9 @@ use std::time::Instant;
 use strandgraph_assets::{Aabb, AssetError, Groom, LoadOptions, Scene, TriMesh, Units};
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph info scenes/crowd.ron
+  strandgraph info my_groom.tfx           # a groom (.hair, .tfx) or mesh (.obj)")]
 pub struct Args {
     /// A scene (.ron), groom (.hair, .tfx) or mesh (.obj) file.
     pub file: std::path::PathBuf,

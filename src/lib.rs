@@ -4,6 +4,7 @@
 
 pub mod agree;
 pub mod compare;
+pub mod demo;
 pub mod frame;
 pub mod images;
 pub mod runner;

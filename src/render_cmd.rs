@@ -3,6 +3,7 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use strandgraph::demo::Demo;
 use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{Display, Tonemap, depth_to_view, motion_image, to_linear, to_picture};
 use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
@@ -18,9 +19,18 @@ pub enum Backend {
 }
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph render scenes/showcase.ron -o showcase.png
+  strandgraph render --demo --size 480x270 -o demo.png            # no checkout needed
+  strandgraph render scenes/showcase.ron --graph scenes/graphs/lipp.ron --backend all")]
 pub struct Args {
     /// The scene (RON), e.g. scenes/showcase.ron.
-    pub scene: PathBuf,
+    #[arg(required_unless_present = "demo")]
+    pub scene: Option<PathBuf>,
+    /// Render the built-in showcase (the scene and its Kulikov graph are in
+    /// the binary), from any directory.
+    #[arg(long, conflicts_with = "scene")]
+    pub demo: bool,
     #[arg(long, value_enum, default_value = "cpu")]
     pub backend: Backend,
     /// Where to write the main image: PNG (sRGB), or linear EXR when the
@@ -65,12 +75,22 @@ pub struct Args {
 pub fn run(args: Args) -> Result<()> {
     let size = args.size.as_deref().map(parse_size).transpose()?;
     let t0 = Instant::now();
+    let demo = args.demo.then(Demo::write).transpose()?;
+    let scene = match (&demo, &args.scene) {
+        (Some(d), _) => d.scene.clone(),
+        (None, Some(s)) => s.clone(),
+        (None, None) => miette::bail!("name a scene, or pass --demo"),
+    };
     // Overrides apply before packing and baking (a `"Baked"` override bakes).
-    let p = prepare_with(&args.scene, args.graph.as_deref(), size, &args.params)?;
+    let p = prepare_with(&scene, args.graph.as_deref(), size, &args.params)?;
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",
-        args.scene.display(),
+        if args.demo {
+            "--demo (the built-in showcase)".to_string()
+        } else {
+            scene.display().to_string()
+        },
         q.models,
         q.strands,
         q.segments,
@@ -82,7 +102,7 @@ pub fn run(args: Args) -> Result<()> {
     let main = args.output.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "{}.png",
-            args.scene
+            scene
                 .file_stem()
                 .and_then(|s| s.to_str())
                 .unwrap_or("render")

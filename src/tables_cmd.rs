@@ -5,6 +5,9 @@ use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use std::path::PathBuf;
 
 #[derive(clap::Args)]
+#[command(after_help = "Examples:
+  strandgraph tables README.md --check
+  strandgraph tables README.md")]
 pub struct Args {
     /// The Markdown file whose generated blocks to rewrite.
     #[arg(default_value = "README.md")]
