@@ -10,10 +10,12 @@
 //! prepared for the row's graph; a graph that cannot run a scene gets its
 //! cells marked skipped with the reason.
 
+mod progress;
 mod report;
 mod variants;
 
 use miette::{Result, miette};
+use progress::Progress;
 use report::{Ceilings, Cell, Report, Stats};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -281,7 +283,9 @@ pub fn run(mut args: Args) -> Result<()> {
         })?;
     // Raster atomics per (row, view), counted once for every backend.
     let mut counts: BTreeMap<(usize, usize), u64> = BTreeMap::new();
-    'backends: for (backend, required) in backends(&args) {
+    let chosen = backends(&args);
+    let progress = Progress::new((chosen.len() * rows.len() * scenes.len()) as u64);
+    'backends: for (backend, required) in chosen {
         // The roofline, on the first scene's screen size. A device that
         // cannot run it (no 64-bit atomics) still gets its rows timed.
         match roofline(backend, first, &args, cpu, counting) {
@@ -289,10 +293,11 @@ pub fn run(mut args: Args) -> Result<()> {
                 report.device(backend, &r.device, &r.notes);
                 report.ceilings(backend, r.ceilings);
             }
-            Err(e) => eprintln!("{}: no roofline: {e:?}", backend.name()),
+            Err(e) => progress.note(&format!("{}: no roofline: {e:?}", backend.name())),
         }
         for (r, v) in rows.iter().enumerate() {
             for s in 0..scenes.len() {
+                progress.done();
                 if let Some(why) = skipped.get(v.graph) {
                     report.cell(backend, v, s, Cell::Skipped(why.clone()));
                     continue;
@@ -304,14 +309,13 @@ pub fn run(mut args: Args) -> Result<()> {
                         continue;
                     }
                 };
-                eprintln!(
-                    "[{:>5.0} s] {} {}: {} / {}",
-                    t0.elapsed().as_secs_f64(),
+                progress.cell(&format!(
+                    "{} {}: {} / {}",
                     backend.name(),
                     v.pipeline,
                     v.name,
                     report.views[s]
-                );
+                ));
                 let atomics = match counts.get(&(r, s)) {
                     Some(&n) => n,
                     None => {
@@ -327,12 +331,12 @@ pub fn run(mut args: Args) -> Result<()> {
                     }
                     // `all` takes the backends that open here.
                     Err(e) if !required && !report.has_device(backend) => {
-                        eprintln!("skipping {}: {e:?}", backend.name());
+                        progress.note(&format!("skipping {}: {e:?}", backend.name()));
                         continue 'backends;
                     }
                     // A row the device cannot run (lavapipe has no 8x MSAA).
                     Err(e) if lacks_feature(&e) => {
-                        eprintln!("skipping the cell: {e}");
+                        progress.note(&format!("skipping the cell: {e}"));
                         report.cell(backend, v, s, Cell::Skipped(e.to_string()));
                     }
                     Err(e) => return Err(e),
@@ -340,6 +344,7 @@ pub fn run(mut args: Args) -> Result<()> {
             }
         }
     }
+    progress.finish();
     report.elapsed_s = t0.elapsed().as_secs_f64();
     print!("{}", report.table());
     if let Some(dir) = &args.out {
