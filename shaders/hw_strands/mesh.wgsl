@@ -50,7 +50,6 @@ const MESH_SEGMENTS: u32 = 64u;
 // What a bundle's task workgroup hands its mesh workgroups.
 struct Task {
     first_strand: u32,
-    control_points: u32,
     chunks: u32,
 }
 var<task_payload> task: Task;
@@ -79,7 +78,6 @@ fn ts_main(@builtin(workgroup_id) wg: vec3<u32>) -> @builtin(mesh_task_size) vec
     let strands = bundle_lod[b * LOD_WORDS];
     let c = clamp(bundle_lod[b * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
     task.first_strand = bundle_lod[b * LOD_WORDS + 2u];
-    task.control_points = c;
     task.chunks = (c - 1u + MESH_SEGMENTS - 1u) / MESH_SEGMENTS;
     return vec3<u32>(strands * task.chunks, 1u, 1u);
 }

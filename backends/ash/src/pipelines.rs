@@ -168,30 +168,37 @@ fn build_pass(
             &gpu.name,
         )
     };
-    let spirv = spirv_of(None)?;
-    let module_of = |words: &[u32]| -> Result<Owned<vk::ShaderModule>, AshError> {
-        let info = vk::ShaderModuleCreateInfo::default().code(words);
-        // SAFETY: valid SPIR-V words from naga.
-        Ok(d.own(
-            unsafe { d.create_shader_module(&info, None) }
-                .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?,
-        ))
-    };
     // A mesh pipeline gets one module per stage, each holding only its
     // entry point, as wgpu-hal builds them; every other pass one module.
     // On the H100 (driver 580.159.04) one module holding the task, mesh and
     // fragment entry points passed spirv-val, but its first draw never
     // completed; the same stages as three modules render.
-    let modules = if mesh {
-        let per_entry = entries
-            .iter()
-            .map(|&e| Ok((e.to_string(), module_of(&spirv_of(Some(&e))?.words)?)));
-        Modules(per_entry.collect::<Result<_, AshError>>()?)
+    let translated: Vec<(&str, Spirv)> = if mesh {
+        let per_entry = entries.iter().map(|e| Ok((*e, spirv_of(Some(e))?)));
+        per_entry.collect::<Result<_, AshError>>()?
     } else {
-        Modules(vec![(String::new(), module_of(&spirv.words)?)])
+        // "": the module of every entry point.
+        vec![("", spirv_of(None)?)]
     };
+    let mut descriptors: Vec<(u32, vk::DescriptorType)> = translated
+        .iter()
+        .flat_map(|(_, s)| s.descriptors.iter().copied())
+        .collect();
+    descriptors.sort_by_key(|(b, _)| *b);
+    descriptors.dedup_by_key(|(b, _)| *b);
+    let modules = translated
+        .iter()
+        .map(|(entry, spirv)| {
+            let info = vk::ShaderModuleCreateInfo::default().code(&spirv.words);
+            // SAFETY: valid SPIR-V words from naga.
+            let module = unsafe { d.create_shader_module(&info, None) }
+                .ctx(&format!("pass `{}`: vkCreateShaderModule", pass.name))?;
+            Ok((entry.to_string(), d.own(module)))
+        })
+        .collect::<Result<_, AshError>>()
+        .map(Modules)?;
     let stage_flags = match &prep.raster {
-        Some(state) if matches!(state.geometry, Geometry::MeshTasks { .. }) => {
+        Some(_) if mesh => {
             vk::ShaderStageFlags::TASK_EXT
                 | vk::ShaderStageFlags::MESH_EXT
                 | vk::ShaderStageFlags::FRAGMENT
@@ -199,7 +206,7 @@ fn build_pass(
         Some(_) => vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
         None => vk::ShaderStageFlags::COMPUTE,
     };
-    let (set_layout, layout) = layouts(gpu, &spirv, stage_flags)?;
+    let (set_layout, layout) = layouts(gpu, &descriptors, stage_flags)?;
     let (work, sets) = match &prep.raster {
         Some(state) => raster_work(cx, prep, state, &modules, layout.raw(), index)?,
         None => compute_work(cx, prep, modules.of(prep.entry), layout.raw(), index)?,
@@ -210,21 +217,20 @@ fn build_pass(
         layout,
         set_layout,
         _modules: modules,
-        descriptors: spirv.descriptors,
+        descriptors,
     };
     Ok((built, sets))
 }
 
-/// The descriptor set layout of the shader's bindings, visible to
-/// `stage_flags`, and a pipeline layout of that one set.
+/// The descriptor set layout of the shader's bindings (`descriptors`),
+/// visible to `stage_flags`, and a pipeline layout of that one set.
 fn layouts(
     gpu: &Gpu,
-    spirv: &Spirv,
+    descriptors: &[(u32, vk::DescriptorType)],
     stage_flags: vk::ShaderStageFlags,
 ) -> Result<(Owned<vk::DescriptorSetLayout>, Owned<vk::PipelineLayout>), AshError> {
     let d = &gpu.device;
-    let bindings: Vec<vk::DescriptorSetLayoutBinding<'_>> = spirv
-        .descriptors
+    let bindings: Vec<vk::DescriptorSetLayoutBinding<'_>> = descriptors
         .iter()
         .map(|&(b, ty)| {
             vk::DescriptorSetLayoutBinding::default()

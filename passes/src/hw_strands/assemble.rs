@@ -19,7 +19,9 @@ use crate::layout::FrameData;
 use crate::lipp::assemble::{Assembly, Strands, assemble};
 use crate::lipp::payload::quantize;
 use crate::lipp::strand::{ControlPoint, strand_uv};
-use crate::lipp::{RASTER_GROUP, frame, mix, normalize, oct_encode, transform};
+use crate::lipp::{
+    BundleLod, BundleRecord, RASTER_GROUP, frame, mix, normalize, oct_encode, transform,
+};
 use crate::params::{Invalid, PassParams};
 use glam::Vec4;
 
@@ -94,10 +96,26 @@ pub static ASSEMBLE: PassKind<AssembleParams, AssembleGpu> = PassKind {
 
 struct AssembleKernel(AssembleParams);
 
+/// Strand `k` of bundle `rec` (LOD `lod`) assembled by Lipp Code 1 and
+/// projected: `emit` receives its segments in order. Shared with
+/// `hw_strands.mesh`, whose mesh shaders emit the same segments as quads.
+pub(super) fn strand_segments(
+    strands: &Strands<'_>,
+    opts: &Assembly,
+    view_proj: &[f32; 16],
+    (lod, rec, k): (&BundleLod, &BundleRecord, u32),
+    emit: &mut dyn FnMut(Segment),
+) {
+    let uv = strand_uv(k);
+    assemble(&strands.layers, rec, lod, k, opts, &mut |a, ta, b, tb| {
+        emit(record(view_proj, (a, ta), (b, tb), uv));
+    });
+}
+
 /// The record of segment (a, b) with end tangents ta, tb (the WGSL's
 /// `write_segment`): the tangent at the middle, packed once per segment
 /// as `lipp.raster` packs it with `segment_payload` on.
-pub(super) fn record(
+fn record(
     view_proj: &[f32; 16],
     (a, ta): (&ControlPoint, [f32; 3]),
     (b, tb): (&ControlPoint, [f32; 3]),
@@ -142,21 +160,14 @@ impl CpuKernel for AssembleKernel {
             let (lod, rec, k) = strands.strand(s);
             let c = lod.control_points.clamp(2, crate::lipp::MAX_CONTROL_POINTS);
             let first = args.fetch_add(0, (c - 1) * VERTICES_PER_SEGMENT) / VERTICES_PER_SEGMENT;
-            let uv = strand_uv(k);
             let mut next = first as usize;
-            assemble(
-                &strands.layers,
-                &rec,
-                &lod,
-                k,
-                &opts,
-                &mut |a, ta, b, tb| {
-                    if next < capacity {
-                        store(&out, next, &record(&view_proj, (a, ta), (b, tb), uv));
-                    }
-                    next += 1;
-                },
-            );
+            let strand = (&lod, &rec, k);
+            strand_segments(&strands, &opts, &view_proj, strand, &mut |segment| {
+                if next < capacity {
+                    store(&out, next, &segment);
+                }
+                next += 1;
+            });
             s += ctx.workgroups.max(1);
         }
     }

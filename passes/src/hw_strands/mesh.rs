@@ -28,13 +28,12 @@
 //! order) and rasterizes the quads with `hw_strands.raster`'s kernel.
 
 use super::Segment;
-use super::assemble::record;
+use super::assemble::strand_segments;
 use super::raster::{BANDS, QuadRaster, RasterParams, quads};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
-use crate::lipp::assemble::{Assembly, Strands, assemble};
-use crate::lipp::strand::strand_uv;
+use crate::lipp::assemble::{Assembly, Strands};
 use crate::lipp::{BundleLod, BundleRecord, frame};
 use crate::params::{Invalid, PassParams};
 use crate::raster_state::{Geometry, RasterState};
@@ -170,30 +169,21 @@ impl MeshKernel {
         let view_proj = frame(ctx).view_proj;
         let strands = Strands::load(ctx);
         let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
-        let per_bundle: Vec<Vec<Segment>> = (0..strands.count)
+        // Launch order: bundle by bundle, strand by strand.
+        (0..strands.count)
             .into_par_iter()
-            .map(|b| {
+            .flat_map_iter(|b| {
                 let lod = BundleLod::load(&strands.lods, b);
                 let rec = BundleRecord::load(&strands.bundles, b);
                 let mut out = Vec::new();
                 let kept = (0..lod.strands).take_while(|k| lod.first_strand + k < strands.total);
                 for k in kept {
-                    let uv = strand_uv(k);
-                    assemble(
-                        &strands.layers,
-                        &rec,
-                        &lod,
-                        k,
-                        &opts,
-                        &mut |a, ta, b, tb| {
-                            out.push(record(&view_proj, (a, ta), (b, tb), uv));
-                        },
-                    );
+                    let strand = (&lod, &rec, k);
+                    strand_segments(&strands, &opts, &view_proj, strand, &mut |s| out.push(s));
                 }
                 out
             })
-            .collect();
-        per_bundle.concat()
+            .collect()
     }
 }
 
