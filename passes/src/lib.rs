@@ -29,6 +29,7 @@ pub mod lipp;
 pub mod opaque_mesh;
 pub mod params;
 pub mod raster_state;
+pub mod reference;
 pub mod scheuermann;
 pub mod spirv;
 pub mod upload;
@@ -85,6 +86,11 @@ pub static PASSES: &[&dyn PassDef] = &[
     &hw_strands::assemble::ASSEMBLE,
     &hw_strands::raster::RASTER,
     &hw_strands::mesh::MESH,
+    // The ground-truth reference (docs/reference.md).
+    &reference::bin::COUNT,
+    &reference::scan::SCAN,
+    &reference::bin::FILL,
+    &reference::resolve::RESOLVE,
     // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,

@@ -14,7 +14,7 @@
 // the same loop over pixels and models.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
-#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, unpack_radiance, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
 
 struct ComposeParams {
     poisson_samples: u32,
@@ -127,22 +127,8 @@ fn rank_of(m: u32) -> u32 {
     return r;
 }
 
-fn f16_to_f32(h: u32) -> f32 {
-    let s = select(1.0, -1.0, (h & 0x8000u) != 0u);
-    let e = (h >> 10u) & 0x1Fu;
-    let m = f32(h & 0x3FFu);
-    if e == 0u {
-        return s * m * 5.9604645e-8;
-    }
-    if e == 31u {
-        return s * 65504.0;
-    }
-    return s * (1.0 + m / 1024.0) * exp2(f32(e) - 15.0);
-}
-
 fn lighting(v: u32) -> vec3<f32> {
-    let w = vertex_lighting[v];
-    return vec3<f32>(f16_to_f32(w.x & 0xFFFFu), f16_to_f32(w.x >> 16u), f16_to_f32(w.y & 0xFFFFu));
+    return unpack_radiance(vertex_lighting[v]);
 }
 
 fn pixel_hash(x: u32, y: u32) -> u32 {

@@ -120,6 +120,14 @@ static EXCEPTIONS: &[Exception] = &[
         why: "segments take their slot in a bin with an atomicAdd, so the order within a bin is the GPU's arrival order; the raster reads a bin's segments in any order",
     },
     Exception {
+        kind: "reference.fill",
+        binding: "reference_segments",
+        on: On::Every,
+        rule: Rule::Multiset,
+        outliers: 0.0,
+        why: "as kulikov.sort: a segment takes its slot in a tile's list with an atomicAdd, so the order within a list is arrival order; the resolve keeps, per sample, the nearest fragment whatever the order",
+    },
+    Exception {
         kind: "kulikov.shade_sort",
         binding: "shading_segments",
         on: On::Every,

@@ -1,0 +1,173 @@
+//! `reference.count` and `reference.fill`: each drawn segment into the list
+//! of every 8 × 8 screen tile its ribbon may reach (a counting sort by
+//! tile, with [`super::scan::SCAN`] between the two).
+//!
+//! A lane per segment. `count` projects the segment once and stores its
+//! ribbon as a record ([`Record`]) that `fill` and the resolve read, so
+//! nothing after it walks the models or the post-transform cache again. A
+//! tile takes the segment when the ribbon's axis passes within its widest
+//! radius of the disk around the tile ([`Ribbon::may_touch`]), so a long
+//! diagonal segment is not listed in every tile of its bounding box. `fill`
+//! takes slots with an atomicAdd on a second, cleared, per-tile counter; the
+//! order within a list is the GPU's arrival order, which the resolve does
+//! not depend on (it orders by depth, then segment).
+
+use super::ribbon::{Record, Ribbon};
+use super::{TILE, segment_ribbon, tiles};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::describe::PassKind;
+use crate::kernel::Ctx;
+use crate::kulikov::Scene;
+use crate::params::NoParams;
+use strandgraph_graph::Quantities;
+use strandgraph_graph::schema::Quantity;
+
+pub const GROUP: u32 = 256;
+
+crate::gpu_block! {
+    /// `BinParams` in shaders/reference/ribbon.wgsl.
+    pub struct BinGpu {
+        segments: u32,
+        width: u32,
+        height: u32,
+        tiles_x: u32,
+    }
+}
+
+fn bin_gpu(q: &Quantities) -> BinGpu {
+    BinGpu {
+        segments: count(q.segments),
+        width: q.width,
+        height: q.height,
+        tiles_x: tiles(q.width, q.height).0,
+    }
+}
+
+pub static COUNT: PassKind<NoParams, BinGpu> = PassKind {
+    kind: "reference.count",
+    summary: "per segment, its screen ribbon, counted in every 8x8 tile it may reach",
+    source: "ours: the ground-truth reference (docs/reference.md)",
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("segment_visibility"),
+        Binding::read("clip_positions"),
+        Binding::read("groom.vertices"),
+        Binding::atomic("reference_counts"),
+        Binding::write("reference_ribbons"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("reference/count.wgsl", "count"),
+    kernel: |_| Box::new(CountKernel),
+    gpu: |_, q| bin_gpu(q),
+    raster: None,
+};
+
+pub static FILL: PassKind<NoParams, BinGpu> = PassKind {
+    kind: "reference.fill",
+    summary: "per segment, write it into the list of every tile it was counted in",
+    source: "ours: the ground-truth reference (docs/reference.md)",
+    bindings: Some(&[
+        Binding::read("reference_ribbons"),
+        Binding::read("reference_offsets"),
+        Binding::atomic("reference_cursor"),
+        Binding::write("reference_segments"),
+    ]),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Segments,
+        per_group: GROUP,
+    },
+    shader: Shader::compute("reference/fill.wgsl", "fill"),
+    kernel: |_| Box::new(FillKernel),
+    gpu: |_, q| bin_gpu(q),
+    raster: None,
+};
+
+/// The tiles `ribbon` may reach, row by row.
+pub fn reached_tiles(ribbon: &Ribbon, width: u32, height: u32) -> Vec<u32> {
+    let [x0, y0, x1, y1] = ribbon.bounds();
+    let (x0, y0) = (x0.max(0.0), y0.max(0.0));
+    let (x1, y1) = (x1.min(width as f32 - 1.0), y1.min(height as f32 - 1.0));
+    if !(x0 <= x1 && y0 <= y1) {
+        return Vec::new();
+    }
+    let tiles_x = tiles(width, height).0;
+    let (tx0, ty0, tx1, ty1) = (
+        x0 as u32 / TILE,
+        y0 as u32 / TILE,
+        x1 as u32 / TILE,
+        y1 as u32 / TILE,
+    );
+    let half = 0.5 * TILE as f32;
+    let mut out = Vec::new();
+    for ty in ty0..=ty1 {
+        for tx in tx0..=tx1 {
+            let centre = [(tx * TILE) as f32 + half, (ty * TILE) as f32 + half];
+            if ribbon.may_touch(centre, half) {
+                out.push(ty * tiles_x + tx);
+            }
+        }
+    }
+    out
+}
+
+/// The segments of workgroup `group` that exist.
+fn lanes(group: u32, q: Quantities) -> impl Iterator<Item = u32> {
+    let first = group * GROUP;
+    let segments = q.segments;
+    (first..first + GROUP).take_while(move |&id| u64::from(id) < segments)
+}
+
+struct CountKernel;
+
+impl CpuKernel for CountKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let scene = Scene::load(ctx);
+        let lods = scene.lods(ctx);
+        let q = ctx.quantities;
+        let (counts, records) = (
+            ctx.words("reference_counts"),
+            ctx.words("reference_ribbons"),
+        );
+        for id in lanes(group, q) {
+            let record = segment_ribbon(&scene, &lods, ctx, id);
+            Record::store(record.as_ref(), &records, id as usize);
+            for t in record.map_or_else(Vec::new, |r| reached_tiles(&r.ribbon, q.width, q.height)) {
+                counts.fetch_add(t as usize, 1);
+            }
+        }
+    }
+}
+
+struct FillKernel;
+
+impl CpuKernel for FillKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let q = ctx.quantities;
+        let (records, offsets, cursor, list) = (
+            ctx.words("reference_ribbons"),
+            ctx.words("reference_offsets"),
+            ctx.words("reference_cursor"),
+            ctx.words("reference_segments"),
+        );
+        for id in lanes(group, q) {
+            let Some(record) = Record::load(&records, id as usize) else {
+                continue;
+            };
+            for t in reached_tiles(&record.ribbon, q.width, q.height) {
+                let taken = cursor.fetch_add(t as usize, 1);
+                let slot = offsets.load(t as usize).wrapping_add(taken) as usize;
+                // Past the capacity the list is cut; check_capacity reports it.
+                if slot < list.len() {
+                    list.store(slot, id);
+                }
+            }
+        }
+    }
+}

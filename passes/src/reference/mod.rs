@@ -1,0 +1,96 @@
+//! The ground-truth reference: what a hair pipeline approximates, rendered
+//! without its approximations, so its error can be measured (FLIP and
+//! coverage against this image, next to the time).
+//!
+//! Every strand is the camera-facing ribbon of its own thickness
+//! ([`ribbon`]): no level of detail, no thickness compensation, no layer
+//! limit, no coverage estimate. Each pixel takes `n × n` stratified samples
+//! (64 by default); at each sample every hair fragment covering it is
+//! blended front to back (strands are opaque, so the nearest one shows). Shading is the
+//! pipeline's own: the passes here read the post-transform cache
+//! (`clip_positions`) and per-vertex radiance (`vertex_lighting`) that
+//! Kulikov's skinning and strand-space shading write, so against the
+//! Kulikov pipeline the reference differs only in visibility, transparency
+//! and antialiasing (`scenes/graphs/kulikov_reference.ron`).
+//!
+//! Four passes, on every backend:
+//! 1. [`bin::COUNT`]: per segment, its ribbon (a record the later passes
+//!    read) and the 8 × 8 screen tiles it may reach, counted per tile;
+//! 2. [`scan::SCAN`]: the tiles' prefix sum, a list range per tile;
+//! 3. [`bin::FILL`]: each segment written into the lists of its tiles;
+//! 4. [`resolve::RESOLVE`]: per pixel, every segment of the tile's list
+//!    tested against every sample, each sample keeping the nearest.
+//!
+//! The lists hold at most the capacity the graph gives `reference_segments`;
+//! the scan records how many entries the frame needed, and
+//! [`check_capacity`] turns an overflow into an error naming the resource.
+
+pub mod bin;
+pub mod resolve;
+pub mod ribbon;
+pub mod scan;
+
+use crate::kernel::Ctx;
+use crate::kulikov::cull::drawn_segment;
+use crate::kulikov::{ModelLod, Scene};
+use ribbon::{Record, Ribbon};
+
+/// Screen tile edge of the segment lists, in pixels (a resolve workgroup of
+/// 64 lanes). A pixel scans its tile's whole list, so the list's length is
+/// the resolve's cost, and a smaller tile lists fewer segments that miss
+/// the pixel.
+pub const TILE: u32 = 8;
+
+/// The screen's tile grid for `width × height` pixels.
+pub fn tiles(width: u32, height: u32) -> (u32, u32) {
+    (width.div_ceil(TILE), height.div_ceil(TILE))
+}
+
+/// Segment `id`'s ribbon, or `None` when it is not drawn: culled (the
+/// fedora), dropped by the LOD, or crossing the near plane. Its ends join
+/// the neighbouring segments of the strand, except at the root and tip.
+pub(crate) fn segment_ribbon(
+    scene: &Scene,
+    lods: &[ModelLod],
+    ctx: &Ctx<'_>,
+    id: u32,
+) -> Option<Record> {
+    let visible = ctx.words("segment_visibility").load((id / 32) as usize) & (1 << (id % 32));
+    if visible == 0 {
+        return None;
+    }
+    let seg = drawn_segment(scene, lods, id)?;
+    let md = &scene.models[seg.model];
+    let lod = &lods[seg.model];
+    let k = seg.local % (md.points_per_strand - 1);
+    let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
+    let thickness = |v: u32| verts.load_f32(4 * v as usize + 3) * lod.thickness_scale;
+    let ribbon = Ribbon::new(
+        &scene.frame,
+        clip.load_vec4(seg.v0 as usize),
+        clip.load_vec4(seg.v1 as usize),
+        thickness(seg.v0),
+        thickness(seg.v1),
+        k > 0,
+        k + 1 < lod.segments_per_strand,
+    )?;
+    Some(Record {
+        ribbon,
+        vertices: [seg.v0, seg.v1],
+    })
+}
+
+/// `Err` when a frame needed more list entries than `reference_segments`
+/// holds (its lists were cut short, so the image is wrong). `offsets` is
+/// `reference_offsets` as read back after the frame: the tiles' offsets,
+/// then the total.
+pub fn check_capacity(offsets: &[u32], capacity: usize, tiles: usize) -> Result<(), String> {
+    let needed = offsets.get(tiles).copied().unwrap_or(0) as usize;
+    if needed > capacity {
+        return Err(format!(
+            "reference: the frame needed {needed} tile-list entries but `reference_segments` holds {capacity}; \
+             give it more bytes per segment in the graph"
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,80 @@
+// reference.count: per segment, its ribbon record, and +1 in every 8x8
+// screen tile the ribbon may reach. Port of passes/src/reference/bin.rs
+// (count) and reference::segment_ribbon.
+
+#define FRAME_BINDING 1
+#define MODELS_BINDING 2
+#define LOD_MODELS_BINDING 3
+#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::kulikov::load_lod
+#import strandgraph::clip::clip_to_screen
+#import strandgraph::reference::{BinParams, Ribbon, ribbon_pack, ribbon_tiles, ribbon_reaches_tile}
+
+@group(0) @binding(0) var<uniform> params: BinParams;
+@group(0) @binding(4) var<storage, read> segment_visibility: array<u32>;
+@group(0) @binding(5) var<storage, read> clip_positions: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> groom_vertices: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read_write> reference_counts: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read_write> reference_ribbons: array<vec4<u32>>;
+
+// reference::segment_ribbon: not drawn when culled, dropped by the LOD or
+// crossing the near plane; joined to its neighbours but at root and tip.
+fn segment_ribbon(id: u32) -> Ribbon {
+    var r: Ribbon;
+    r.valid = false;
+    if (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
+        return r;
+    }
+    let seg = drawn_segment(id);
+    if !seg.valid {
+        return r;
+    }
+    let per = models[seg.model].points_per_strand - 1u;
+    let lod = load_lod(lod_models[seg.model]);
+    let k = seg.local % per;
+    let c0 = clip_positions[seg.va];
+    let c1 = clip_positions[seg.vb];
+    if !(c0.w >= frame.near && c1.w >= frame.near) {
+        return r;
+    }
+    let sa = clip_to_screen(c0, frame.screen.x, frame.screen.y);
+    let sb = clip_to_screen(c1, frame.screen.x, frame.screen.y);
+    let t0 = groom_vertices[seg.va].w * lod.thickness_scale;
+    let t1 = groom_vertices[seg.vb].w * lod.thickness_scale;
+    r.a = sa.xy;
+    r.b = sb.xy;
+    r.ha = 0.5 * t0 * frame.pixels_per_unit / c0.w;
+    r.hb = 0.5 * t1 * frame.pixels_per_unit / c1.w;
+    r.wa = c0.w;
+    r.wb = c1.w;
+    r.join_a = k > 0u;
+    r.join_b = k + 1u < lod.segments_per_strand;
+    r.va = seg.va;
+    r.vb = seg.vb;
+    r.valid = true;
+    return r;
+}
+
+@compute @workgroup_size(256)
+fn count(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let id = gid.x;
+    if id >= params.segments {
+        return;
+    }
+    let r = segment_ribbon(id);
+    let words = ribbon_pack(r);
+    reference_ribbons[3u * id] = words[0];
+    reference_ribbons[3u * id + 1u] = words[1];
+    reference_ribbons[3u * id + 2u] = words[2];
+    if !r.valid {
+        return;
+    }
+    let t = ribbon_tiles(r, params.width, params.height);
+    for (var ty = t.y; ty <= t.w; ty++) {
+        for (var tx = t.x; tx <= t.z; tx++) {
+            if ribbon_reaches_tile(r, tx, ty) {
+                atomicAdd(&reference_counts[ty * params.tiles_x + tx], 1u);
+            }
+        }
+    }
+}
