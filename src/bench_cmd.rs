@@ -11,6 +11,7 @@
 //! cells marked skipped with the reason.
 
 mod progress;
+mod quality;
 mod report;
 mod variants;
 
@@ -21,6 +22,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
+use strandgraph::images::main_picture;
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -91,7 +93,7 @@ pub struct Args {
 
 /// `rel` under the working directory, else under the checkout the binary
 /// was built from (the device machine runs from a copy of the tree).
-fn locate(rel: &str) -> PathBuf {
+pub(crate) fn locate(rel: &str) -> PathBuf {
     let here = PathBuf::from(rel);
     if here.exists() {
         return here;
@@ -140,7 +142,7 @@ fn missing_kernel(graph: &Path) -> Result<Option<String>> {
 /// the offline bake (`frame::bake_shadows`, run by `frame::complete_upload`) takes minutes per groom on a
 /// 2-core CI machine and its cache is per machine. Full runs keep the
 /// graph's `Baked`, baked once and then read from the cache.
-fn prepare_graph(
+pub(crate) fn prepare_graph(
     scene_path: &Path,
     graph: &Path,
     size: Option<(u32, u32)>,
@@ -285,6 +287,7 @@ pub fn run(mut args: Args) -> Result<()> {
     let mut counts: BTreeMap<(usize, usize), u64> = BTreeMap::new();
     let chosen = backends(&args);
     let progress = Progress::new((chosen.len() * rows.len() * scenes.len()) as u64);
+    let mut references = quality::References::default();
     'backends: for (backend, required) in chosen {
         // The roofline, on the first scene's screen size. A device that
         // cannot run it (no 64-bit atomics) still gets its rows timed.
@@ -325,8 +328,19 @@ pub fn run(mut args: Args) -> Result<()> {
                     }
                 };
                 match measure(backend, p, v, &args, cpu, atomics) {
-                    Ok((device, notes, stats)) => {
+                    Ok((device, notes, mut stats, picture)) => {
                         report.device(backend, &device, &notes);
+                        if let Some(img) = picture {
+                            let setup = quality::Setup {
+                                scene: &scenes[s],
+                                size,
+                                quick: args.quick,
+                                cpu,
+                            };
+                            stats.flip = references
+                                .flip(backend, s, &setup, v, &img)
+                                .map_err(|e| miette!("{}: {}: {e}", v.pipeline, v.name))?;
+                        }
                         report.cell(backend, v, s, Cell::Measured(stats));
                     }
                     // `all` takes the backends that open here.
@@ -345,6 +359,9 @@ pub fn run(mut args: Args) -> Result<()> {
         }
     }
     progress.finish();
+    for line in references.notes.drain(..) {
+        report.note(line);
+    }
     report.elapsed_s = t0.elapsed().as_secs_f64();
     print!("{}", report.table());
     if let Some(dir) = &args.out {
@@ -421,7 +438,8 @@ fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptio
         .sum())
 }
 
-/// One cell's timed frames: the device, its notes, the statistics.
+/// One cell's timed frames: the device, its notes, the statistics, and
+/// the last frame's picture (for its quality).
 fn measure(
     backend: Backend,
     p: &Prepared,
@@ -429,12 +447,17 @@ fn measure(
     args: &Args,
     cpu: CpuOptions,
     atomics: u64,
-) -> Result<(String, Vec<String>, Stats)> {
+) -> Result<(String, Vec<String>, Stats, Option<image::RgbaImage>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
+    runner::check_frame(&plan, &p.instance, session.as_ref())?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);
-    Ok((session.device(), session.notes(), stats))
+    let q = p.upload.quantities;
+    let picture = main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
+        session.read(name).ok().flatten()
+    });
+    Ok((session.device(), session.notes(), stats, picture))
 }
 
 /// What the roofline run gives one backend.

@@ -145,3 +145,18 @@ mod tests {
         (f / (n - f) * -d + n * f / (n - f)) / d
     }
 }
+
+/// The first image output of `plan` that makes a picture, read from a
+/// session by `read`: what `render` writes as its main image.
+pub fn main_picture(
+    plan: &Plan,
+    width: u32,
+    height: u32,
+    display: Display,
+    read: impl Fn(&str) -> Option<Vec<u32>>,
+) -> Option<RgbaImage> {
+    plan.graph.outputs.iter().find_map(|&(r, _)| {
+        let words = read(&plan.graph.resources[r].name)?;
+        to_picture(plan, r, &words, width, height, display)
+    })
+}

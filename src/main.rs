@@ -5,6 +5,7 @@
 
 mod agree_cmd;
 mod bench_cmd;
+mod compare_cmd;
 mod graph_cmd;
 mod info;
 mod render_cmd;
@@ -32,6 +33,8 @@ enum Command {
     Bench(bench_cmd::Args),
     /// Run every pass of a scene's graph alone on the CPU simulator and the GPU backends, and compare every output.
     Agree(agree_cmd::Args),
+    /// How two pictures differ (FLIP): a render against the reference, say.
+    Compare(compare_cmd::Args),
     /// Regenerate (or --check) README's tables from the measurements under benches/results/.
     Tables(tables_cmd::Args),
 }
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(args),
         Command::Bench(args) => bench_cmd::run(args),
         Command::Agree(args) => agree_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
         Command::Tables(args) => tables_cmd::run(args),
     };
     match result {

@@ -129,6 +129,7 @@ pub fn run(args: Args) -> Result<()> {
         let mut session = runner::open(backend, &p.plan, &p.instance, options)?;
         let times = session.run(&p.upload)?;
         let wall = t1.elapsed().as_secs_f64() * 1e3;
+        runner::check_frame(&p.plan, &p.instance, session.as_ref())?;
         print_timings(&p.plan, &times, args.instrument);
         println!(
             "{} backend: frame {wall:.1} ms wall, including device and pipeline creation; {}",

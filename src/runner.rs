@@ -126,3 +126,39 @@ impl std::fmt::Display for Unsupported {
 
 impl std::error::Error for Unsupported {}
 impl miette::Diagnostic for Unsupported {}
+
+/// What the host checks after a frame of `plan`: where it runs the
+/// reference's resolve, that its tile lists fit their buffer and, on
+/// lavapipe, that no lane had more to walk than the driver's loop cap
+/// ([`strandgraph_passes::reference::check_lists`]).
+pub fn check_frame(plan: &Plan, instance: &Instance, session: &dyn Session) -> Result<()> {
+    use strandgraph_passes::reference::{
+        self, LLVMPIPE_LOOP_ITERATIONS, ListLimits, resolve::ResolveParams,
+    };
+    let resolve = plan
+        .order
+        .iter()
+        .find(|&&p| plan.live[p] && plan.graph.passes[p].kind == reference::resolve::RESOLVE.kind);
+    let (Some(&p), Some(lists)) = (resolve, plan.graph.resource_id("reference_segments")) else {
+        return Ok(());
+    };
+    let params: ResolveParams = plan.graph.passes[p]
+        .params
+        .clone()
+        .into_rust()
+        .map_err(|e| miette::miette!("pass `{}`: {e}", plan.pass_name(p)))?;
+    let Some(offsets) = session.read("reference_offsets").into_diagnostic()? else {
+        return Ok(());
+    };
+    let q = &instance.quantities;
+    let (tx, ty) = reference::tiles(q.width, q.height);
+    let limits = ListLimits {
+        capacity: (instance.sizes[lists].bytes / 4) as usize,
+        loop_cap: session
+            .device()
+            .contains("llvmpipe")
+            .then_some(LLVMPIPE_LOOP_ITERATIONS),
+        samples_per_axis: params.samples_per_axis,
+    };
+    reference::check_lists(&offsets, (tx * ty) as usize, limits).map_err(|e| miette::miette!("{e}"))
+}

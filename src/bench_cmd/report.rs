@@ -1,6 +1,7 @@
 //! The bench's results: statistics per cell, the printed table (shaped as
 //! Lipp's Table 1), and the CSV and JSON files.
 
+use super::quality;
 use super::{Args, Variant};
 use miette::{IntoDiagnostic, Result, WrapErr};
 use serde_json::{Value, json};
@@ -57,6 +58,8 @@ pub struct Stats {
     pub raster_atomics: u64,
     /// Every frame's per-pass times (JSON only).
     pub per_frame: Vec<Vec<f64>>,
+    /// Mean FLIP of the last frame against the pipeline's reference.
+    pub flip: Option<f32>,
 }
 
 impl Stats {
@@ -92,6 +95,7 @@ impl Stats {
                 .iter()
                 .map(|f| f.iter().map(|t| t.millis.unwrap_or(f64::NAN)).collect())
                 .collect(),
+            flip: None,
         }
     }
 
@@ -219,6 +223,51 @@ impl Report {
     }
 
     /// The text table.
+    /// Mean FLIP per row and view, for the rows whose pipeline has a
+    /// reference; empty when none has.
+    fn quality_table(&self, rows: &[(Backend, Variant)]) -> String {
+        let mut o = String::new();
+        let w = 12;
+        let with: Vec<&(Backend, Variant)> = rows
+            .iter()
+            .filter(|(_, v)| quality::reference_graph(v.pipeline).is_some())
+            .collect();
+        if with.is_empty() {
+            return o;
+        }
+        let _ = writeln!(
+            o,
+            "\nQuality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)"
+        );
+        let _ = write!(o, "  {:<5} {:<34}", "", "pipeline: variant");
+        for v in &self.views {
+            let _ = write!(o, " {v:>w$}");
+        }
+        let _ = writeln!(o);
+        for (b, v) in with {
+            let _ = write!(
+                o,
+                "  {:<5} {:<34}",
+                b.name(),
+                format!("{}: {}", v.pipeline, v.name)
+            );
+            for s in 0..self.views.len() {
+                let flip = self.cells.iter().find_map(|(x, y, view, c)| match c {
+                    Cell::Measured(st)
+                        if x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s =>
+                    {
+                        st.flip
+                    }
+                    _ => None,
+                });
+                let text = flip.map_or("-".into(), |f| format!("{f:.4}"));
+                let _ = write!(o, " {text:>w$}");
+            }
+            let _ = writeln!(o);
+        }
+        o
+    }
+
     pub fn table(&self) -> String {
         let mut o = String::new();
         let _ = writeln!(
@@ -313,6 +362,7 @@ impl Report {
         for why in skipped {
             let _ = writeln!(o, "  skipped: {why}");
         }
+        o.push_str(&self.quality_table(&rows));
         for note in &self.notes {
             let _ = writeln!(o, "  {note}");
         }
@@ -409,6 +459,10 @@ impl Report {
                     Cell::Skipped(why) => j["skipped"] = json!(why),
                     Cell::Measured(st) => {
                         j["frames"] = json!(st.frames);
+                        if let Some(f) = st.flip {
+                            j["flip"] = json!(f);
+                            j["flip_reference"] = json!(quality::reference_graph(v.pipeline));
+                        }
                         j["frame"] = st.total.json();
                         j["raster"] = st.raster.json();
                         j["raster_passes"] = json!(v.raster);

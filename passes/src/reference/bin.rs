@@ -163,7 +163,7 @@ impl CpuKernel for FillKernel {
             for t in reached_tiles(&record.ribbon, q.width, q.height) {
                 let taken = cursor.fetch_add(t as usize, 1);
                 let slot = offsets.load(t as usize).wrapping_add(taken) as usize;
-                // Past the capacity the list is cut; check_capacity reports it.
+                // Past the capacity the list is cut; check_lists reports it.
                 if slot < list.len() {
                     list.store(slot, id);
                 }

@@ -22,8 +22,8 @@
 //!    tested against every sample, each sample keeping the nearest.
 //!
 //! The lists hold at most the capacity the graph gives `reference_segments`;
-//! the scan records how many entries the frame needed, and
-//! [`check_capacity`] turns an overflow into an error naming the resource.
+//! the scan records how many entries the frame needed, and [`check_lists`]
+//! turns an overflow into an error naming the resource.
 
 pub mod bin;
 pub mod resolve;
@@ -80,17 +80,91 @@ pub(crate) fn segment_ribbon(
     })
 }
 
-/// `Err` when a frame needed more list entries than `reference_segments`
-/// holds (its lists were cut short, so the image is wrong). `offsets` is
-/// `reference_offsets` as read back after the frame: the tiles' offsets,
-/// then the total.
-pub fn check_capacity(offsets: &[u32], capacity: usize, tiles: usize) -> Result<(), String> {
+/// Lavapipe (llvmpipe) ends every loop of a shader invocation once the
+/// invocation has run this many loop iterations in all
+/// (`LP_MAX_TGSI_LOOP_ITERATIONS`): past it a resolve lane silently skips
+/// samples.
+pub const LLVMPIPE_LOOP_ITERATIONS: u64 = 65_535;
+
+/// What a frame's tile lists must satisfy, checked on the host after it.
+#[derive(Debug, Clone, Copy)]
+pub struct ListLimits {
+    /// Entries `reference_segments` holds.
+    pub capacity: usize,
+    /// The device's cap on loop iterations per invocation, if it has one.
+    pub loop_cap: Option<u64>,
+    /// The resolve's `samples_per_axis`.
+    pub samples_per_axis: u32,
+}
+
+/// `Err` when the frame's lists did not fit their buffer (they were cut
+/// short), or when on a device with a loop cap a resolve lane had more list
+/// entries to walk than the cap lets it: either way the image is wrong.
+/// `offsets` is `reference_offsets` read back after the frame: the tiles'
+/// offsets, then the total.
+pub fn check_lists(offsets: &[u32], tiles: usize, limits: ListLimits) -> Result<(), String> {
     let needed = offsets.get(tiles).copied().unwrap_or(0) as usize;
-    if needed > capacity {
+    if needed > limits.capacity {
         return Err(format!(
-            "reference: the frame needed {needed} tile-list entries but `reference_segments` holds {capacity}; \
-             give it more bytes per segment in the graph"
+            "reference: the frame needed {needed} tile-list entries but `reference_segments` holds {}; \
+             give it more bytes per segment in the graph",
+            limits.capacity
+        ));
+    }
+    let Some(cap) = limits.loop_cap else {
+        return Ok(());
+    };
+    let longest = offsets
+        .windows(2)
+        .take(tiles)
+        .map(|w| u64::from(w[1].saturating_sub(w[0])))
+        .max()
+        .unwrap_or(0);
+    // resolve.wgsl: per block of 64 samples, 64 iterations to set up, the
+    // list, 64 to finish.
+    let samples = u64::from(limits.samples_per_axis).pow(2);
+    let iterations = samples.div_ceil(64) * (longest + 128);
+    if iterations >= cap {
+        return Err(format!(
+            "reference: a tile lists {longest} segments, {iterations} loop iterations for a resolve lane \
+             at {samples} samples, and this device stops an invocation's loops after {cap} \
+             (lavapipe); render at a higher resolution, with fewer samples, or on a GPU"
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LIMITS: ListLimits = ListLimits {
+        capacity: 10,
+        loop_cap: None,
+        samples_per_axis: 8,
+    };
+
+    #[test]
+    fn lists_that_overflow_or_outrun_the_loop_cap_are_errors() {
+        // Two tiles: 4 and 6 entries, 10 in all.
+        let offsets = [0, 4, 10];
+        assert!(check_lists(&offsets, 2, LIMITS).is_ok());
+        let small = ListLimits {
+            capacity: 9,
+            ..LIMITS
+        };
+        let e = check_lists(&offsets, 2, small).unwrap_err();
+        assert!(e.contains("needed 10") && e.contains("holds 9"), "{e}");
+        let capped = ListLimits {
+            loop_cap: Some(134),
+            ..LIMITS
+        };
+        let e = check_lists(&offsets, 2, capped).unwrap_err();
+        assert!(e.contains("lists 6 segments") && e.contains("134"), "{e}");
+        let roomy = ListLimits {
+            loop_cap: Some(135),
+            ..capped
+        };
+        assert!(check_lists(&offsets, 2, roomy).is_ok());
+    }
 }

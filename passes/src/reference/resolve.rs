@@ -235,3 +235,81 @@ impl CpuKernel for ResolveKernel {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reference::ribbon::Ribbon;
+
+    /// A horizontal ribbon across pixel (0, 0) at height `y`, half width
+    /// `h`, view depth `w`; its colour is its vertex index.
+    fn across(id: u32, y: f32, h: f32, w: f32) -> Candidate {
+        let ribbon = Ribbon {
+            a: [-4.0, y],
+            b: [4.0, y],
+            ha: h,
+            hb: h,
+            wa: w,
+            wb: w,
+            join_a: false,
+            join_b: false,
+        };
+        Candidate {
+            id,
+            record: Record {
+                ribbon,
+                vertices: [id, id],
+            },
+        }
+    }
+
+    const PX: Pixel = Pixel {
+        x: 0,
+        y: 0,
+        width: 16,
+        samples_per_axis: 8,
+        scene_z: 1.0,
+        near: 0.1,
+        far: 100.0,
+    };
+
+    fn colour(v: [u32; 2], _: f32) -> [f32; 3] {
+        [v[0] as f32, 1.0, 0.0]
+    }
+
+    #[test]
+    fn a_ribbon_covers_its_width_of_the_pixel() {
+        // A quarter-pixel band: 8 x 8 stratified samples find it within a row.
+        let (hair, open) = resolve_pixel(&PX, &[across(3, 0.5, 0.125, 1.0)], colour);
+        assert!((open - 0.75).abs() <= 0.125, "{open}");
+        assert!((hair[1] - (1.0 - open)).abs() < 1e-6);
+        assert!((hair[0] - 3.0 * (1.0 - open)).abs() < 1e-5);
+    }
+
+    #[test]
+    fn each_sample_shows_the_nearest_fragment_whatever_the_list_order() {
+        let near = across(1, 0.5, 1.0, 2.0);
+        let far = across(2, 0.5, 1.0, 3.0);
+        for list in [[near, far], [far, near]] {
+            let (hair, open) = resolve_pixel(&PX, &list, colour);
+            assert_eq!(open, 0.0);
+            assert!((hair[0] - 1.0).abs() < 1e-6, "{hair:?}");
+        }
+        // At equal depth the lower segment id wins, on every backend alike.
+        let twin = across(0, 0.5, 1.0, 2.0);
+        let (hair, _) = resolve_pixel(&PX, &[near, twin], colour);
+        assert_eq!(hair[0], 0.0);
+    }
+
+    #[test]
+    fn the_opaque_scene_hides_hair_behind_it() {
+        let hidden = Pixel {
+            scene_z: ndc_depth(1.5, PX.near, PX.far),
+            ..PX
+        };
+        let (hair, open) = resolve_pixel(&hidden, &[across(1, 0.5, 1.0, 2.0)], colour);
+        assert_eq!((hair, open), ([0.0; 3], 1.0));
+        let (_, open) = resolve_pixel(&hidden, &[across(1, 0.5, 1.0, 1.2)], colour);
+        assert_eq!(open, 0.0);
+    }
+}

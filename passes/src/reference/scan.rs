@@ -1,6 +1,6 @@
 //! `reference.scan`: the tiles' list offsets, an exclusive prefix sum of
 //! the counts `reference.count` left, and after them the total the frame
-//! needs (which [`super::check_capacity`] compares with the lists' size).
+//! needs (which [`super::check_lists`] compares with the lists' size).
 //!
 //! One workgroup: each lane sums a run of consecutive tiles, the lanes'
 //! sums are scanned in workgroup memory, then each lane writes its run (the
