@@ -126,6 +126,21 @@ pub fn motion_image(words: &[u32], width: u32, height: u32) -> Option<Rgb32FImag
     Rgb32FImage::from_raw(width, height, data)
 }
 
+/// The first image output of `plan` that makes a picture, read from a
+/// session by `read`: what `render` writes as its main image.
+pub fn main_picture(
+    plan: &Plan,
+    width: u32,
+    height: u32,
+    display: Display,
+    read: impl Fn(&str) -> Option<Vec<u32>>,
+) -> Option<RgbaImage> {
+    plan.graph.outputs.iter().find_map(|&(r, _)| {
+        let words = read(&plan.graph.resources[r].name)?;
+        to_picture(plan, r, &words, width, height, display)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,17 +161,3 @@ mod tests {
     }
 }
 
-/// The first image output of `plan` that makes a picture, read from a
-/// session by `read`: what `render` writes as its main image.
-pub fn main_picture(
-    plan: &Plan,
-    width: u32,
-    height: u32,
-    display: Display,
-    read: impl Fn(&str) -> Option<Vec<u32>>,
-) -> Option<RgbaImage> {
-    plan.graph.outputs.iter().find_map(|&(r, _)| {
-        let words = read(&plan.graph.resources[r].name)?;
-        to_picture(plan, r, &words, width, height, display)
-    })
-}

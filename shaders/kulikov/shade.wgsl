@@ -237,12 +237,17 @@ fn store_lighting(v: u32, c: vec3<f32>) {
     vertex_lighting[v] = vec2<u32>(f16_bits(c.x) | (f16_bits(c.y) << 16u), f16_bits(c.z) | (0x3C00u << 16u));
 }
 
+// shade_sort::MAX_SHADE_GROUPS: the dispatch's cap in x, past which lanes stride.
+const MAX_SHADE_GROUPS: u32 = 65535u;
+
 @compute @workgroup_size(64)
 fn shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let i = wg.x * GROUP + lane;
-    if i >= shade_args[3] {
-        return;
+    for (var i = wg.x * GROUP + lane; i < shade_args[3]; i += MAX_SHADE_GROUPS * GROUP) {
+        shade_segment(i);
     }
+}
+
+fn shade_segment(i: u32) {
     let id = shading_segments[i];
     let seg = drawn_segment(id);
     if !seg.valid {

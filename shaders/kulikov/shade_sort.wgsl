@@ -19,6 +19,8 @@ struct ShadeSortParams {
 const GROUP: u32 = 256u;
 // kulikov.shade's workgroup size (shade_sort::SHADE_GROUP).
 const SHADE_GROUP: u32 = 64u;
+// shade_sort::MAX_SHADE_GROUPS: x of the shade dispatch; its lanes stride past it.
+const MAX_SHADE_GROUPS: u32 = 65535u;
 
 @compute @workgroup_size(256)
 fn shade_sort(
@@ -36,7 +38,7 @@ fn shade_sort(
         var base = 0u;
         if elected(sg_lane) && n > 0u {
             base = atomicAdd(&shade_args[3], n);
-            atomicMax(&shade_args[0], (base + n + SHADE_GROUP - 1u) / SHADE_GROUP);
+            atomicMax(&shade_args[0], min((base + n + SHADE_GROUP - 1u) / SHADE_GROUP, MAX_SHADE_GROUPS));
             atomicStore(&shade_args[1], 1u);
             atomicStore(&shade_args[2], 1u);
         }
@@ -47,7 +49,7 @@ fn shade_sort(
     } else if visible {
         let slot = atomicAdd(&shade_args[3], 1u);
         shading_segments[slot] = id;
-        atomicMax(&shade_args[0], (slot + 1u + SHADE_GROUP - 1u) / SHADE_GROUP);
+        atomicMax(&shade_args[0], min((slot + 1u + SHADE_GROUP - 1u) / SHADE_GROUP, MAX_SHADE_GROUPS));
         atomicStore(&shade_args[1], 1u);
         atomicStore(&shade_args[2], 1u);
     }

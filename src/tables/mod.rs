@@ -15,6 +15,8 @@
 //! it, `tests/readme_tables.rs`). Generators:
 //! - `agree FILE.json...`: per-pass agreement ([`crate::agree::summary`]);
 //! - `bench FILE.json`: frame medians per pipeline variant and view;
+//! - `bench-flip FILE.json`: mean FLIP against the reference per variant
+//!   and view, for the variants whose pipeline has one;
 //! - `bench-passes FILE.json VARIANT [VIEW...]`: one variant's per-pass
 //!   medians per view, or only the views named (`_` in VARIANT stands for a
 //!   space: `Kulikov:_all_optimisations`);
@@ -104,6 +106,9 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
         [kind, file] if kind == "bench" => {
             bench::frame_table(&read(file)?).map_err(|e| format!("{file}: {e}"))
         }
+        [kind, file] if kind == "bench-flip" => {
+            bench::flip_table(&read(file)?).map_err(|e| format!("{file}: {e}"))
+        }
         [kind, file, variant, views @ ..] if kind == "bench-passes" => {
             bench::pass_table(&read(file)?, &variant.replace('_', " "), views)
                 .map_err(|e| format!("{file}: {e}"))
@@ -115,7 +120,7 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
             view,
         ),
         _ => Err(format!(
-            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-passes FILE.json VARIANT [VIEW...], bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
+            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-flip FILE.json, bench-passes FILE.json VARIANT [VIEW...], bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
             command.join(" ")
         )),
     }

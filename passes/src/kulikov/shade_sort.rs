@@ -22,6 +22,11 @@ use strandgraph_graph::schema::Quantity;
 pub const GROUP: u32 = 256;
 /// Segments per workgroup of `kulikov.shade` (the indirect count's divisor).
 pub const SHADE_GROUP: u32 = 64;
+/// The most workgroups `shade_args` asks for: every Vulkan device launches
+/// 65,535 in x (wgpu's limit per dimension), and past it (more than 4.19M
+/// visible segments: the reference graph's crowd, with no LOD) the shading
+/// lanes stride over the rest.
+pub const MAX_SHADE_GROUPS: u32 = 65_535;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -128,7 +133,7 @@ impl CpuKernel for ShadeSortKernel {
                     out.store(*slot as usize, *id);
                 }
             }
-            args.fetch_max(0, end.div_ceil(SHADE_GROUP));
+            args.fetch_max(0, end.div_ceil(SHADE_GROUP).min(MAX_SHADE_GROUPS));
             args.store(1, 1);
             args.store(2, 1);
             tally.atomics += 1;
@@ -148,8 +153,16 @@ mod tests {
     use strandgraph_graph::Quantities;
 
     fn run(aggregated: bool, width: u32) -> (Vec<u32>, Vec<u32>, u64) {
-        let segments = 1000u32;
-        let visible: Vec<u32> = (0..segments).filter(|i| (i * 7919) % 3 != 0).collect();
+        run_on(1000, aggregated, width, |i| (i * 7919) % 3 != 0)
+    }
+
+    fn run_on(
+        segments: u32,
+        aggregated: bool,
+        width: u32,
+        shown: impl Fn(u32) -> bool,
+    ) -> (Vec<u32>, Vec<u32>, u64) {
+        let visible: Vec<u32> = (0..segments).filter(|&i| shown(i)).collect();
         let mut bits = vec![0u32; segments.div_ceil(32) as usize];
         for &v in &visible {
             bits[(v / 32) as usize] |= 1 << (v % 32);
@@ -182,5 +195,12 @@ mod tests {
         assert_eq!(args8, args);
         // One append per subgroup instead of one per visible lane.
         assert!(aggregated * 8 < per_lane, "{aggregated} vs {per_lane}");
+    }
+
+    #[test]
+    fn more_segments_than_one_dispatch_holds_cap_the_groups() {
+        let n = MAX_SHADE_GROUPS * SHADE_GROUP + 100;
+        let (args, ..) = run_on(n, true, 32, |_| true);
+        assert_eq!(args, vec![MAX_SHADE_GROUPS, 1, 1, n]);
     }
 }

@@ -32,7 +32,7 @@ pub mod karis;
 use super::cull::drawn_segment;
 use super::debug_resolve::store_rgba16f;
 use super::density::{GRID_WORDS, Grid, MAX_RESOLUTION, check_resolution};
-use super::shade_sort::SHADE_GROUP;
+use super::shade_sort::{MAX_SHADE_GROUPS, SHADE_GROUP};
 use super::{Scene, world_of_clip};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
@@ -365,8 +365,12 @@ impl CpuKernel for ShadeKernel {
         let count = ctx.words("shade_args").load(3);
         let inv = scene.frame.inv_view_proj;
         let world = |v: u32| Vec3::from(world_of_clip(&inv, clip.load_vec4(v as usize)));
-        for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(count) {
-            let id = list.load(i as usize);
+        // A lane per segment, striding past the dispatch's cap.
+        let stride = (MAX_SHADE_GROUPS * SHADE_GROUP) as usize;
+        let lanes = (group * SHADE_GROUP..(group + 1) * SHADE_GROUP)
+            .flat_map(|first| (first as usize..count as usize).step_by(stride));
+        for i in lanes {
+            let id = list.load(i);
             let Some(seg) = drawn_segment(&scene, &lods, id) else {
                 continue;
             };
