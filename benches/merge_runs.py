@@ -37,7 +37,10 @@ else:
     added = [c for r in runs[1:] for c in r["cells"] if c["pipeline"] == add]
     if not added:
         sys.exit(f"no `{add}` cells in the added runs")
-    out["cells"] = [c for c in out["cells"] if c["pipeline"] != add] + added
+    # In place of the cells they replace, so the tables keep their row order.
+    at = next((i for i, c in enumerate(out["cells"]) if c["pipeline"] == add), len(out["cells"]))
+    kept = [c for c in out["cells"] if c["pipeline"] != add]
+    out["cells"] = kept[:at] + added + kept[at:]
     out["elapsed_s"] = out["elapsed_s"] + sum(r["elapsed_s"] for r in runs[1:])
     out["notes"] = out["notes"] + [f"`{add}` rows added from later runs on the same device (benches/merge_runs.py --add): {backends}"]
 json.dump(out, sys.stdout, indent=2, sort_keys=True)
