@@ -160,4 +160,3 @@ mod tests {
         (f / (n - f) * -d + n * f / (n - f)) / d
     }
 }
-
