@@ -29,6 +29,8 @@ struct ComposeParams {
     height: u32,
     // Skip, per workgroup, models whose tiles cannot reach its pixels.
     workgroup_cull: u32,
+    // Atlas layers read, 1..=LAYERS.
+    layers: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ComposeParams;
@@ -177,7 +179,7 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
     var cov = array<f32, 3>(0.0, 0.0, 0.0);
     var lit = array<vec3<f32>, 3>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     var n = 0u;
-    for (var l = 0u; l < LAYERS; l++) {
+    for (var l = 0u; l < min(params.layers, LAYERS); l++) {
         let p = vis_atlas[texel + l * stride];
         if p == EMPTY {
             break;

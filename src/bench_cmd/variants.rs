@@ -106,6 +106,35 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    // Quality ablations of the talk's composition (their FLIP against the
+    // reference is the point; the raster still writes three layers):
+    // one atlas layer instead of three, the random-lines limit 1 - e^-x
+    // instead of the shipped quadratic fit, and no reconstruction of the
+    // coverage beyond the layers.
+    Variant {
+        pipeline: "Kulikov",
+        name: "one atlas layer",
+        graph: KULIKOV,
+        overrides: &["compose.layers=1"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "exponential coverage fit",
+        graph: KULIKOV,
+        overrides: &["compose.coverage_fit=\"Exponential\""],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no coverage reconstruction",
+        graph: KULIKOV,
+        overrides: &["compose.reconstruct_missing=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
     // reference mode, scenes/graphs/lipp_msaa.ron). `filter.enabled=false`

@@ -26,7 +26,8 @@
 //!   strand width in texels, clamped to 1: a strand crossing the pixel covers
 //!   about its width of it], and its lighting interpolated along the segment
 //!   from `vertex_lighting` at the pixel centre's projection;
-//! - [`reconstruct`] [`reconstruct_missing`: false uses the 3 front layers only];
+//! - [`reconstruct`] [`reconstruct_missing`: false uses the 3 front layers only;
+//!   `layers`: how many of the 3 it reads, for the one-layer ablation];
 //! - hair depth (the front layer's) where the result's coverage reaches
 //!   [`depth_threshold`] and is nearer than `scene.depth`, into `hair_depth`.
 //!
@@ -100,6 +101,10 @@ pub struct ComposeParams {
     /// Ours: each workgroup first drops the models whose tiles cannot reach
     /// its pixels ([`reaches`]), so a pixel visits only nearby models.
     pub workgroup_cull: bool,
+    /// The atlas layers composition reads, front first (1..=3). The talk
+    /// reads its 3; fewer measure what the extra layers buy against the
+    /// reference (the raster still writes all 3).
+    pub layers: u32,
 }
 
 impl Default for ComposeParams {
@@ -112,6 +117,7 @@ impl Default for ComposeParams {
             depth_threshold: 0.75,
             facial_hair_bias: 0.5,
             workgroup_cull: true,
+            layers: LAYERS as u32,
         }
     }
 }
@@ -122,7 +128,8 @@ impl PassParams for ComposeParams {
             "poisson_samples",
             self.poisson_samples,
             0..=POISSON.len() as u32,
-        )
+        )?;
+        in_range("layers", self.layers, 1..=LAYERS as u32)
     }
 }
 
@@ -148,6 +155,7 @@ impl ComposeParams {
             width: q.width,
             height: q.height,
             workgroup_cull: flag(self.workgroup_cull),
+            layers: self.layers,
         }
     }
 }
@@ -166,6 +174,8 @@ crate::gpu_block! {
         width: u32,
         height: u32,
         workgroup_cull: u32,
+        /// Atlas layers read, 1..=3.
+        layers: u32,
     }
 }
 
@@ -323,7 +333,7 @@ impl ComposeKernel {
         let (vis, light) = (ctx.words("vis_atlas"), ctx.words("vertex_lighting"));
         let stride = vis.len() / LAYERS;
         let mut out = Vec::with_capacity(LAYERS);
-        for l in 0..LAYERS {
+        for l in 0..(self.0.layers as usize).min(LAYERS) {
             let p = vis.load(texel + l * stride);
             if p == EMPTY {
                 break;
