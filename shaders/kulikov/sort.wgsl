@@ -9,6 +9,7 @@
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::clip::clip_to_screen
 #import strandgraph::kulikov::screen_bin
+#import strandgraph::scan::{scan_run, scan_lanes, scan_total, SCAN_LANES}
 
 struct SortParams {
     // kulikov.sort `enabled` (scatter only).
@@ -33,45 +34,21 @@ struct SortParams {
 // Raster workgroup size (raster::GROUP).
 const RASTER_GROUP: u32 = 256u;
 
-// Lanes of the scan: each sums a run of consecutive bins, the lanes' sums
-// are scanned in workgroup memory (Hillis and Steele), then each lane writes
-// its run's offsets. A single thread walking the 510 bins of a 1080p screen
-// took 0.049 ms on an H100.
-const SCAN_LANES: u32 = 256u;
-var<workgroup> lane_sums: array<u32, SCAN_LANES>;
-
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) lane: u32) {
     let bins = params.bins;
-    let per = (bins + SCAN_LANES - 1u) / SCAN_LANES;
-    let first = min(lane * per, bins);
-    let last = min(first + per, bins);
+    let run = scan_run(lane, bins);
     var sum = 0u;
-    for (var b = first; b < last; b++) {
+    for (var b = run.x; b < run.y; b++) {
         sum += sort_bins[b];
     }
-    lane_sums[lane] = sum;
-    workgroupBarrier();
-    // Inclusive scan of the lanes' sums.
-    for (var d = 1u; d < SCAN_LANES; d <<= 1u) {
-        var v = lane_sums[lane];
-        if lane >= d {
-            v += lane_sums[lane - d];
-        }
-        workgroupBarrier();
-        lane_sums[lane] = v;
-        workgroupBarrier();
-    }
-    var run = 0u;
-    if lane > 0u {
-        run = lane_sums[lane - 1u];
-    }
-    for (var b = first; b < last; b++) {
-        scan_sort_offsets[b] = run;
-        run += sort_bins[b];
+    var offset = scan_lanes(lane, sum);
+    for (var b = run.x; b < run.y; b++) {
+        scan_sort_offsets[b] = offset;
+        offset += sort_bins[b];
     }
     if lane == SCAN_LANES - 1u {
-        let total = lane_sums[SCAN_LANES - 1u];
+        let total = scan_total();
         // Header after the bins: the arrival counter the unsorted variant uses.
         scan_sort_offsets[bins] = 0u;
         raster_args[0] = (total + RASTER_GROUP - 1u) / RASTER_GROUP;

@@ -77,6 +77,27 @@ fn caption(json: &Value, backend: &str, device: &str) -> String {
     )
 }
 
+/// A row per label of `rows`, a column per view; each cell `text` of the
+/// backend's cell of that row and view ("–" where there is none).
+fn grid<'a>(
+    md: &mut String,
+    cells: impl Fn() -> Box<dyn Iterator<Item = &'a Value> + 'a>,
+    rows: &[String],
+    views: &[String],
+    text: impl Fn(&Value) -> String,
+) {
+    let _ = writeln!(md, "| variant | {} |", views.join(" | "));
+    let _ = writeln!(md, "|---|{}", "---:|".repeat(views.len()));
+    for row in rows {
+        let _ = write!(md, "| {row} |");
+        for view in views {
+            let cell = cells().find(|c| label(c) == *row && c["view"] == view.as_str());
+            let _ = write!(md, " {} |", cell.map_or("–".into(), &text));
+        }
+        md.push('\n');
+    }
+}
+
 /// Per backend: a row per pipeline variant, a column per view; each cell the
 /// median frame time with the raster passes' median and their atomics as a
 /// fraction of the same run's atomicMin roofline (Lipp's Table 1 shape).
@@ -90,17 +111,13 @@ pub fn frame_table(json: &Value) -> Result<String, String> {
             "{}; ms: median frame (raster median; raster atomics as % of the atomicMin roofline):\n",
             caption(json, &backend, &device)
         );
-        let _ = writeln!(md, "| variant | {} |", views.join(" | "));
-        let _ = writeln!(md, "|---|{}", "---:|".repeat(views.len()));
-        for row in &rows {
-            let _ = write!(md, "| {row} |");
-            for view in &views {
-                let cell =
-                    cells(json, &backend).find(|c| label(c) == *row && c["view"] == view.as_str());
-                let _ = write!(md, " {} |", cell.map_or("–".into(), cell_text));
-            }
-            md.push('\n');
-        }
+        grid(
+            &mut md,
+            || Box::new(cells(json, &backend)),
+            &rows,
+            &views,
+            cell_text,
+        );
         md.push_str(&roofline_line(json, &backend));
     }
     Ok(md)
@@ -125,24 +142,19 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
             "{}; mean FLIP against `{reference}` (ACES, 0 EV; 0 is identical), then the median frame in ms:\n",
             caption(json, &backend, &device)
         );
-        let _ = writeln!(md, "| variant | {} |", views.join(" | "));
-        let _ = writeln!(md, "|---|{}", "---:|".repeat(views.len()));
-        for row in &rows {
-            let _ = write!(md, "| {row} |");
-            for view in &views {
-                let text = with()
-                    .find(|c| label(c) == *row && c["view"] == view.as_str())
-                    .map_or("–".into(), |c| {
-                        format!(
-                            "{:.4} ({:.2})",
-                            c["flip"].as_f64().unwrap_or(f64::NAN),
-                            c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
-                        )
-                    });
-                let _ = write!(md, " {text} |");
-            }
-            md.push('\n');
-        }
+        grid(
+            &mut md,
+            || Box::new(with()),
+            &rows,
+            &views,
+            |c| {
+                format!(
+                    "{:.4} ({:.2})",
+                    c["flip"].as_f64().unwrap_or(f64::NAN),
+                    c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
+                )
+            },
+        );
         md.push('\n');
     }
     if md.is_empty() {

@@ -100,7 +100,6 @@ impl Ribbon {
     /// `t0`, `t1`. `None` when an end lies at or behind the near plane (the
     /// skinning pass leaves skipped vertices at w = 0): the reference draws
     /// no hair that crosses the camera.
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         frame: &FrameData,
         c0: [f32; 4],
