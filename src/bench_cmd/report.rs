@@ -151,6 +151,15 @@ pub struct Report {
     pub elapsed_s: f64,
 }
 
+/// The widest `pipeline: variant` label, so the tables' columns line up.
+fn label_width() -> usize {
+    super::VARIANTS
+        .iter()
+        .map(|v| v.pipeline.len() + 2 + v.name.len())
+        .max()
+        .unwrap_or(0)
+}
+
 /// `close` from `scenes/distances/close.ron`.
 fn view_name(p: &Path) -> String {
     p.file_stem()
@@ -239,18 +248,20 @@ impl Report {
             o,
             "\nQuality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)"
         );
-        let _ = write!(o, "  {:<5} {:<34}", "", "pipeline: variant");
+        let _ = write!(
+            o,
+            "  {:<5} {:<lw$}",
+            "",
+            "pipeline: variant",
+            lw = label_width()
+        );
         for v in &self.views {
             let _ = write!(o, " {v:>w$}");
         }
         let _ = writeln!(o);
         for (b, v) in with {
-            let _ = write!(
-                o,
-                "  {:<5} {:<34}",
-                b.name(),
-                format!("{}: {}", v.pipeline, v.name)
-            );
+            let label = format!("{}: {}", v.pipeline, v.name);
+            let _ = write!(o, "  {:<5} {label:<lw$}", b.name(), lw = label_width());
             for s in 0..self.views.len() {
                 let flip = self.cells.iter().find_map(|(x, y, view, c)| match c {
                     Cell::Measured(st)
@@ -315,7 +326,13 @@ impl Report {
             o,
             "\nFrame time, ms: median [min-max] over frames (raster pass median; raster atomics/s as % of the roofline atomicMin rate)"
         );
-        let _ = write!(o, "  {:<5} {:<34}", "", "pipeline: variant");
+        let _ = write!(
+            o,
+            "  {:<5} {:<lw$}",
+            "",
+            "pipeline: variant",
+            lw = label_width()
+        );
         for v in &self.views {
             let _ = write!(o, " {v:>w$}");
         }
@@ -332,7 +349,7 @@ impl Report {
         let mut skipped = Vec::new();
         for (b, v) in &rows {
             let label = format!("{}: {}", v.pipeline, v.name);
-            let _ = write!(o, "  {:<5} {label:<34}", b.name());
+            let _ = write!(o, "  {:<5} {label:<lw$}", b.name(), lw = label_width());
             for s in 0..self.views.len() {
                 let cell = self.cells.iter().find(|(x, y, view, _)| {
                     x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s
