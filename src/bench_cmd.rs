@@ -439,7 +439,7 @@ fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptio
 }
 
 /// One cell's timed frames: the device, its notes, the statistics, and
-/// the last frame's picture (for its quality).
+/// the last frame's picture where its pipeline has a reference.
 fn measure(
     backend: Backend,
     p: &Prepared,
@@ -453,9 +453,12 @@ fn measure(
     let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);
+    // Read back only what a reference will be compared with.
     let q = p.upload.quantities;
-    let picture = main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
-        session.read(name).ok().flatten()
+    let picture = quality::reference_graph(v.pipeline).and_then(|_| {
+        main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
+            session.read(name).ok().flatten()
+        })
     });
     Ok((session.device(), session.notes(), stats, picture))
 }

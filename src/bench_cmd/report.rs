@@ -151,11 +151,16 @@ pub struct Report {
     pub elapsed_s: f64,
 }
 
-/// The widest `pipeline: variant` label, so the tables' columns line up.
+/// A row's `pipeline: variant` label.
+fn row_label(v: &Variant) -> String {
+    format!("{}: {}", v.pipeline, v.name)
+}
+
+/// The widest row label, so the tables' columns line up.
 fn label_width() -> usize {
     super::VARIANTS
         .iter()
-        .map(|v| v.pipeline.len() + 2 + v.name.len())
+        .map(|v| row_label(v).len())
         .max()
         .unwrap_or(0)
 }
@@ -231,7 +236,31 @@ impl Report {
             .map_or("?", |(_, d, _)| d.as_str())
     }
 
-    /// The text table.
+    /// The cell of row `v` on backend `b` at view `s`.
+    fn cell_at(&self, b: Backend, v: &Variant, s: usize) -> Option<&Cell> {
+        self.cells
+            .iter()
+            .find(|(x, y, view, _)| {
+                *x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s
+            })
+            .map(|c| &c.3)
+    }
+
+    /// A table's header line: the label column, then the views `w` wide.
+    fn header(&self, o: &mut String, w: usize) {
+        let _ = write!(
+            o,
+            "  {:<5} {:<lw$}",
+            "",
+            "pipeline: variant",
+            lw = label_width()
+        );
+        for v in &self.views {
+            let _ = write!(o, " {v:>w$}");
+        }
+        let _ = writeln!(o);
+    }
+
     /// Mean FLIP per row and view, for the rows whose pipeline has a
     /// reference; empty when none has.
     fn quality_table(&self, rows: &[(Backend, Variant)]) -> String {
@@ -248,29 +277,20 @@ impl Report {
             o,
             "\nQuality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)"
         );
-        let _ = write!(
-            o,
-            "  {:<5} {:<lw$}",
-            "",
-            "pipeline: variant",
-            lw = label_width()
-        );
-        for v in &self.views {
-            let _ = write!(o, " {v:>w$}");
-        }
-        let _ = writeln!(o);
+        self.header(&mut o, w);
         for (b, v) in with {
-            let label = format!("{}: {}", v.pipeline, v.name);
-            let _ = write!(o, "  {:<5} {label:<lw$}", b.name(), lw = label_width());
+            let _ = write!(
+                o,
+                "  {:<5} {:<lw$}",
+                b.name(),
+                row_label(v),
+                lw = label_width()
+            );
             for s in 0..self.views.len() {
-                let flip = self.cells.iter().find_map(|(x, y, view, c)| match c {
-                    Cell::Measured(st)
-                        if x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s =>
-                    {
-                        st.flip
-                    }
+                let flip = match self.cell_at(*b, v, s) {
+                    Some(Cell::Measured(st)) => st.flip,
                     _ => None,
-                });
+                };
                 let text = flip.map_or("-".into(), |f| format!("{f:.4}"));
                 let _ = write!(o, " {text:>w$}");
             }
@@ -279,6 +299,7 @@ impl Report {
         o
     }
 
+    /// The text table.
     pub fn table(&self) -> String {
         let mut o = String::new();
         let _ = writeln!(
@@ -326,17 +347,7 @@ impl Report {
             o,
             "\nFrame time, ms: median [min-max] over frames (raster pass median; raster atomics/s as % of the roofline atomicMin rate)"
         );
-        let _ = write!(
-            o,
-            "  {:<5} {:<lw$}",
-            "",
-            "pipeline: variant",
-            lw = label_width()
-        );
-        for v in &self.views {
-            let _ = write!(o, " {v:>w$}");
-        }
-        let _ = writeln!(o);
+        self.header(&mut o, w);
         let mut rows: Vec<(Backend, Variant)> = Vec::new();
         for (b, v, ..) in &self.cells {
             if !rows
@@ -348,13 +359,15 @@ impl Report {
         }
         let mut skipped = Vec::new();
         for (b, v) in &rows {
-            let label = format!("{}: {}", v.pipeline, v.name);
-            let _ = write!(o, "  {:<5} {label:<lw$}", b.name(), lw = label_width());
+            let _ = write!(
+                o,
+                "  {:<5} {:<lw$}",
+                b.name(),
+                row_label(v),
+                lw = label_width()
+            );
             for s in 0..self.views.len() {
-                let cell = self.cells.iter().find(|(x, y, view, _)| {
-                    x == b && y.name == v.name && y.pipeline == v.pipeline && *view == s
-                });
-                let text = match cell.map(|c| &c.3) {
+                let text = match self.cell_at(*b, v, s) {
                     Some(Cell::Measured(st)) => {
                         let pct = self.ceiling(*b, v).map_or("-".into(), |c| {
                             format!("{:.0}%", 100.0 * st.atomic_rate() / c)
