@@ -10,6 +10,7 @@
 //! prepared for the row's graph; a graph that cannot run a scene gets its
 //! cells marked skipped with the reason.
 
+mod pictures;
 mod progress;
 mod quality;
 mod report;
@@ -55,6 +56,7 @@ pub enum Choice {
 #[command(after_help = "Examples:
   strandgraph bench --quick
   strandgraph bench --backend ash --row \"Lipp\" --out bench/
+  strandgraph bench --quick --out bench/ --pictures   (then: strandgraph report --from bench/bench.json -o bench/)
   strandgraph bench scenes/showcase.ron --backend wgpu,ash --row \"HW mesh\"")]
 pub struct Args {
     /// Scenes, one column each (default: scenes/distances/{close,mid,far}.ron,
@@ -78,6 +80,10 @@ pub struct Args {
     /// Write bench.csv, bench.json and bench.txt here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Also save every measured cell's last frame, its FLIP error map and
+    /// its reference as PNG under OUT/pictures/ (what `report` shows).
+    #[arg(long, requires = "out")]
+    pub pictures: bool,
     /// CI smoke run: 320x180, 2 frames, no warm-up (unless given), VoxelMarch
     /// shadows, seven rows (each pipeline as published and one ablation).
     #[arg(long)]
@@ -288,6 +294,10 @@ pub fn run(mut args: Args) -> Result<()> {
     let chosen = backends(&args);
     let progress = Progress::new((chosen.len() * rows.len() * scenes.len()) as u64);
     let mut references = quality::References::default();
+    let mut saver = match (&args.out, args.pictures) {
+        (Some(dir), true) => Some(pictures::Saver::new(dir)),
+        _ => None,
+    };
     'backends: for (backend, required) in chosen {
         // The roofline, on the first scene's screen size. A device that
         // cannot run it (no 64-bit atomics) still gets its rows timed.
@@ -337,9 +347,20 @@ pub fn run(mut args: Args) -> Result<()> {
                                 quick: args.quick,
                                 cpu,
                             };
-                            stats.flip = references
-                                .flip(backend, s, &setup, v, &img)
+                            let judged = references
+                                .judge(backend, s, &setup, v, &img)
                                 .map_err(|e| miette!("{}: {}: {e}", v.pipeline, v.name))?;
+                            stats.flip = judged.as_ref().map(|j| j.diff.mean);
+                            if let Some(saver) = &mut saver {
+                                let saved = saver.save(
+                                    backend,
+                                    &report.views[s],
+                                    v,
+                                    &img,
+                                    judged.as_ref(),
+                                )?;
+                                stats.pictures = Some(saved);
+                            }
                         }
                         report.cell(backend, v, s, Cell::Measured(stats));
                     }
@@ -367,8 +388,9 @@ pub fn run(mut args: Args) -> Result<()> {
     if let Some(dir) = &args.out {
         report.write(dir)?;
         println!(
-            "wrote {0}/bench.txt, {0}/bench.csv, {0}/bench.json",
-            dir.display()
+            "wrote {0}/bench.txt, {0}/bench.csv, {0}/bench.json{1}",
+            dir.display(),
+            if args.pictures { ", pictures/" } else { "" }
         );
     }
     Ok(())
@@ -439,7 +461,8 @@ fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptio
 }
 
 /// One cell's timed frames: the device, its notes, the statistics, and
-/// the last frame's picture where its pipeline has a reference.
+/// the last frame's picture where its pipeline has a reference or
+/// `--pictures` asks for it.
 fn measure(
     backend: Backend,
     p: &Prepared,
@@ -453,13 +476,17 @@ fn measure(
     let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);
-    // Read back only what a reference will be compared with.
+    // Read back only what a reference will be compared with, or
+    // `--pictures` saves.
     let q = p.upload.quantities;
-    let picture = quality::reference_graph(v.pipeline).and_then(|_| {
-        main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
-            session.read(name).ok().flatten()
+    let wanted = args.pictures || quality::reference_graph(v.pipeline).is_some();
+    let picture = wanted
+        .then(|| {
+            main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
+                session.read(name).ok().flatten()
+            })
         })
-    });
+        .flatten();
     Ok((session.device(), session.notes(), stats, picture))
 }
 

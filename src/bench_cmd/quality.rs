@@ -14,7 +14,7 @@ use image::RgbaImage;
 use miette::Result;
 use std::collections::BTreeMap;
 use std::path::Path;
-use strandgraph::compare::flip;
+use strandgraph::compare::{ImageDiff, flip};
 use strandgraph::images::{Display, main_picture};
 use strandgraph::runner::{self, Backend, CpuOptions};
 
@@ -48,24 +48,32 @@ pub struct Setup<'a> {
     pub cpu: CpuOptions,
 }
 
+/// A row's picture against its pipeline's reference: the reference (kept
+/// for `bench --pictures`) and the FLIP difference (its mean is the
+/// table's FLIP, its error map the report's heat map).
+pub struct Judged {
+    pub reference: RgbaImage,
+    pub diff: ImageDiff,
+}
+
 impl References {
-    /// Mean FLIP of `image` (row `v`'s, on `backend`, scene `s`) against
-    /// the reference; `None` when the pipeline has none.
-    pub fn flip(
+    /// `image` (row `v`'s, on `backend`, scene `s`) against the reference;
+    /// `None` when the pipeline has none.
+    pub fn judge(
         &mut self,
         backend: Backend,
         s: usize,
         setup: &Setup<'_>,
         v: &Variant,
         image: &RgbaImage,
-    ) -> Result<Option<f32>, String> {
+    ) -> Result<Option<Judged>, String> {
         let Some(graph) = reference_graph(v.pipeline) else {
             return Ok(None);
         };
         let reference = self.reference(backend, s, setup, graph)?;
         let diff = flip(&reference, image)
             .ok_or_else(|| format!("{graph}: the reference and the row differ in size"))?;
-        Ok(Some(diff.mean))
+        Ok(Some(Judged { reference, diff }))
     }
 
     /// The reference of scene `s` on `backend`, else (once, shared by

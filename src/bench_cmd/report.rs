@@ -1,6 +1,7 @@
 //! The bench's results: statistics per cell, the printed table (shaped as
 //! Lipp's Table 1), and the CSV and JSON files.
 
+use super::pictures::Saved;
 use super::quality;
 use super::{Args, Variant};
 use miette::{IntoDiagnostic, Result, WrapErr};
@@ -60,6 +61,8 @@ pub struct Stats {
     pub per_frame: Vec<Vec<f64>>,
     /// Mean FLIP of the last frame against the pipeline's reference.
     pub flip: Option<f32>,
+    /// Where `--pictures` saved the last frame, its FLIP map and reference.
+    pub pictures: Option<Saved>,
 }
 
 impl Stats {
@@ -96,6 +99,7 @@ impl Stats {
                 .map(|f| f.iter().map(|t| t.millis.unwrap_or(f64::NAN)).collect())
                 .collect(),
             flip: None,
+            pictures: None,
         }
     }
 
@@ -492,6 +496,11 @@ impl Report {
                         if let Some(f) = st.flip {
                             j["flip"] = json!(f);
                             j["flip_reference"] = json!(quality::reference_graph(v.pipeline));
+                        }
+                        if let Some(p) = &st.pictures {
+                            j["picture"] = json!(p.picture);
+                            j["flip_map"] = json!(p.flip_map);
+                            j["reference_picture"] = json!(p.reference);
                         }
                         j["frame"] = st.total.json();
                         j["raster"] = st.raster.json();
