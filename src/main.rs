@@ -9,6 +9,7 @@ mod compare_cmd;
 mod graph_cmd;
 mod info;
 mod render_cmd;
+mod report_cmd;
 mod tables_cmd;
 
 use clap::{Parser, Subcommand};
@@ -35,6 +36,8 @@ enum Command {
     Agree(agree_cmd::Args),
     /// How two pictures differ (FLIP): a render against the reference, say.
     Compare(compare_cmd::Args),
+    /// Run the bench with pictures and write an HTML page: pictures beside the reference, FLIP maps, time-versus-FLIP chart, per-pass bars.
+    Report(report_cmd::Args),
     /// Regenerate (or --check) README's tables from the measurements under benches/results/.
     Tables(tables_cmd::Args),
 }
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench_cmd::run(args),
         Command::Agree(args) => agree_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
+        Command::Report(args) => report_cmd::run(args),
         Command::Tables(args) => tables_cmd::run(args),
     };
     match result {

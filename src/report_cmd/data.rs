@@ -1,0 +1,286 @@
+//! What the report reads: `bench.json` as `strandgraph bench --pictures`
+//! writes it (src/bench_cmd/report.rs), grouped into one section per view
+//! and backend, with the checks that the pictures it names are there.
+
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
+use serde::Deserialize;
+use std::path::{Component, Path};
+
+#[derive(Debug, Deserialize)]
+pub struct Bench {
+    pub size: String,
+    pub frames: usize,
+    pub warmup: usize,
+    #[serde(default)]
+    pub devices: Vec<Device>,
+    pub cells: Vec<Cell>,
+    #[serde(default)]
+    pub notes: Vec<String>,
+    pub elapsed_s: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct Device {
+    pub backend: String,
+    pub device: String,
+    #[serde(default)]
+    pub clock: String,
+}
+
+/// Median, min and max over frames; `null` in the JSON (an empty or
+/// non-finite spread) reads as `None`.
+#[derive(Debug, Deserialize)]
+pub struct Spread {
+    pub median_ms: Option<f64>,
+    pub min_ms: Option<f64>,
+    pub max_ms: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct Pass {
+    pub pass: String,
+    pub median_ms: Option<f64>,
+}
+
+/// One row at one view on one backend: measured, or skipped with why.
+#[derive(Debug, Deserialize)]
+pub struct Cell {
+    pub backend: String,
+    pub pipeline: String,
+    pub variant: String,
+    pub view: String,
+    #[serde(default)]
+    pub scene: String,
+    pub skipped: Option<String>,
+    pub frame: Option<Spread>,
+    pub raster: Option<Spread>,
+    pub flip: Option<f64>,
+    /// Relative error of the summed coverage against the reference, where
+    /// the bench measures it.
+    pub coverage_error: Option<f64>,
+    #[serde(default)]
+    pub passes: Vec<Pass>,
+    pub picture: Option<String>,
+    pub flip_map: Option<String>,
+    pub reference_picture: Option<String>,
+}
+
+impl Cell {
+    pub fn label(&self) -> String {
+        format!("{}: {}", self.pipeline, self.variant)
+    }
+    pub fn measured(&self) -> bool {
+        self.skipped.is_none()
+    }
+    /// Median frame time in ms, if measured.
+    pub fn ms(&self) -> Option<f64> {
+        self.frame.as_ref().and_then(|f| f.median_ms)
+    }
+    /// The picture files this cell names.
+    pub fn files(&self) -> impl Iterator<Item = &str> {
+        [&self.picture, &self.flip_map, &self.reference_picture]
+            .into_iter()
+            .filter_map(|p| p.as_deref())
+    }
+}
+
+/// The cells of one view on one backend, in the bench's row order.
+pub struct Section<'a> {
+    pub view: &'a str,
+    pub scene: &'a str,
+    pub backend: &'a str,
+    pub device: Option<&'a Device>,
+    pub cells: Vec<&'a Cell>,
+}
+
+impl Section<'_> {
+    /// `far-cpu`: the section's anchor.
+    pub fn id(&self) -> String {
+        let slug = |s: &str| -> String {
+            s.chars()
+                .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+                .collect()
+        };
+        format!("{}-{}", slug(self.view), slug(self.backend))
+    }
+    /// Each reference picture once, with its pipeline, in row order.
+    pub fn references(&self) -> Vec<(&str, &str)> {
+        let mut out: Vec<(&str, &str)> = Vec::new();
+        for c in &self.cells {
+            if let Some(r) = c.reference_picture.as_deref()
+                && !out.iter().any(|(_, x)| *x == r)
+            {
+                out.push((c.pipeline.as_str(), r));
+            }
+        }
+        out
+    }
+}
+
+/// Reads and parses `path`.
+pub fn load(path: &Path) -> Result<Bench> {
+    let text = std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| {
+        miette!(
+            "{}: not a bench.json as `strandgraph bench --out` writes it: {e}",
+            path.display()
+        )
+    })
+}
+
+/// Views in the order they first appear, each with the backends in the
+/// order of `devices` (then of first appearance).
+pub fn sections(b: &Bench) -> Vec<Section<'_>> {
+    let (mut keys, mut views): (Vec<(&str, &str)>, Vec<&str>) = (Vec::new(), Vec::new());
+    for c in &b.cells {
+        let key = (c.view.as_str(), c.backend.as_str());
+        if !keys.contains(&key) {
+            keys.push(key);
+        }
+        if !views.contains(&key.0) {
+            views.push(key.0);
+        }
+    }
+    // A backend without a device line (it never opened) goes last.
+    let rank = |backend: &str| {
+        b.devices
+            .iter()
+            .position(|d| d.backend == backend)
+            .unwrap_or(usize::MAX)
+    };
+    // Stable: backends without a device keep their order of appearance.
+    keys.sort_by_key(|(v, backend)| (views.iter().position(|x| x == v), rank(backend)));
+    keys.into_iter()
+        .map(|(view, backend)| {
+            let cells: Vec<&Cell> = b
+                .cells
+                .iter()
+                .filter(|c| c.view == view && c.backend == backend)
+                .collect();
+            Section {
+                view,
+                scene: cells.first().map_or("", |c| c.scene.as_str()),
+                backend,
+                device: b.devices.iter().find(|d| d.backend == backend),
+                cells,
+            }
+        })
+        .collect()
+}
+
+/// A picture path from the JSON, relative and inside its directory (the
+/// page links it as is, and `--from` copies it).
+fn check_relative(json: &Path, rel: &str) -> Result<()> {
+    let inside = Path::new(rel)
+        .components()
+        .all(|c| matches!(c, Component::Normal(_)));
+    if rel.is_empty() || !inside {
+        return Err(miette!(
+            "{}: picture path {rel:?} is not a relative path inside the bench's directory",
+            json.display()
+        ));
+    }
+    Ok(())
+}
+
+/// Every measured cell names its picture, and every file named exists
+/// next to `json`.
+pub fn check_pictures(b: &Bench, json: &Path) -> Result<()> {
+    let dir = json.parent().unwrap_or(Path::new("."));
+    let measured: Vec<&Cell> = b.cells.iter().filter(|c| c.measured()).collect();
+    if measured.is_empty() {
+        return Err(miette!(
+            "{}: no measured cells (every cell was skipped): nothing to show",
+            json.display()
+        ));
+    }
+    if let Some(c) = measured.iter().find(|c| c.picture.is_none()) {
+        return Err(miette!(
+            help = "run `strandgraph bench --out DIR --pictures` (or `strandgraph report`, which does)",
+            "{}: the cell {} at {} on {} has no `picture`: the bench ran without --pictures",
+            json.display(),
+            c.label(),
+            c.view,
+            c.backend
+        ));
+    }
+    for c in &measured {
+        for rel in c.files() {
+            check_relative(json, rel)?;
+            if !dir.join(rel).is_file() {
+                return Err(miette!(
+                    "{}: {} (of {} at {} on {}) is missing",
+                    json.display(),
+                    dir.join(rel).display(),
+                    c.label(),
+                    c.view,
+                    c.backend
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Which of `points` (time, error) no other point beats on both (lower
+/// or equal on each, lower on one): the Pareto frontier.
+pub fn frontier(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(t, e)| {
+            !points
+                .iter()
+                .any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frontier_keeps_the_undominated() {
+        let pts = [(1.0, 0.5), (2.0, 0.2), (3.0, 0.3), (2.0, 0.2), (4.0, 0.1)];
+        assert_eq!(frontier(&pts), [true, true, false, true, true]);
+    }
+
+    #[test]
+    fn a_bench_without_pictures_is_refused_with_the_reason() {
+        let json = r#"{"size":"160x90","frames":1,"warmup":0,"cells":[
+            {"backend":"cpu","pipeline":"Kulikov","variant":"all","view":"far",
+             "frame":{"median_ms":1.0,"min_ms":1.0,"max_ms":1.0}}]}"#;
+        let b: Bench = serde_json::from_str(json).unwrap();
+        let e = check_pictures(&b, Path::new("x/bench.json")).unwrap_err();
+        assert!(format!("{e}").contains("without --pictures"), "{e}");
+    }
+
+    #[test]
+    fn picture_paths_must_stay_inside() {
+        let p = Path::new("b/bench.json");
+        assert!(check_relative(p, "pictures/cpu/far/a.png").is_ok());
+        assert!(check_relative(p, "../etc/passwd").is_err());
+        assert!(check_relative(p, "/tmp/a.png").is_err());
+    }
+
+    #[test]
+    fn sections_go_view_then_backend() {
+        let cell = |v: &str, b: &str| {
+            format!(
+                r#"{{"backend":"{b}","pipeline":"P","variant":"v","view":"{v}","skipped":"x"}}"#
+            )
+        };
+        let json = format!(
+            r#"{{"size":"s","frames":1,"warmup":0,"devices":[{{"backend":"wgpu","device":"d"}},{{"backend":"cpu","device":"c"}}],"cells":[{},{},{},{}]}}"#,
+            cell("close", "cpu"),
+            cell("far", "cpu"),
+            cell("close", "wgpu"),
+            cell("far", "wgpu")
+        );
+        let b: Bench = serde_json::from_str(&json).unwrap();
+        let ids: Vec<String> = sections(&b).iter().map(Section::id).collect();
+        assert_eq!(ids, ["close-wgpu", "close-cpu", "far-wgpu", "far-cpu"]);
+    }
+}

@@ -1,0 +1,389 @@
+//! The report page: one self-contained HTML file (inline CSS, script and
+//! SVG; pictures by relative path) that opens from disk with no server.
+
+use super::charts::{self, Bar, Point};
+use super::data::{Bench, Cell, Section, frontier, sections};
+use miette::Result;
+use std::fmt::Write as _;
+
+const CSS: &str = include_str!("page.css");
+const JS: &str = include_str!("page.js");
+/// Runs first, so errors of anything after it are recorded for the check.
+const ERRORS_JS: &str = r#"window.reportErrors = [];
+window.addEventListener("error", (e) => window.reportErrors.push(e.message || ("failed to load " + ((e.target && (e.target.src || e.target.href)) || "?"))), true);
+window.addEventListener("unhandledrejection", (e) => window.reportErrors.push(String(e.reason)));
+(() => { const ce = console.error; console.error = (...a) => { window.reportErrors.push(a.join(" ")); ce.apply(console, a); }; })();"#;
+
+/// What the page holds, for its self-check.
+#[derive(Default)]
+struct Counts {
+    images: usize,
+    charts: usize,
+}
+
+pub fn esc(s: &str) -> String {
+    let mut o = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => o.push_str("&amp;"),
+            '<' => o.push_str("&lt;"),
+            '>' => o.push_str("&gt;"),
+            '"' => o.push_str("&quot;"),
+            '\'' => o.push_str("&#39;"),
+            _ => o.push(c),
+        }
+    }
+    o
+}
+
+/// Milliseconds to two decimals (one past 100).
+fn ms(x: f64) -> String {
+    if x >= 100.0 {
+        format!("{x:.1}")
+    } else {
+        format!("{x:.2}")
+    }
+}
+
+/// Mean FLIP to five decimals: rows of one pipeline often differ in
+/// the fourth.
+fn flip(x: f64) -> String {
+    format!("{x:.5}")
+}
+
+/// The whole page for `b`; `source` names the bench.json it came from.
+pub fn page(b: &Bench, source: &str) -> Result<String> {
+    let secs = sections(b);
+    let mut counts = Counts::default();
+    let mut body = String::new();
+    for s in &secs {
+        body.push_str(&section(s, &mut counts)?);
+    }
+    let mut o = String::new();
+    let _ = write!(
+        o,
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\
+         <meta name=\"color-scheme\" content=\"dark\">\
+         <title>strandgraph report: {}</title>\n<script>{ERRORS_JS}</script>\n<style>{CSS}</style></head>\n\
+         <body data-expect-images=\"{}\" data-expect-charts=\"{}\">\n",
+        esc(&b.size),
+        counts.images,
+        counts.charts
+    );
+    o.push_str(&header(b, &secs, source));
+    let _ = write!(o, "<main>{body}</main>\n{}", footer(b));
+    let _ = write!(o, "<script>{JS}</script>\n</body></html>\n");
+    Ok(o)
+}
+
+fn header(b: &Bench, secs: &[Section<'_>], source: &str) -> String {
+    let mut o = String::from(
+        "<header class=\"top\"><h1>strandgraph report <span>time against quality</span></h1>",
+    );
+    let took = b
+        .elapsed_s
+        .map_or(String::new(), |t| format!(" · bench took {t:.0} s"));
+    let _ = write!(
+        o,
+        "<p class=\"meta\">{} · {} timed frame{} after {} warm-up{took} · from <a href=\"{src}\">{src}</a></p>",
+        esc(&b.size),
+        b.frames,
+        if b.frames == 1 { "" } else { "s" },
+        b.warmup,
+        src = esc(source)
+    );
+    o.push_str("<table class=\"devices\">");
+    for d in &b.devices {
+        let _ = write!(
+            o,
+            "<tr><td>{}</td><td>{}</td><td>{}</td></tr>",
+            esc(&d.backend),
+            esc(&d.device),
+            esc(&d.clock)
+        );
+    }
+    o.push_str("</table><nav class=\"toc\">");
+    for s in secs {
+        let _ = write!(
+            o,
+            "<a href=\"#{}\">{} · {}</a>",
+            s.id(),
+            esc(s.view),
+            esc(s.backend)
+        );
+    }
+    o.push_str(
+        "</nav><p class=\"howto\">Click a row or a picture to show it large; click the large picture \
+         (or press space) to flip between the row and its pipeline's reference; hover a picture for \
+         its FLIP error map (magma: black is no error, yellow the largest). FLIP is the mean over the \
+         last timed frame against the reference, both through ACES at 0 EV; ◆ marks the rows on the \
+         time-versus-FLIP Pareto frontier.</p></header>\n",
+    );
+    o
+}
+
+fn footer(b: &Bench) -> String {
+    let mut o = String::from("<footer>");
+    if !b.notes.is_empty() {
+        o.push_str("Notes of the run:<ul>");
+        for n in &b.notes {
+            let _ = write!(o, "<li>{}</li>", esc(n));
+        }
+        o.push_str("</ul>");
+    }
+    o.push_str("Made by <code>strandgraph report</code>; every picture is a file under <code>pictures/</code> next to this page.</footer>\n");
+    o
+}
+
+/// Pipelines of the section's cells, in order (their colour index).
+fn pipelines<'a>(s: &Section<'a>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for c in &s.cells {
+        if !out.contains(&c.pipeline.as_str()) {
+            out.push(c.pipeline.as_str());
+        }
+    }
+    out
+}
+
+/// Each cell's place on the frontier (`None`: no FLIP to place it by).
+fn fronts(s: &Section<'_>) -> Vec<Option<bool>> {
+    let placed: Vec<(usize, (f64, f64))> = s
+        .cells
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| Some((i, (c.ms()?, c.flip?))))
+        .collect();
+    let pts: Vec<(f64, f64)> = placed.iter().map(|p| p.1).collect();
+    let mut out = vec![None; s.cells.len()];
+    for ((i, _), f) in placed.iter().zip(frontier(&pts)) {
+        out[*i] = Some(f);
+    }
+    out
+}
+
+fn section(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
+    let mut o = String::new();
+    let device = s
+        .device
+        .map_or(String::new(), |d| format!(" — {}", esc(&d.device)));
+    let _ = write!(
+        o,
+        "<section class=\"view\" id=\"{}\"><h2>{}<span class=\"where\">{}{device}</span></h2>\
+         <p class=\"scene\">{}</p>",
+        s.id(),
+        esc(s.view),
+        esc(s.backend),
+        esc(s.scene)
+    );
+    let pipes = pipelines(s);
+    let fronts = fronts(s);
+    o.push_str("<div class=\"grid\"><div>");
+    o.push_str(&viewer(s, counts));
+    o.push_str("</div><div>");
+    o.push_str(&pareto(s, &pipes, &fronts, counts)?);
+    o.push_str("</div></div>");
+    o.push_str(&table(s, &pipes, &fronts));
+    o.push_str(&thumbs(s, counts));
+    o.push_str(&bars(s, counts)?);
+    o.push_str("</section>\n");
+    Ok(o)
+}
+
+/// The large picture: the first row with a reference, else the first
+/// measured row; the script swaps what it shows.
+fn viewer(s: &Section<'_>, counts: &mut Counts) -> String {
+    let first = s
+        .cells
+        .iter()
+        .position(|c| c.reference_picture.is_some())
+        .or_else(|| s.cells.iter().position(|c| c.picture.is_some()));
+    let Some(i) = first else {
+        return "<p class=\"nochart\">Every row was skipped here.</p>".into();
+    };
+    let pic = esc(s.cells[i].picture.as_deref().unwrap_or_default());
+    counts.images += 1;
+    format!(
+        "<div class=\"viewer\" data-row=\"{i}\"><div class=\"frame\" title=\"click to flip between the row and its reference\">\
+         <img class=\"big\" src=\"{pic}\" alt=\"selected picture\"></div><div class=\"bar\"><span class=\"what\"></span>\
+         <button data-mode=\"row\">row</button><button data-mode=\"ref\">reference</button>\
+         <button data-mode=\"map\">FLIP map</button><a class=\"full\" href=\"{pic}\">full size</a></div></div>"
+    )
+}
+
+fn pareto(
+    s: &Section<'_>,
+    pipes: &[&str],
+    fronts: &[Option<bool>],
+    counts: &mut Counts,
+) -> Result<String> {
+    let points: Vec<Point> = s
+        .cells
+        .iter()
+        .zip(fronts)
+        .filter_map(|(c, f)| {
+            Some(Point {
+                label: c.variant.clone(),
+                pipeline: pipes.iter().position(|p| *p == c.pipeline)?,
+                ms: c.ms()?,
+                flip: c.flip?,
+                front: (*f)?,
+            })
+        })
+        .collect();
+    if points.is_empty() {
+        return Ok(
+            "<p class=\"nochart\">No row here has a reference, so there is no FLIP to chart: \
+                   the table gives their times.</p>"
+                .into(),
+        );
+    }
+    let with: Vec<(&str, usize)> = pipes
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| points.iter().any(|p| p.pipeline == *i))
+        .map(|(i, p)| (*p, i))
+        .collect();
+    let svg = charts::pareto(&points, &with)?;
+    counts.charts += 1;
+    Ok(format!(
+        "<figure class=\"chart\" data-chart=\"pareto\">{}<figcaption>Median frame time against mean FLIP, \
+         each row against its own pipeline's reference ({}); amber: the Pareto frontier (no other row is \
+         both faster and closer).</figcaption></figure>",
+        inline_svg(&svg),
+        esc(&with.iter().map(|w| w.0).collect::<Vec<_>>().join(", "))
+    ))
+}
+
+/// plotters' SVG as an inline element (its XML prologue, if any, dropped).
+fn inline_svg(svg: &str) -> &str {
+    svg.find("<svg").map_or(svg, |i| &svg[i..])
+}
+
+fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
+    let best = |f: fn(&Cell) -> Option<f64>| {
+        s.cells
+            .iter()
+            .filter_map(|c| f(c))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (best_ms, best_flip) = (best(Cell::ms), best(|c| c.flip));
+    let mut o = String::from(
+        "<table class=\"rows\"><thead><tr><th>row</th><th>frame ms</th><th>min–max</th>\
+         <th>raster ms</th><th>FLIP</th><th>coverage err.</th><th title=\"on the Pareto frontier\">◆</th></tr></thead><tbody>",
+    );
+    for (i, c) in s.cells.iter().enumerate() {
+        let colour = charts::pipeline_css(pipes.iter().position(|p| *p == c.pipeline).unwrap_or(0));
+        let label = format!(
+            "<td><span class=\"dot\" style=\"background:{colour}\"></span>{}</td>",
+            esc(&c.label())
+        );
+        if let Some(why) = &c.skipped {
+            let _ = write!(
+                o,
+                "<tr>{label}<td class=\"skip\" colspan=\"6\">skipped: {}</td></tr>",
+                esc(why)
+            );
+            continue;
+        }
+        let num = |x: Option<f64>, fmt: fn(f64) -> String, best: f64| match x {
+            Some(v) if v == best => format!("<td class=\"num best\">{}</td>", fmt(v)),
+            Some(v) => format!("<td class=\"num\">{}</td>", fmt(v)),
+            None => "<td class=\"na\">—</td>".into(),
+        };
+        let spread = c.frame.as_ref().and_then(|f| Some((f.min_ms?, f.max_ms?)));
+        let raster = c.raster.as_ref().and_then(|r| r.median_ms);
+        let _ = write!(
+            o,
+            "<tr data-row=\"{i}\">{label}{}{}{}{}{}<td class=\"front\">{}</td></tr>",
+            num(c.ms(), ms, best_ms),
+            spread.map_or("<td class=\"na\">—</td>".into(), |(a, b)| format!(
+                "<td class=\"num\">{}–{}</td>",
+                ms(a),
+                ms(b)
+            )),
+            num(raster, ms, f64::NAN),
+            num(c.flip, flip, best_flip),
+            num(c.coverage_error, |f| format!("{f:.4}"), f64::NAN),
+            if fronts[i] == Some(true) { "◆" } else { "" }
+        );
+    }
+    o.push_str("</tbody></table>");
+    o
+}
+
+/// The references first, then every measured row; each picture with its
+/// FLIP map stacked over it (shown on hover).
+fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
+    let mut o = String::from("<div class=\"thumbs\">");
+    for (k, (pipeline, path)) in s.references().into_iter().enumerate() {
+        counts.images += 1;
+        let _ = write!(
+            o,
+            "<figure class=\"thumb reference\" data-row=\"ref{k}\" data-pic=\"{p}\" data-label=\"{pipe}\">\
+             <div class=\"stack\"><img src=\"{p}\" alt=\"reference of {pipe}\"></div>\
+             <figcaption><span class=\"name\">reference · {pipe}</span><span class=\"num\">ground truth</span></figcaption></figure>",
+            p = esc(path),
+            pipe = esc(pipeline)
+        );
+    }
+    for (i, c) in s.cells.iter().enumerate() {
+        let Some(pic) = &c.picture else { continue };
+        counts.images += 1;
+        let label = esc(&c.label());
+        let mut attrs = format!(
+            "data-row=\"{i}\" data-pic=\"{}\" data-label=\"{label}\"",
+            esc(pic)
+        );
+        let mut map = String::new();
+        if let (Some(m), Some(r)) = (&c.flip_map, &c.reference_picture) {
+            counts.images += 1;
+            let _ = write!(attrs, " data-map=\"{}\" data-ref=\"{}\"", esc(m), esc(r));
+            map = format!(
+                "<img class=\"map\" src=\"{}\" alt=\"FLIP error map of {label}\">",
+                esc(m)
+            );
+        }
+        let num = c
+            .flip
+            .map_or("no reference".into(), |f| format!("FLIP {}", flip(f)));
+        let _ = write!(
+            o,
+            "<figure class=\"thumb\" {attrs}><div class=\"stack\"><img src=\"{}\" alt=\"{label}\">{map}</div>\
+             <figcaption><span class=\"name\" title=\"{label}\">{label}</span><span class=\"num\">{num}</span></figcaption></figure>",
+            esc(pic)
+        );
+    }
+    o.push_str("</div>");
+    o
+}
+
+/// Per-pass stacked bars of the measured rows.
+fn bars(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
+    let bars: Vec<Bar> = s
+        .cells
+        .iter()
+        .filter(|c| c.measured() && !c.passes.is_empty())
+        .map(|c| Bar {
+            label: c.label(),
+            passes: c
+                .passes
+                .iter()
+                .map(|p| (p.pass.clone(), p.median_ms.unwrap_or(0.0)))
+                .collect(),
+            frame_ms: c.ms(),
+        })
+        .collect();
+    if bars.is_empty() {
+        return Ok(String::new());
+    }
+    let svg = charts::pass_bars(&bars)?;
+    counts.charts += 1;
+    Ok(format!(
+        "<figure class=\"chart\" data-chart=\"passes\">{}<figcaption>Where each row's time goes: its passes' \
+         median times stacked in plan order (passes under 2% of every row's sum are \"other passes\"); the \
+         white tick is the median frame time, shorter than the sum where queues overlap (ash).</figcaption></figure>",
+        inline_svg(&svg)
+    ))
+}

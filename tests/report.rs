@@ -1,0 +1,198 @@
+//! `strandgraph report` end to end: a small report rendered on this
+//! machine (the CPU simulator and wgpu on lavapipe), opened in headless
+//! Chromium. The page checks itself (every <img> decoded, every chart's
+//! SVG present, no script error) into `<body data-report-check>`, which
+//! `--dump-dom` prints. Then the same page regenerated with `--from` into
+//! another directory, as the H100 report is made.
+//!
+//! Chromium is required: the test fails, not skips, without it
+//! (scripts/test.sh installs Debian's `chromium`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const CHROMIUM: &str = "/usr/bin/chromium";
+
+fn strandgraph() -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_strandgraph"));
+    cmd.current_dir(env!("CARGO_MANIFEST_DIR"));
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        cmd.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    }
+    cmd
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("strandgraph-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// Runs `cmd` to its end or kills it after `limit` (a hung browser must
+/// fail the test, not stall it).
+fn run_for(mut cmd: Command, limit: Duration) -> Output {
+    let mut child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    let t0 = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            panic!("{cmd:?} ran past {limit:?}");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.wait_with_output().expect("output")
+}
+
+/// The page's DOM after load, and Chromium's log.
+fn open_in_chromium(index: &Path) -> (String, String) {
+    assert!(
+        Path::new(CHROMIUM).exists(),
+        "{CHROMIUM} is missing: install Debian's `chromium` package (scripts/test.sh does)"
+    );
+    let profile = scratch("report-chromium-profile");
+    let mut cmd = Command::new(CHROMIUM);
+    cmd.args(["--headless", "--no-sandbox", "--disable-gpu"])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(["--enable-logging=stderr", "--v=0"])
+        // Load events run, then the DOM is printed (virtual time: no wait).
+        .args(["--virtual-time-budget=10000", "--dump-dom"])
+        .arg(format!(
+            "file://{}",
+            index.canonicalize().expect("index.html").display()
+        ));
+    let out = run_for(cmd, Duration::from_secs(120));
+    let _ = std::fs::remove_dir_all(&profile);
+    assert!(out.status.success(), "chromium: {out:?}");
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The value of `attr` on the page's <body>.
+fn body_attr<'a>(dom: &'a str, attr: &str) -> Option<&'a str> {
+    let body = &dom[dom.find("<body")?..];
+    let body = &body[..body.find('>')?];
+    let at = body.find(&format!("{attr}=\""))? + attr.len() + 2;
+    Some(&body[at..at + body[at..].find('"')?])
+}
+
+/// The page loads in Chromium with every picture and chart and no
+/// console error.
+fn check_page(index: &Path) {
+    let (dom, log) = open_in_chromium(index);
+    let check = body_attr(&dom, "data-report-check");
+    assert_eq!(
+        check,
+        Some("ok"),
+        "{}: the page's self-check ({:?}); chromium log:\n{log}",
+        index.display(),
+        body_attr(&dom, "data-report-counts")
+    );
+    // Console messages reach the log as `INFO:CONSOLE:line] "text"`; the page writes
+    // none, so any is an error or a warning to look at.
+    let console: Vec<&str> = log.lines().filter(|l| l.contains(":CONSOLE")).collect();
+    assert!(console.is_empty(), "console output: {console:#?}");
+    let images: usize = body_attr(&dom, "data-expect-images")
+        .unwrap()
+        .parse()
+        .unwrap();
+    let charts: usize = body_attr(&dom, "data-expect-charts")
+        .unwrap()
+        .parse()
+        .unwrap();
+    // Two sections (cpu, wgpu): a viewer, a reference, three rows' pictures
+    // and two FLIP maps each; a Pareto chart and per-pass bars each.
+    assert_eq!((images, charts), (2 * 7, 2 * 2), "{}", index.display());
+    assert_eq!(dom.matches("data-chart=\"pareto\"").count(), 2);
+    assert_eq!(dom.matches("data-chart=\"passes\"").count(), 2);
+}
+
+#[test]
+fn report_renders_and_loads_in_chromium() {
+    let t0 = Instant::now();
+    let dir = scratch("report");
+    let mut cmd = strandgraph();
+    cmd.args([
+        "report",
+        "scenes/distances/far.ron",
+        "--backend",
+        "cpu,wgpu",
+    ])
+    .args(["--quick", "--size", "160x90", "--frames", "1"])
+    .args([
+        "--row",
+        "Kulikov: all optimisations",
+        "--row",
+        "Kulikov: no sort",
+    ])
+    .args(["--row", "Lipp: SWR 1+L", "-o"])
+    .arg(&dir);
+    let out = run_for(cmd, Duration::from_secs(600));
+    assert!(
+        out.status.success(),
+        "report: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    for cell in json["cells"].as_array().unwrap() {
+        let pic = cell["picture"].as_str().expect("every cell has a picture");
+        assert!(dir.join(pic).is_file(), "{pic}");
+        let kulikov = cell["pipeline"] == "Kulikov";
+        assert_eq!(cell["flip_map"].is_string(), kulikov, "{cell}");
+        assert_eq!(cell["reference_picture"].is_string(), kulikov, "{cell}");
+    }
+    check_page(&dir.join("index.html"));
+
+    // The page again from the run's bench.json, elsewhere: the pictures
+    // come along.
+    let again = scratch("report-again");
+    let mut cmd = strandgraph();
+    cmd.args(["report", "--from"])
+        .arg(dir.join("bench.json"))
+        .arg("-o")
+        .arg(&again);
+    let out = run_for(cmd, Duration::from_secs(60));
+    assert!(out.status.success(), "{out:?}");
+    check_page(&again.join("index.html"));
+    eprintln!("report test took {:.0} s", t0.elapsed().as_secs_f64());
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&again);
+}
+
+/// A bench.json without pictures is refused, naming the file and why.
+#[test]
+fn from_a_bench_without_pictures_says_so() {
+    let dir = scratch("report-nopictures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let json = dir.join("bench.json");
+    let cell = r#"{"backend":"cpu","pipeline":"Kulikov","variant":"all optimisations","view":"far",
+        "frame":{"median_ms":1.0,"min_ms":1.0,"max_ms":1.0},"passes":[]}"#;
+    let text = format!(r#"{{"size":"160x90","frames":1,"warmup":0,"cells":[{cell}]}}"#);
+    std::fs::write(&json, text).unwrap();
+    let mut cmd = strandgraph();
+    cmd.args(["report", "--from"])
+        .arg(&json)
+        .arg("-o")
+        .arg(&dir);
+    let out = run_for(cmd, Duration::from_secs(60));
+    // miette wraps its lines and draws a margin: compare the words.
+    let err: String = String::from_utf8_lossy(&out.stderr)
+        .replace('│', " ")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("bench.json") && err.contains("without --pictures"),
+        "{err}"
+    );
+    assert!(!dir.join("index.html").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
