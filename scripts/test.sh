@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
 # Runs every test on a fresh Debian machine: installs what the tests need
-# (Graphviz for the DOT export check; a Vulkan driver, lavapipe, and the
-# Vulkan loader for the wgpu differential test when no Vulkan device is
-# installed), then the workspace tests and a quick pass of the criterion
+# (Graphviz for the DOT export check; Chromium for the HTML report's; a
+# Vulkan driver, lavapipe, and the Vulkan loader for the wgpu differential
+# test when no Vulkan device is installed), then the workspace tests and a quick pass of the criterion
 # benches so they keep building and running.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 missing=()
 command -v dot >/dev/null 2>&1 || missing+=(graphviz)
+# tests/report.rs opens the HTML report in headless Chromium and fails
+# without it.
+command -v chromium >/dev/null 2>&1 || missing+=(chromium)
 # tests/diff_wgpu.rs needs a Vulkan adapter and fails without one. Any ICD
 # manifest counts (lavapipe's is lvp_icd*.json, NVIDIA's nvidia_icd.json).
 icds=$(ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json 2>/dev/null || true)
