@@ -2,8 +2,8 @@
 # Runs every test on a fresh Debian machine: installs what the tests need
 # (Graphviz for the DOT export check; Chromium for the HTML report's; a
 # Vulkan driver, lavapipe, and the Vulkan loader for the wgpu differential
-# test when no Vulkan device is installed), then the workspace tests and a quick pass of the criterion
-# benches so they keep building and running.
+# test when no Vulkan device is installed), then the workspace tests and a
+# quick pass of the criterion benches so they keep building and running.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
