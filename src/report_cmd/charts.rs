@@ -75,7 +75,7 @@ fn padded(lo: f64, hi: f64, floor: Option<f64>) -> std::ops::Range<f64> {
 fn decimals(span: f64) -> usize {
     let d = -(span / 5.0).log10();
     if d.is_finite() {
-        d.ceil().clamp(1.0, 8.0) as usize
+        d.ceil().clamp(0.0, 8.0) as usize
     } else {
         3
     }
@@ -100,6 +100,7 @@ pub fn pareto(points: &[Point], pipelines: &[(&str, usize)]) -> Result<String> {
             what,
             ChartBuilder::on(&root)
                 .margin(14)
+                .margin_top(36)
                 .margin_right(24)
                 .x_label_area_size(44)
                 .y_label_area_size(72)
@@ -159,8 +160,8 @@ pub fn pareto(points: &[Point], pipelines: &[(&str, usize)]) -> Result<String> {
             .iter()
             .map(|p| chart.backend_coord(&(p.ms, p.flip)))
             .collect();
-        labels(&root, points, &at, w)?;
-        legend(&root, pipelines, w)?;
+        labels(&root, points, &at, (w, h))?;
+        legend(&root, pipelines)?;
         drawn(what, root.present())?;
     }
     Ok(svg)
@@ -172,35 +173,53 @@ fn text_width(text: &str, size: u32) -> i32 {
     (text.chars().count() as f64 * 0.56 * f64::from(size)).ceil() as i32
 }
 
-/// Each point's label beside it, moved up or down past labels already
-/// placed (rows of nearly equal time and FLIP would print over each
-/// other), with a leader line when moved.
+/// Where each label goes: beside its point, right or left, moved up or
+/// down past points and labels already placed (rows of nearly equal time
+/// and FLIP would print over each other). `(x, y, moved)`: the label's
+/// left end and middle, and whether it left its point's side.
+fn place_labels(widths: &[i32], at: &[(i32, i32)], w: i32, h: i32) -> Vec<(i32, i32, bool)> {
+    let overlaps = |r: (i32, i32, i32, i32), q: &(i32, i32, i32, i32)| {
+        r.0 < q.2 && q.0 < r.2 && r.1 < q.3 && q.1 < r.3
+    };
+    let mut taken: Vec<(i32, i32, i32, i32)> = at
+        .iter()
+        .map(|&(x, y)| (x - 6, y - 6, x + 6, y + 6))
+        .collect();
+    let mut out = Vec::with_capacity(at.len());
+    for (&tw, &(px, py)) in widths.iter().zip(at) {
+        let sides = [px + 10, px - 10 - tw];
+        let candidates = [0, -16, 16, -32, 32, -48, 48, -64, 64, -80, 80]
+            .into_iter()
+            .flat_map(|dy| sides.map(|x| (x, py - 8 + dy, dy != 0)));
+        let fits = |&(x, y, _): &(i32, i32, bool)| {
+            let r = (x, y - 8, x + tw, y + 8);
+            x >= 0 && x + tw <= w && r.1 >= 0 && r.3 <= h && !taken.iter().any(|q| overlaps(r, q))
+        };
+        let spot = candidates
+            .into_iter()
+            .find(fits)
+            .unwrap_or((sides[0], py - 8, false));
+        taken.push((spot.0, spot.1 - 8, spot.0 + tw, spot.1 + 8));
+        out.push(spot);
+    }
+    out
+}
+
+/// Each point's label, with a leader line where it had to move.
 fn labels(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
     points: &[Point],
     at: &[(i32, i32)],
-    w: u32,
+    (w, h): (u32, u32),
 ) -> Result<()> {
     let size = 12;
-    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-    for (p, &(px, py)) in points.iter().zip(at) {
-        let tw = text_width(&p.label, size);
-        let right = px + 10 + tw < w as i32 - 4;
-        let x = if right { px + 10 } else { px - 10 - tw };
-        let free = |y: i32| {
-            let r = (x, y - 8, x + tw, y + 8);
-            !placed
-                .iter()
-                .any(|q| r.0 < q.2 && q.0 < r.2 && r.1 < q.3 && q.1 < r.3)
-        };
-        let y = [0, -16, 16, -32, 32, -48, 48, -64, 64]
-            .into_iter()
-            .map(|dy| py - 8 + dy)
-            .find(|&y| free(y))
-            .unwrap_or(py - 8);
-        placed.push((x, y - 8, x + tw, y + 8));
-        if (y - (py - 8)).abs() > 0 {
-            let end = if right { x - 2 } else { x + tw + 2 };
+    let widths: Vec<i32> = points.iter().map(|p| text_width(&p.label, size)).collect();
+    let spots = place_labels(&widths, at, w as i32, h as i32);
+    for ((p, &(px, py)), ((x, y, moved), tw)) in
+        points.iter().zip(at).zip(spots.into_iter().zip(widths))
+    {
+        if moved {
+            let end = if x > px { x - 2 } else { x + tw + 2 };
             let line = PathElement::new(vec![(px, py), (end, y)], AXIS.mix(0.6));
             drawn("time-versus-FLIP", root.draw(&line))?;
         }
@@ -213,25 +232,24 @@ fn labels(
     Ok(())
 }
 
-/// The pipelines' colours and the frontier, top right.
-fn legend(
-    root: &DrawingArea<SVGBackend<'_>, Shift>,
-    pipelines: &[(&str, usize)],
-    w: u32,
-) -> Result<()> {
+/// The pipelines' colours and the frontier, in a line above the plot
+/// (inside it, they would cover points).
+fn legend(root: &DrawingArea<SVGBackend<'_>, Shift>, pipelines: &[(&str, usize)]) -> Result<()> {
     let entries = pipelines
         .iter()
         .map(|&(name, i)| (name.to_string(), PIPELINES[i % PIPELINES.len()]))
         .chain([("Pareto frontier".to_string(), FRONTIER)]);
-    for (i, (name, colour)) in entries.enumerate() {
-        let (x, y) = (w as i32 - 150, 26 + 18 * i as i32);
-        let dot = Circle::new((x, y), 5, colour.filled());
+    let mut x = 90;
+    for (name, colour) in entries {
+        let dot = Circle::new((x, 16), 5, colour.filled());
         drawn("time-versus-FLIP", root.draw(&dot))?;
         let style = font(12).pos(Pos::new(HPos::Left, VPos::Center));
+        let width = text_width(&name, 12);
         drawn(
             "time-versus-FLIP",
-            root.draw(&Text::new(name, (x + 10, y), style)),
+            root.draw(&Text::new(name, (x + 10, 16), style)),
         )?;
+        x += width + 34;
     }
     Ok(())
 }
@@ -319,6 +337,7 @@ pub fn pass_bars(bars: &[Bar]) -> Result<String> {
                 // Segments of `0..k` are 0..=k: `n - 1` gives one per row.
                 .build_cartesian_2d(0.0..max * 1.14, (0..n.saturating_sub(1)).into_segmented()),
         )?;
+        let dx = decimals(max * 1.14);
         drawn(
             what,
             chart
@@ -327,6 +346,7 @@ pub fn pass_bars(bars: &[Bar]) -> Result<String> {
                 .bold_line_style(GRID)
                 .light_line_style(TRANSPARENT)
                 .disable_y_mesh()
+                .x_label_formatter(&|x| format!("{x:.dx$}"))
                 .y_labels(n.max(1))
                 .label_style(font(12))
                 .axis_desc_style(font(13))
@@ -408,4 +428,31 @@ fn bar_legend(side: &DrawingArea<SVGBackend<'_>, Shift>, major: &[String]) -> Re
 pub fn pipeline_css(i: usize) -> String {
     let RGBColor(r, g, b) = PIPELINES[i % PIPELINES.len()];
     format!("#{r:02x}{g:02x}{b:02x}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_of_coincident_points_do_not_overlap() {
+        let at = [(100, 100), (102, 100), (104, 101), (600, 50)];
+        let spots = place_labels(&[80, 80, 80, 80], &at, 640, 400);
+        for (i, a) in spots.iter().enumerate() {
+            for b in &spots[i + 1..] {
+                let apart = (a.0 - b.0).abs() >= 80 || (a.1 - b.1).abs() >= 16;
+                assert!(apart, "{a:?} and {b:?} overlap");
+            }
+        }
+        // The last point is near the right edge: its label goes left.
+        assert!(spots[3].0 + 80 <= 600, "{:?}", spots[3]);
+        assert!(!spots[0].2, "the first label stays beside its point");
+    }
+
+    #[test]
+    fn decimals_follow_the_span() {
+        assert_eq!(decimals(0.0001), 5);
+        assert_eq!(decimals(2.0), 1);
+        assert_eq!(decimals(900.0), 0);
+    }
 }

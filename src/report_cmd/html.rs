@@ -345,9 +345,10 @@ fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
                 esc(m)
             );
         }
-        let num = c
-            .flip
-            .map_or("no reference".into(), |f| format!("FLIP {}", flip(f)));
+        let time = c.ms().map_or(String::new(), |t| format!("{} ms · ", ms(t)));
+        let num = c.flip.map_or(format!("{time}no reference"), |f| {
+            format!("{time}FLIP {}", flip(f))
+        });
         let _ = write!(
             o,
             "<figure class=\"thumb\" {attrs}><div class=\"stack\"><img src=\"{}\" alt=\"{label}\">{map}</div>\

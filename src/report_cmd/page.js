@@ -49,6 +49,11 @@ function setUp() {
         select(section, section.querySelector('.thumb[data-row="' + el.dataset.row + '"]'));
       });
     });
+    const big = v.querySelector("img.big");
+    const scale = () => big.classList.toggle("up", big.naturalWidth < big.clientWidth);
+    big.addEventListener("load", scale);
+    window.addEventListener("resize", scale);
+    if (big.complete) scale();
     v.querySelector(".frame").addEventListener("click", () => {
       window.lastViewer = v;
       flip(v);
