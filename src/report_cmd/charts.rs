@@ -187,10 +187,12 @@ fn place_labels(widths: &[i32], at: &[(i32, i32)], w: i32, h: i32) -> Vec<(i32, 
         .collect();
     let mut out = Vec::with_capacity(at.len());
     for (&tw, &(px, py)) in widths.iter().zip(at) {
-        let sides = [px + 10, px - 10 - tw];
+        // Right, left, then centred over or under the point (off 0 only).
+        let sides = [px + 10, px - 10 - tw, px - tw / 2];
         let candidates = [0, -16, 16, -32, 32, -48, 48, -64, 64, -80, 80]
             .into_iter()
-            .flat_map(|dy| sides.map(|x| (x, py - 8 + dy, dy != 0)));
+            .flat_map(|dy| sides.map(|x| (x, py - 8 + dy, dy != 0)))
+            .filter(|&(x, _, moved)| moved || x != px - tw / 2);
         let fits = |&(x, y, _): &(i32, i32, bool)| {
             let r = (x, y - 8, x + tw, y + 8);
             x >= 0 && x + tw <= w && r.1 >= 0 && r.3 <= h && !taken.iter().any(|q| overlaps(r, q))
@@ -219,8 +221,14 @@ fn labels(
         points.iter().zip(at).zip(spots.into_iter().zip(widths))
     {
         if moved {
-            let end = if x > px { x - 2 } else { x + tw + 2 };
-            let line = PathElement::new(vec![(px, py), (end, y)], AXIS.mix(0.6));
+            // To the label's near end, or its near edge when centred.
+            let end = match (x > px, x + tw < px) {
+                (true, _) => (x - 2, y),
+                (_, true) => (x + tw + 2, y),
+                _ if y < py => (px, y + 7),
+                _ => (px, y - 7),
+            };
+            let line = PathElement::new(vec![(px, py), end], AXIS.mix(0.6));
             drawn("time-versus-FLIP", root.draw(&line))?;
         }
         let style = font(size).pos(Pos::new(HPos::Left, VPos::Center));
