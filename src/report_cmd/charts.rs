@@ -34,7 +34,7 @@ const PASSES: [RGBColor; 12] = [
     RGBColor(0xff, 0x9d, 0xa7),
     RGBColor(0x9c, 0x75, 0x5f),
     RGBColor(0xba, 0xb0, 0xac),
-    RGBColor(0x86, 0xbc, 0xb6),
+    RGBColor(0xa0, 0xcb, 0xe8),
     RGBColor(0xd3, 0x72, 0x95),
 ];
 /// Passes under this share of every row's sum go into "other passes".
@@ -81,6 +81,25 @@ fn decimals(span: f64) -> usize {
     }
 }
 
+type XyChart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+/// The axes' ranges: the points' time and FLIP, padded, from zero up.
+fn ranges(points: &[Point]) -> (std::ops::Range<f64>, std::ops::Range<f64>) {
+    let span = |v: Vec<f64>| {
+        let lo = v.iter().copied().fold(f64::MAX, f64::min);
+        let hi = v.iter().copied().fold(0.0, f64::max);
+        padded(lo, hi, Some(0.0))
+    };
+    (
+        span(points.iter().map(|p| p.ms).collect()),
+        span(points.iter().map(|p| p.flip).collect()),
+    )
+}
+
 /// Time (x) against mean FLIP (y), coloured by pipeline, the frontier as
 /// an amber staircase with rings, every point labelled; the legend names
 /// `pipelines` (name and colour index).
@@ -90,11 +109,7 @@ pub fn pareto(points: &[Point], pipelines: &[(&str, usize)]) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        let xs = points.iter().map(|p| p.ms);
-        let ys = points.iter().map(|p| p.flip);
-        let (x0, x1) = (xs.clone().fold(f64::MAX, f64::min), xs.fold(0.0, f64::max));
-        let (y0, y1) = (ys.clone().fold(f64::MAX, f64::min), ys.fold(0.0, f64::max));
-        let (xr, yr) = (padded(x0, x1, Some(0.0)), padded(y0, y1, Some(0.0)));
+        let (xr, yr) = ranges(points);
         let (dx, dy) = (decimals(xr.end - xr.start), decimals(yr.end - yr.start));
         let mut chart = drawn(
             what,
@@ -121,50 +136,53 @@ pub fn pareto(points: &[Point], pipelines: &[(&str, usize)]) -> Result<String> {
                 .y_label_formatter(&|y| format!("{y:.dy$}"))
                 .draw(),
         )?;
-        let mut front: Vec<(f64, f64)> = points
-            .iter()
-            .filter(|p| p.front)
-            .map(|p| (p.ms, p.flip))
-            .collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        // The staircase bounds what the frontier's rows dominate.
-        let stairs: Vec<(f64, f64)> = front
-            .iter()
-            .enumerate()
-            .flat_map(|(i, &(t, e))| {
-                let prev = i.checked_sub(1).map(|j| (t, front[j].1));
-                prev.into_iter().chain([(t, e)])
-            })
-            .collect();
-        drawn(
-            what,
-            chart.draw_series(LineSeries::new(stairs, FRONTIER.mix(0.7).stroke_width(2))),
-        )?;
-        drawn(
-            what,
-            chart.draw_series(
-                points
-                    .iter()
-                    .filter(|p| p.front)
-                    .map(|p| Circle::new((p.ms, p.flip), 8, FRONTIER.stroke_width(2))),
-            ),
-        )?;
-        drawn(
-            what,
-            chart.draw_series(points.iter().map(|p| {
-                let c = PIPELINES[p.pipeline % PIPELINES.len()];
-                Circle::new((p.ms, p.flip), 5, c.filled())
-            })),
-        )?;
-        let at: Vec<(i32, i32)> = points
-            .iter()
-            .map(|p| chart.backend_coord(&(p.ms, p.flip)))
-            .collect();
+        let at = draw_points(&mut chart, points)?;
         labels(&root, points, &at, (w, h))?;
         legend(&root, pipelines)?;
         drawn(what, root.present())?;
     }
     Ok(svg)
+}
+
+/// The frontier's points joined as a staircase (the boundary of what its
+/// rows dominate), by time.
+fn stairs(points: &[Point]) -> Vec<(f64, f64)> {
+    let mut front: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|p| p.front)
+        .map(|p| (p.ms, p.flip))
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    front
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &(t, e))| {
+            let prev = i.checked_sub(1).map(|j| (t, front[j].1));
+            prev.into_iter().chain([(t, e)])
+        })
+        .collect()
+}
+
+/// The staircase, the frontier's rings and every point; where the points
+/// landed, in pixels.
+fn draw_points(chart: &mut XyChart<'_, '_>, points: &[Point]) -> Result<Vec<(i32, i32)>> {
+    let what = "time-versus-FLIP";
+    let line = LineSeries::new(stairs(points), FRONTIER.mix(0.7).stroke_width(2));
+    drawn(what, chart.draw_series(line))?;
+    let rings = points
+        .iter()
+        .filter(|p| p.front)
+        .map(|p| Circle::new((p.ms, p.flip), 8, FRONTIER.stroke_width(2)));
+    drawn(what, chart.draw_series(rings))?;
+    let dots = points.iter().map(|p| {
+        let c = PIPELINES[p.pipeline % PIPELINES.len()];
+        Circle::new((p.ms, p.flip), 5, c.filled())
+    });
+    drawn(what, chart.draw_series(dots))?;
+    Ok(points
+        .iter()
+        .map(|p| chart.backend_coord(&(p.ms, p.flip)))
+        .collect())
 }
 
 /// Approximate width in pixels of `text` at `size` (no font metrics in
@@ -271,6 +289,13 @@ pub struct Bar {
     pub frame_ms: Option<f64>,
 }
 
+impl Bar {
+    /// The passes' summed medians.
+    fn total(&self) -> f64 {
+        self.passes.iter().map(|p| p.1).sum()
+    }
+}
+
 /// The passes that get their own colour: at most a dozen, by their
 /// largest share of any row; the rest are "other passes".
 fn major_passes(bars: &[Bar]) -> Vec<String> {
@@ -328,8 +353,7 @@ pub fn pass_bars(bars: &[Bar]) -> Result<String> {
     let legend_h = 30 + 20 * (major.len() as u32 + 1);
     let bars_h = 70 + 28 * n.max(1) as u32;
     let (w, h) = (1080u32, bars_h.max(legend_h));
-    let total = |b: &Bar| b.passes.iter().map(|p| p.1).sum::<f64>();
-    let max = bars.iter().map(total).fold(0.0, f64::max).max(1e-6);
+    let max = bars.iter().map(Bar::total).fold(0.0, f64::max).max(1e-6);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
@@ -342,8 +366,8 @@ pub fn pass_bars(bars: &[Bar]) -> Result<String> {
                 .margin(10)
                 .x_label_area_size(40)
                 .y_label_area_size(label_px as u32)
-                // Segments of `0..k` are 0..=k: `n - 1` gives one per row.
-                .build_cartesian_2d(0.0..max * 1.14, (0..n.saturating_sub(1)).into_segmented()),
+                // Row i spans y in [n-1-i, n-i]: row 0 on top.
+                .build_cartesian_2d(0.0..max * 1.14, 0.0..n.max(1) as f64),
         )?;
         let dx = decimals(max * 1.14);
         drawn(
@@ -354,61 +378,62 @@ pub fn pass_bars(bars: &[Bar]) -> Result<String> {
                 .bold_line_style(GRID)
                 .light_line_style(TRANSPARENT)
                 .disable_y_mesh()
+                // Row labels are drawn beside their bars (draw_bars).
+                .y_labels(0)
                 .x_label_formatter(&|x| format!("{x:.dx$}"))
-                .y_labels(n.max(1))
                 .label_style(font(12))
                 .axis_desc_style(font(13))
                 .x_desc("ms: sum of the passes' medians (tick: median frame)")
-                .y_label_formatter(&|v| match v {
-                    SegmentValue::CenterOf(i) if *i < n => bars[n - 1 - i].label.clone(),
-                    _ => String::new(),
-                })
                 .draw(),
         )?;
-        // Row 0 on top: segment n-1-i holds row i.
-        for (i, bar) in bars.iter().enumerate() {
-            let y = n - 1 - i;
-            for (colour, a, b) in segments(bar, &major) {
-                let c = colour.map_or(OTHER, |k| PASSES[k % PASSES.len()]);
-                let mut rect = Rectangle::new(
-                    [(a, SegmentValue::Exact(y)), (b, SegmentValue::Exact(y + 1))],
-                    c.filled(),
-                );
-                rect.set_margin(4, 4, 0, 0);
-                drawn(what, chart.draw_series(std::iter::once(rect)))?;
-            }
-            bar_annotations(&root, &chart, bar, y, total(bar))?;
-        }
+        draw_bars(&root, &mut chart, bars, &major)?;
         bar_legend(&side, &major)?;
         drawn(what, root.present())?;
     }
     Ok(svg)
 }
 
-type BarChart<'a, 'b> = ChartContext<
-    'a,
-    SVGBackend<'b>,
-    Cartesian2d<
-        plotters::coord::types::RangedCoordf64,
-        plotters::coord::ranged1d::SegmentedCoord<plotters::coord::types::RangedCoordusize>,
-    >,
->;
+/// Each row's segments and annotations; row i spans y in [n-1-i, n-i].
+fn draw_bars(
+    root: &DrawingArea<SVGBackend<'_>, Shift>,
+    chart: &mut XyChart<'_, '_>,
+    bars: &[Bar],
+    major: &[String],
+) -> Result<()> {
+    let n = bars.len();
+    for (i, bar) in bars.iter().enumerate() {
+        let y = (n - 1 - i) as f64;
+        for (colour, a, b) in segments(bar, major) {
+            let c = colour.map_or(OTHER, |k| PASSES[k % PASSES.len()]);
+            let mut rect = Rectangle::new([(a, y), (b, y + 1.0)], c.filled());
+            rect.set_margin(4, 4, 0, 0);
+            drawn("per-pass", chart.draw_series(std::iter::once(rect)))?;
+        }
+        bar_annotations(root, chart, bar, y + 0.5)?;
+    }
+    Ok(())
+}
 
-/// The sum at the bar's end and a tick at its median frame time, drawn
-/// on `root` in pixels (text in a chart's coordinates cannot be offset).
+/// The row's label left of its bar, its sum at the bar's end and a tick
+/// at its median frame time, drawn on `root` in pixels (text in a chart's
+/// coordinates cannot be offset).
 fn bar_annotations(
     root: &DrawingArea<SVGBackend<'_>, Shift>,
-    chart: &BarChart<'_, '_>,
+    chart: &XyChart<'_, '_>,
     bar: &Bar,
-    y: usize,
-    sum: f64,
+    y: f64,
 ) -> Result<()> {
-    let (x, yc) = chart.backend_coord(&(sum, SegmentValue::CenterOf(y)));
+    let sum = bar.total();
+    let (x0, yc) = chart.backend_coord(&(0.0, y));
+    let style = font(12).pos(Pos::new(HPos::Right, VPos::Center));
+    let label = Text::new(bar.label.clone(), (x0 - 8, yc), style);
+    drawn("per-pass", root.draw(&label))?;
+    let (x, yc) = chart.backend_coord(&(sum, y));
     let style = font(11).pos(Pos::new(HPos::Left, VPos::Center));
     let text = Text::new(format!("{sum:.2}"), (x + 6, yc), style);
     drawn("per-pass", root.draw(&text))?;
     if let Some(f) = bar.frame_ms {
-        let (x, yc) = chart.backend_coord(&(f, SegmentValue::CenterOf(y)));
+        let (x, yc) = chart.backend_coord(&(f, y));
         let tick = PathElement::new(vec![(x, yc - 11), (x, yc + 11)], WHITE.stroke_width(2));
         drawn("per-pass", root.draw(&tick))?;
     }
