@@ -91,6 +91,9 @@ pub static PASSES: &[&dyn PassDef] = &[
     &reference::scan::SCAN,
     &reference::bin::FILL,
     &reference::resolve::RESOLVE,
+    &reference::bin::FILL_STRANDS,
+    &lipp::reference::strands::STRANDS,
+    &lipp::reference::shade::SHADE,
     // Roofline references for `strandgraph bench` (scenes/graphs/roofline.ron).
     &bench::ATOMIC_MIN32,
     &bench::ATOMIC_MIN64,

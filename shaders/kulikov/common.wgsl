@@ -348,23 +348,3 @@ fn morton_spread(v_in: u32) -> u32 {
 fn morton_code(x: u32, y: u32) -> u32 {
     return morton_spread(x) | (morton_spread(y) << 1u);
 }
-
-// A half float's bits as f32 (debug_resolve::load_rgba16f; infinities and
-// NaNs as the largest half, which lighting never reaches).
-fn f16_to_f32(h: u32) -> f32 {
-    let s = select(1.0, -1.0, (h & 0x8000u) != 0u);
-    let e = (h >> 10u) & 0x1Fu;
-    let m = f32(h & 0x3FFu);
-    if e == 0u {
-        return s * m * 5.9604645e-8;
-    }
-    if e == 31u {
-        return s * 65504.0;
-    }
-    return s * (1.0 + m / 1024.0) * exp2(f32(e) - 15.0);
-}
-
-// One vertex_lighting entry (rgba16f) as linear RGB radiance.
-fn unpack_radiance(w: vec2<u32>) -> vec3<f32> {
-    return vec3<f32>(f16_to_f32(w.x & 0xFFFFu), f16_to_f32(w.x >> 16u), f16_to_f32(w.y & 0xFFFFu));
-}

@@ -14,7 +14,8 @@
 // the same loop over pixels and models.
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
-#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, unpack_radiance, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+#import strandgraph::half::unpack_radiance
+#import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
 
 struct ComposeParams {
     poisson_samples: u32,

@@ -15,6 +15,7 @@
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment, world_of_clip}
 #import strandgraph::layout::{ModelData, LightData}
 #import strandgraph::kulikov::{load_lod, GRID_WORDS, AREA_UNIT, F32_MAX}
+#import strandgraph::half::pack_radiance
 
 struct ShadeParams {
     // r, tt, trt scales; scatter (0 = no multiple scattering).
@@ -197,44 +198,8 @@ fn shade_vertex(model: u32, vertex: u32, p: vec3<f32>, t: vec3<f32>) -> vec3<f32
     return out;
 }
 
-// half::f16::from_f32 (round to nearest even) without the f16 capability
-// pack2x16float needs.
-fn f16_bits(x: f32) -> u32 {
-    let b = bitcast<u32>(x);
-    let sign = (b >> 16u) & 0x8000u;
-    let e = i32((b >> 23u) & 0xFFu);
-    var m = b & 0x7FFFFFu;
-    if e == 255 {
-        return sign | 0x7C00u | select(0u, 0x200u | (m >> 13u), m != 0u);
-    }
-    let he = e - 112;
-    if he >= 31 {
-        return sign | 0x7C00u;
-    }
-    if he <= 0 {
-        if he < -10 {
-            return sign;
-        }
-        m = m | 0x800000u;
-        let shift = u32(14 - he);
-        var hm = m >> shift;
-        let rem = m & ((1u << shift) - 1u);
-        let half = 1u << (shift - 1u);
-        if rem > half || (rem == half && (hm & 1u) != 0u) {
-            hm += 1u;
-        }
-        return sign | hm;
-    }
-    var h = (u32(he) << 10u) | (m >> 13u);
-    let rem = m & 0x1FFFu;
-    if rem > 0x1000u || (rem == 0x1000u && (h & 1u) != 0u) {
-        h += 1u;
-    }
-    return sign | h;
-}
-
 fn store_lighting(v: u32, c: vec3<f32>) {
-    vertex_lighting[v] = vec2<u32>(f16_bits(c.x) | (f16_bits(c.y) << 16u), f16_bits(c.z) | (0x3C00u << 16u));
+    vertex_lighting[v] = pack_radiance(c);
 }
 
 // shade_sort::MAX_SHADE_GROUPS: the dispatch's cap in x, past which lanes stride.

@@ -7,8 +7,7 @@
 #define LOD_MODELS_BINDING 3
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::kulikov::load_lod
-#import strandgraph::clip::clip_to_screen
-#import strandgraph::reference::{BinParams, Ribbon, ribbon_pack, ribbon_tiles, ribbon_reaches_tile}
+#import strandgraph::reference::{BinParams, Ribbon, ribbon_of, ribbon_pack, ribbon_tiles, ribbon_reaches_tile}
 
 @group(0) @binding(0) var<uniform> params: BinParams;
 @group(0) @binding(4) var<storage, read> segment_visibility: array<u32>;
@@ -32,27 +31,13 @@ fn segment_ribbon(id: u32) -> Ribbon {
     let per = models[seg.model].points_per_strand - 1u;
     let lod = load_lod(lod_models[seg.model]);
     let k = seg.local % per;
-    let c0 = clip_positions[seg.va];
-    let c1 = clip_positions[seg.vb];
-    if !(c0.w >= frame.near && c1.w >= frame.near) {
-        return r;
-    }
-    let sa = clip_to_screen(c0, frame.screen.x, frame.screen.y);
-    let sb = clip_to_screen(c1, frame.screen.x, frame.screen.y);
     let t0 = groom_vertices[seg.va].w * lod.thickness_scale;
     let t1 = groom_vertices[seg.vb].w * lod.thickness_scale;
-    r.a = sa.xy;
-    r.b = sb.xy;
-    r.ha = 0.5 * t0 * frame.pixels_per_unit / c0.w;
-    r.hb = 0.5 * t1 * frame.pixels_per_unit / c1.w;
-    r.wa = c0.w;
-    r.wb = c1.w;
-    r.join_a = k > 0u;
-    r.join_b = k + 1u < lod.segments_per_strand;
-    r.va = seg.va;
-    r.vb = seg.vb;
-    r.valid = true;
-    return r;
+    return ribbon_of(
+        clip_positions[seg.va], clip_positions[seg.vb], t0, t1,
+        k > 0u, k + 1u < lod.segments_per_strand, seg.va, seg.vb,
+        frame.near, frame.screen.xy, frame.pixels_per_unit,
+    );
 }
 
 @compute @workgroup_size(256)

@@ -1,7 +1,7 @@
-// reference.fill: each drawn segment into the list of every tile
-// reference.count counted it in, taking slots with an atomicAdd on a
-// second, cleared, per-tile counter. Port of passes/src/reference/bin.rs
-// (fill).
+// reference.fill and reference.fill_strands: each drawn segment into the
+// list of every tile its count pass counted it in, taking slots with an
+// atomicAdd on a second, cleared, per-tile counter. Port of
+// passes/src/reference/bin.rs (fill).
 
 #import strandgraph::reference::{BinParams, Ribbon, ribbon_unpack, ribbon_tiles, ribbon_reaches_tile}
 
@@ -11,12 +11,10 @@
 @group(0) @binding(3) var<storage, read_write> reference_cursor: array<atomic<u32>>;
 @group(0) @binding(4) var<storage, read_write> reference_segments: array<u32>;
 
-@compute @workgroup_size(256)
-fn fill(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let id = gid.x;
-    if id >= params.segments {
-        return;
-    }
+// lipp::MAX_CONTROL_POINTS: record slots per strand in fill_strands.
+const STRAND_SLOTS: u32 = 129u;
+
+fn fill_record(id: u32) {
     let r = ribbon_unpack(reference_ribbons[3u * id], reference_ribbons[3u * id + 1u], reference_ribbons[3u * id + 2u]);
     if !r.valid {
         return;
@@ -34,5 +32,27 @@ fn fill(@builtin(global_invocation_id) gid: vec3<u32>) {
                 }
             }
         }
+    }
+}
+
+// A lane per segment (`params.segments` records).
+@compute @workgroup_size(256)
+fn fill(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x < params.segments {
+        fill_record(gid.x);
+    }
+}
+
+// A lane per strand (`params.segments` strands), each with STRAND_SLOTS
+// record slots of which the first C - 1 hold its segments.
+@compute @workgroup_size(64)
+fn fill_strands(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if gid.x >= params.segments {
+        return;
+    }
+    let records = arrayLength(&reference_ribbons) / 3u;
+    let first = gid.x * STRAND_SLOTS;
+    for (var id = first; id < min(first + STRAND_SLOTS - 1u, records); id++) {
+        fill_record(id);
     }
 }

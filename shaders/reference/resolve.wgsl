@@ -7,7 +7,8 @@
 // of 64, so a lane walks the list once per block (256 samples: 4 times).
 
 #import strandgraph::layout::FrameData
-#import strandgraph::kulikov::{F32_MAX, unpack_radiance}
+#import strandgraph::kulikov::F32_MAX
+#import strandgraph::half::unpack_radiance
 #import strandgraph::reference::{Ribbon, ribbon_unpack, ribbon_axis, ribbon_covers, ribbon_may_touch, ribbon_depth_at, ribbon_world_t, sample_position, REFERENCE_TILE}
 
 struct ResolveParams {

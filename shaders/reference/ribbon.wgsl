@@ -5,6 +5,8 @@
 //   #import strandgraph::reference::{Ribbon, ribbon_covers, ...}
 #define_import_path strandgraph::reference
 
+#import strandgraph::clip::clip_to_screen
+
 // reference::TILE: the lists' screen tile edge.
 const REFERENCE_TILE: u32 = 8u;
 
@@ -29,6 +31,28 @@ struct Ribbon {
     join_b: bool,
     va: u32,
     vb: u32,
+}
+
+// Ribbon::new for the segment from clip position c0 to c1 with world
+// thicknesses t0, t1 and end vertices va, vb; not valid when an end lies at
+// or behind the near plane.
+fn ribbon_of(c0: vec4<f32>, c1: vec4<f32>, t0: f32, t1: f32, join_a: bool, join_b: bool, va: u32, vb: u32, near: f32, screen: vec2<f32>, pixels_per_unit: f32) -> Ribbon {
+    var r: Ribbon;
+    r.valid = c0.w >= near && c1.w >= near;
+    if !r.valid {
+        return r;
+    }
+    r.a = clip_to_screen(c0, screen.x, screen.y).xy;
+    r.b = clip_to_screen(c1, screen.x, screen.y).xy;
+    r.ha = 0.5 * t0 * pixels_per_unit / c0.w;
+    r.hb = 0.5 * t1 * pixels_per_unit / c1.w;
+    r.wa = c0.w;
+    r.wb = c1.w;
+    r.join_a = join_a;
+    r.join_b = join_b;
+    r.va = va;
+    r.vb = vb;
+    return r;
 }
 
 // Record::store: three words of four (RECORD_WORDS = 12).

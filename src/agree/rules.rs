@@ -128,6 +128,22 @@ static EXCEPTIONS: &[Exception] = &[
         why: "as kulikov.sort: a segment takes its slot in a tile's list with an atomicAdd, so the order within a list is arrival order; the resolve keeps, per sample, the nearest fragment whatever the order",
     },
     Exception {
+        kind: "reference.fill_strands",
+        binding: "reference_segments",
+        on: On::Every,
+        rule: Rule::Multiset,
+        outliers: 0.0,
+        why: "as reference.fill: list order is atomic arrival order",
+    },
+    Exception {
+        kind: "lipp.reference_shade",
+        binding: "vertex_lighting",
+        on: On::Every,
+        rule: Rule::F16 { ulps: 16 },
+        outliers: 0.0,
+        why: "lipp.shade's shading (its rule: relative error ≤ 4e-3 from acos, exp and sqrt), packed to halves: 4e-3 is 4 half ULPs, and a value on a rounding boundary one more",
+    },
+    Exception {
         kind: "kulikov.shade_sort",
         binding: "shading_segments",
         on: On::Every,
@@ -204,6 +220,36 @@ static EXCEPTIONS: &[Exception] = &[
         rule: Rule::Exact,
         outliers: 0.06,
         why: "contracted projection changes the packed depth bits of 4% of the layers on lavapipe",
+    },
+    Exception {
+        kind: "lipp.reference_strands",
+        binding: "reference_points",
+        on: On::Wgpu,
+        rule: Rule::F32 {
+            ulps: 256,
+            abs: 4e-3,
+        },
+        outliers: 0.00001,
+        why: "as lipp.raster on wgpu: naga's SPIR-V lets the driver contract the Hermite and styling arithmetic into fused multiply-adds, which moves positions by a few ULPs; a tangent is a finite difference of positions a millimetre or less apart (the beard's curls), normalised, so its components move by up to 3e-3, and 32 of 8,256,000 words (tangent y, where the neighbours nearly coincide) by up to 1.3e-2 (lavapipe; the G-buffer's octahedral tangent has steps of 8e-3)",
+    },
+    Exception {
+        kind: "lipp.reference_strands",
+        binding: "reference_ribbons",
+        on: On::Wgpu,
+        rule: Rule::F32 {
+            ulps: 256,
+            abs: 1e-5,
+        },
+        outliers: 0.0,
+        why: "the contracted positions, projected: screen ends, radii and depths a few ULPs apart",
+    },
+    Exception {
+        kind: "lipp.reference_strands",
+        binding: "reference_counts",
+        on: On::Wgpu,
+        rule: Rule::Near { max: 4 },
+        outliers: 0.0,
+        why: "a ribbon whose reach touches a tile's corner by a contracted ULP is counted there or not",
     },
     // Scheuermann's stages draw through the hardware rasterizer: the same
     // snapped coverage, but depth and attributes interpolated by the GPU's

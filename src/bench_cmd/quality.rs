@@ -22,6 +22,8 @@ use strandgraph::runner::{self, Backend, CpuOptions};
 pub fn reference_graph(pipeline: &str) -> Option<&'static str> {
     match pipeline {
         "Kulikov" => Some("scenes/graphs/kulikov_reference.ron"),
+        // The hardware-raster baselines shade with lipp.shade.
+        "Lipp" | "HW strands" | "HW mesh" => Some("scenes/graphs/lipp_reference.ron"),
         _ => None,
     }
 }

@@ -123,39 +123,41 @@ pub fn frame_table(json: &Value) -> Result<String, String> {
     Ok(md)
 }
 
-/// Per backend: a row per variant that was measured against a reference,
-/// a column per view; each cell the mean FLIP and the frame median.
+/// Per backend and reference: a row per variant measured against it, a
+/// column per view; each cell the mean FLIP and the frame median.
 pub fn flip_table(json: &Value) -> Result<String, String> {
     let mut md = String::new();
     for (backend, device) in devices(json)? {
-        let with = || cells(json, &backend).filter(|c| c["flip"].is_number());
-        let rows = distinct(with(), label);
-        if rows.is_empty() {
-            continue;
-        }
+        let measured = || cells(json, &backend).filter(|c| c["flip"].is_number());
+        let references = distinct(measured(), |c| {
+            c["flip_reference"].as_str().unwrap_or("?").to_string()
+        });
         let views = distinct(cells(json, &backend), view_of);
-        let reference = with()
-            .find_map(|c| c["flip_reference"].as_str())
-            .unwrap_or("?");
-        let _ = writeln!(
-            md,
-            "{}; mean FLIP against `{reference}` (ACES, 0 EV; 0 is identical), then the median frame in ms:\n",
-            caption(json, &backend, &device)
-        );
-        grid(
-            &mut md,
-            || Box::new(with()),
-            &rows,
-            &views,
-            |c| {
-                format!(
-                    "{:.4} ({:.2})",
-                    c["flip"].as_f64().unwrap_or(f64::NAN),
-                    c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
-                )
-            },
-        );
-        md.push('\n');
+        for reference in &references {
+            let with = || {
+                measured().filter(move |c| c["flip_reference"].as_str().unwrap_or("?") == reference)
+            };
+            let rows = distinct(with(), label);
+            let _ = writeln!(
+                md,
+                "{}; mean FLIP against `{reference}` (ACES, 0 EV; 0 is identical), then the median frame in ms:\n",
+                caption(json, &backend, &device)
+            );
+            grid(
+                &mut md,
+                || Box::new(with()),
+                &rows,
+                &views,
+                |c| {
+                    format!(
+                        "{:.4} ({:.2})",
+                        c["flip"].as_f64().unwrap_or(f64::NAN),
+                        c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
+                    )
+                },
+            );
+            md.push('\n');
+        }
     }
     if md.is_empty() {
         return Err("no cell has a `flip` (a bench run before the reference)".into());

@@ -16,6 +16,7 @@ pub mod lod;
 pub mod payload;
 pub mod probe;
 pub mod raster;
+pub mod reference;
 pub mod shade;
 pub mod strand;
 pub mod upload;

@@ -390,4 +390,4 @@ impl CpuKernel for RasterKernel {
 
 #[cfg(test)]
 #[path = "raster_tests.rs"]
-mod tests;
+pub(crate) mod tests;

@@ -14,7 +14,7 @@ use strandgraph_graph::Quantities;
 const W: u32 = 96;
 const H: u32 = 64;
 
-fn frame() -> FrameData {
+pub(crate) fn frame() -> FrameData {
     let view = glam::Mat4::look_at_rh(
         glam::Vec3::new(0.0, -0.15, 0.6),
         glam::Vec3::new(0.0, -0.15, 0.0),
@@ -33,7 +33,7 @@ fn frame() -> FrameData {
 }
 
 /// Two curly bundles of 4 layers hanging down from y = 0.
-fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
+pub(crate) fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
     let mut bundles = Vec::new();
     let mut layers = Vec::new();
     for b in 0..2u32 {

@@ -44,6 +44,7 @@ use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, LightData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
+use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
 pub const SHADE_GROUP: u32 = 64;
@@ -126,7 +127,29 @@ crate::gpu_block! {
         dom_layer_thickness: f32,
         model_index: u32,
         probe_specular: u32,
-        _pad2: u32,
+        /// `lipp.reference_shade` only: point slots to shade (the mesh
+        /// strands × [`super::reference::SLOTS`]); 0 here.
+        slots: u32,
+    }
+}
+
+/// The shading parameters as both shading passes' shaders read them.
+pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
+    ShadeGpu {
+        multiple_scattering: flag(p.multiple_scattering),
+        probe_lighting: flag(p.probe_lighting),
+        specular: p.specular,
+        width: q.width,
+        height: q.height,
+        lights: count(q.lights),
+        dom_shadows: flag(p.dom_shadows),
+        lod_depth_correction: flag(p.lod_depth_correction),
+        dom_resolution: p.dom_resolution,
+        dom_layers: p.dom_layers,
+        dom_layer_thickness: p.dom_layer_thickness,
+        model_index: p.model_index,
+        probe_specular: flag(p.probe_specular),
+        slots,
     }
 }
 
@@ -153,22 +176,7 @@ pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
     },
     shader: Shader::compute("lipp/shade.wgsl", "shade"),
     kernel: |p| Box::new(ShadeKernel(*p)),
-    gpu: |p, q| ShadeGpu {
-        multiple_scattering: flag(p.multiple_scattering),
-        probe_lighting: flag(p.probe_lighting),
-        specular: p.specular,
-        width: q.width,
-        height: q.height,
-        lights: count(q.lights),
-        dom_shadows: flag(p.dom_shadows),
-        lod_depth_correction: flag(p.lod_depth_correction),
-        dom_resolution: p.dom_resolution,
-        dom_layers: p.dom_layers,
-        dom_layer_thickness: p.dom_layer_thickness,
-        model_index: p.model_index,
-        probe_specular: flag(p.probe_specular),
-        _pad2: 0,
-    },
+    gpu: |p, q| shade_gpu(p, q, 0),
     raster: None,
 };
 
@@ -204,6 +212,38 @@ pub struct Inputs<'a> {
     pub params: &'a ShadeParams,
     /// The deep opacity maps and their light views (one per mapped light).
     pub dom: Option<Dom<'a>>,
+}
+
+impl<'a> Inputs<'a> {
+    /// What the shading passes' bindings hold (`lipp.shade`'s, which
+    /// `lipp.reference_shade` shares), looking the maps up `delta` layers
+    /// nearer the light (Lipp Eq. 8).
+    pub fn load(
+        ctx: &Ctx<'a>,
+        f: &'a FrameData,
+        model: &'a ModelData,
+        lights: &'a [LightData],
+        params: &'a ShadeParams,
+        delta: f32,
+    ) -> Self {
+        Inputs {
+            f,
+            model,
+            lights,
+            sh: load_sh(&ctx.words("env.sh")),
+            prefiltered: ctx.words("env.prefiltered"),
+            params,
+            dom: params.dom_shadows.then(|| {
+                let depth = ctx.words("dom_depth");
+                Dom {
+                    frames: light_frames(ctx, Some((params.dom_resolution, depth.len()))),
+                    depth,
+                    layers: ctx.words("dom_layers"),
+                    delta,
+                }
+            }),
+        }
+    }
 }
 
 /// Deep opacity maps as `lipp.shade` reads them.
@@ -260,21 +300,46 @@ impl Dom<'_> {
 /// Radiance towards the camera of one G-buffer sample at pixel (x, y).
 pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
     let pos = world_position(inp.f, x, y, s.depth);
+    let q = |x: f32| (x * 63.0 + 0.5).floor() as u32;
+    let point = Point {
+        pos,
+        tangent: s.tangent,
+        strand: [q(s.uvw[0]), q(s.uvw[1])],
+        ao: s.ao,
+    };
+    shade_point(inp, inp.model, &point)
+}
+
+/// A point of a strand as the shading sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point {
+    pub pos: [f32; 3],
+    pub tangent: [f32; 3],
+    /// The strand's (u, v) in 1/63 steps: its colour variation (the
+    /// G-buffer keeps 6 bits of each).
+    pub strand: [u32; 2],
+    pub ao: f32,
+}
+
+/// Radiance towards the camera from `p` on a strand of `model`: Chiang's
+/// lobes and Kajiya-Kay multiple scattering per light, shadowed by the
+/// deep opacity maps, then the probe's diffuse and specular times AO.
+pub fn shade_point(inp: &Inputs<'_>, model: &ModelData, p: &Point) -> [f32; 3] {
+    let pos = p.pos;
     let cam = [
         inp.f.camera_pos[0],
         inp.f.camera_pos[1],
         inp.f.camera_pos[2],
     ];
     let v = normalize(sub(cam, pos));
-    let t = s.tangent;
+    let t = p.tangent;
     // Per-strand variation from (u, v) (Lipp: shading parameters from uvw).
-    let q = |x: f32| (x * 63.0 + 0.5).floor() as u32;
-    let vary = 0.85 + 0.3 * unit(pcg(q(s.uvw[0]) | (q(s.uvw[1]) << 6)));
-    let c = inp.model.color;
+    let vary = 0.85 + 0.3 * unit(pcg(p.strand[0] | (p.strand[1] << 6)));
+    let c = model.color;
     let m = Material {
         color: [c[0] * vary, c[1] * vary, c[2] * vary].map(|x| x.clamp(0.0, 1.0)),
         roughness: c[3],
-        alpha: inp.model.highlight_shift,
+        alpha: model.highlight_shift,
     };
     let mut out = [0.0f32; 3];
     for (li, light) in inp.lights.iter().enumerate() {
@@ -316,7 +381,7 @@ pub fn shade_sample(inp: &Inputs<'_>, s: &Sample, x: u32, y: u32) -> [f32; 3] {
         };
         for k in 0..3 {
             let diffuse = e[k].max(0.0) / PI * m.color[k];
-            out[k] += (diffuse + spec[k] * inp.params.specular) * s.ao;
+            out[k] += (diffuse + spec[k] * inp.params.specular) * p.ao;
         }
     }
     out
@@ -340,28 +405,13 @@ impl CpuKernel for ShadeKernel {
         let model: ModelData = read(&ctx.words("models"), self.0.model_index as usize);
         let lw = ctx.words("lights");
         let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
-        let inp = Inputs {
-            f: &f,
-            model: &model,
-            lights: &lights,
-            sh: load_sh(&ctx.words("env.sh")),
-            prefiltered: ctx.words("env.prefiltered"),
-            params: &self.0,
-            dom: self.0.dom_shadows.then(|| {
-                let depth = ctx.words("dom_depth");
-                let args = ctx.words("raster_args");
-                Dom {
-                    frames: light_frames(ctx, Some((self.0.dom_resolution, depth.len()))),
-                    depth,
-                    layers: ctx.words("dom_layers"),
-                    delta: if self.0.lod_depth_correction {
-                        depth_correction(args.load(3), args.load(4))
-                    } else {
-                        0.0
-                    },
-                }
-            }),
+        let args = ctx.words("raster_args");
+        let delta = if self.0.lod_depth_correction {
+            depth_correction(args.load(3), args.load(4))
+        } else {
+            0.0
         };
+        let inp = Inputs::load(ctx, &f, &model, &lights, &self.0, delta);
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let layers = super::gbuffer_layers(&g, &out, pixels);
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {

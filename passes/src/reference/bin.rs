@@ -12,12 +12,13 @@
 //! order within a list is the GPU's arrival order, which the resolve does
 //! not depend on (it orders by depth, then segment).
 
-use super::ribbon::{Record, Ribbon};
+use super::ribbon::{RECORD_WORDS, Record, Ribbon};
 use super::{TILE, segment_ribbon, tiles};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::kulikov::Scene;
+use crate::lipp::MAX_CONTROL_POINTS;
 use crate::params::NoParams;
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
@@ -145,28 +146,75 @@ impl CpuKernel for CountKernel {
     }
 }
 
+/// `fill` of record `id`: into the list of every tile it reaches.
+fn fill_record(ctx: &Ctx<'_>, id: u32) {
+    let q = ctx.quantities;
+    let (records, offsets, cursor, list) = (
+        ctx.words("reference_ribbons"),
+        ctx.words("reference_offsets"),
+        ctx.words("reference_cursor"),
+        ctx.words("reference_segments"),
+    );
+    let Some(record) = Record::load(&records, id as usize) else {
+        return;
+    };
+    for t in reached_tiles(&record.ribbon, q.width, q.height) {
+        let taken = cursor.fetch_add(t as usize, 1);
+        let slot = offsets.load(t as usize).wrapping_add(taken) as usize;
+        // Past the capacity the list is cut; check_lists reports it.
+        if slot < list.len() {
+            list.store(slot, id);
+        }
+    }
+}
+
 struct FillKernel;
 
 impl CpuKernel for FillKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let q = ctx.quantities;
-        let (records, offsets, cursor, list) = (
-            ctx.words("reference_ribbons"),
-            ctx.words("reference_offsets"),
-            ctx.words("reference_cursor"),
-            ctx.words("reference_segments"),
-        );
-        for id in lanes(group, q) {
-            let Some(record) = Record::load(&records, id as usize) else {
-                continue;
-            };
-            for t in reached_tiles(&record.ribbon, q.width, q.height) {
-                let taken = cursor.fetch_add(t as usize, 1);
-                let slot = offsets.load(t as usize).wrapping_add(taken) as usize;
-                // Past the capacity the list is cut; check_lists reports it.
-                if slot < list.len() {
-                    list.store(slot, id);
-                }
+        for id in lanes(group, ctx.quantities) {
+            fill_record(ctx, id);
+        }
+    }
+}
+
+/// Record slots per strand in `fill_strands` (Lipp's strands: at most
+/// [`MAX_CONTROL_POINTS`] points, one slot per point, the last unused).
+pub const STRAND_SLOTS: u32 = MAX_CONTROL_POINTS;
+
+/// Strands per `fill_strands` workgroup (a lane each).
+pub const STRAND_GROUP: u32 = 64;
+
+pub static FILL_STRANDS: PassKind<NoParams, BinGpu> = PassKind {
+    kind: "reference.fill_strands",
+    summary: "per strand, write each of its segments into the list of every tile it was counted in",
+    source: "ours: the ground-truth reference (docs/reference.md)",
+    bindings: FILL.bindings,
+    workgroup_size: STRAND_GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::MeshStrands,
+        per_group: STRAND_GROUP,
+    },
+    shader: Shader::compute("reference/fill.wgsl", "fill_strands"),
+    kernel: |_| Box::new(FillStrandsKernel),
+    gpu: |_, q| BinGpu {
+        segments: count(q.mesh_strands),
+        ..bin_gpu(q)
+    },
+    raster: None,
+};
+
+struct FillStrandsKernel;
+
+impl CpuKernel for FillStrandsKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let strands = ctx.quantities.mesh_strands;
+        let records = ctx.words("reference_ribbons").len() / RECORD_WORDS;
+        let first = group * STRAND_GROUP;
+        for s in (first..first + STRAND_GROUP).take_while(|&s| u64::from(s) < strands) {
+            let base = s * STRAND_SLOTS;
+            for id in base..(base + STRAND_SLOTS - 1).min(records as u32) {
+                fill_record(ctx, id);
             }
         }
     }
