@@ -3,7 +3,8 @@
 //! Chromium. The page checks itself (every <img> decoded, every chart's
 //! SVG present, no script error) into `<body data-report-check>`, which
 //! `--dump-dom` prints. Then the same page regenerated with `--from` into
-//! another directory, as the H100 report is made.
+//! another directory, as the H100 report is made, and once more cut to a
+//! 64x48 crop as JPEG, as the committed report is.
 //!
 //! Chromium is required: the test fails, not skips, without it
 //! (scripts/test.sh installs Debian's `chromium`).
@@ -92,8 +93,8 @@ fn body_attr<'a>(dom: &'a str, attr: &str) -> Option<&'a str> {
 }
 
 /// The page loads in Chromium with every picture and chart and no
-/// console error.
-fn check_page(index: &Path, json: &serde_json::Value) {
+/// console error; its DOM.
+fn check_page(index: &Path, json: &serde_json::Value) -> String {
     let (dom, log) = open_in_chromium(index);
     let check = body_attr(&dom, "data-report-check");
     assert_eq!(
@@ -128,6 +129,90 @@ fn check_page(index: &Path, json: &serde_json::Value) {
         .iter()
         .any(|c| c["flip"].is_null());
     assert_eq!(dom.contains("no reference"), unreferenced);
+    dom
+}
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Every picture path that `json` names.
+fn pictures(json: &serde_json::Value) -> Vec<&str> {
+    let mut out: Vec<&str> = json["cells"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|c| ["picture", "flip_map", "reference_picture"].map(|k| c[k].as_str()))
+        .flatten()
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// Every file under `dir`, relative, with `/`.
+fn files_under(dir: &Path, root: &Path, out: &mut Vec<String>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let path = e.unwrap().path();
+        if path.is_dir() {
+            files_under(&path, root, out);
+        } else {
+            let rel = path.strip_prefix(root).unwrap();
+            out.push(rel.to_string_lossy().replace('\\', "/"));
+        }
+    }
+}
+
+/// stderr as words (miette wraps its lines and draws a margin).
+fn words(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr)
+        .replace('│', " ")
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `report --from` of `json` into `out` with `extra` flags.
+fn report_from(json: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut cmd = strandgraph();
+    cmd.args(["report", "--from"])
+        .arg(json)
+        .arg("-o")
+        .arg(out)
+        .args(extra);
+    run_for(cmd, Duration::from_secs(60))
+}
+
+/// The run cut to 64x48 at the frame's centre, as JPEG: the page passes
+/// the same check, says what the crop is, and holds only 64x48 JPEGs.
+fn check_cropped(run: &Path) {
+    let small = scratch("report-small");
+    let out = report_from(
+        &run.join("bench.json"),
+        &small,
+        &["--crop", "64x48", "--jpeg", "80"],
+    );
+    assert!(out.status.success(), "{}", words(&out));
+    let json = read_json(&small.join("bench.json"));
+    let dom = check_page(&small.join("index.html"), &json);
+    let note = "1:1 crop 64x48 at (48, 21) of the 160x90 frame; FLIP and coverage error are over the whole frame";
+    assert!(dom.contains(note), "no crop note in the page");
+    let named = pictures(&json);
+    for rel in &named {
+        let bytes = std::fs::read(small.join(rel)).unwrap();
+        assert!(
+            rel.ends_with(".jpg") && bytes.starts_with(&[0xFF, 0xD8, 0xFF]),
+            "{rel}"
+        );
+        let size = image::load_from_memory_with_format(&bytes, image::ImageFormat::Jpeg)
+            .map(|i| (i.width(), i.height()));
+        assert_eq!(size.ok(), Some((64, 48)), "{rel}");
+    }
+    let mut files = Vec::new();
+    files_under(&small.join("pictures"), &small, &mut files);
+    files.sort();
+    assert_eq!(files, named, "only the page's pictures are copied");
+    let _ = std::fs::remove_dir_all(&small);
 }
 
 /// The pictures the page should hold, counted from bench.json: per view
@@ -175,8 +260,7 @@ fn report_renders_and_loads_in_chromium() {
         "report: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("bench.json")).unwrap()).unwrap();
+    let json = read_json(&dir.join("bench.json"));
     for cell in json["cells"].as_array().unwrap() {
         let pic = cell["picture"].as_str().expect("every cell has a picture");
         assert!(dir.join(pic).is_file(), "{pic}");
@@ -197,14 +281,10 @@ fn report_renders_and_loads_in_chromium() {
     // The page again from the run's bench.json, elsewhere: the pictures
     // come along.
     let again = scratch("report-again");
-    let mut cmd = strandgraph();
-    cmd.args(["report", "--from"])
-        .arg(dir.join("bench.json"))
-        .arg("-o")
-        .arg(&again);
-    let out = run_for(cmd, Duration::from_secs(60));
+    let out = report_from(&dir.join("bench.json"), &again, &[]);
     assert!(out.status.success(), "{out:?}");
     check_page(&again.join("index.html"), &json);
+    check_cropped(&dir);
     eprintln!("report test took {:.0} s", t0.elapsed().as_secs_f64());
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&again);
@@ -220,18 +300,8 @@ fn from_a_bench_without_pictures_says_so() {
         "frame":{"median_ms":1.0,"min_ms":1.0,"max_ms":1.0},"passes":[]}"#;
     let text = format!(r#"{{"size":"160x90","frames":1,"warmup":0,"cells":[{cell}]}}"#);
     std::fs::write(&json, text).unwrap();
-    let mut cmd = strandgraph();
-    cmd.args(["report", "--from"])
-        .arg(&json)
-        .arg("-o")
-        .arg(&dir);
-    let out = run_for(cmd, Duration::from_secs(60));
-    // miette wraps its lines and draws a margin: compare the words.
-    let err: String = String::from_utf8_lossy(&out.stderr)
-        .replace('│', " ")
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ");
+    let out = report_from(&json, &dir, &[]);
+    let err = words(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains("bench.json") && err.contains("without --pictures"),
@@ -239,4 +309,40 @@ fn from_a_bench_without_pictures_says_so() {
     );
     assert!(!dir.join("index.html").exists());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A crop must lie inside the pictures: one larger is refused, naming the
+/// picture and its size. And a picture the page does not show (a skipped
+/// cell's) is not copied.
+#[test]
+fn a_crop_larger_than_the_pictures_is_refused() {
+    let dir = scratch("report-bigcrop");
+    std::fs::create_dir_all(dir.join("pictures")).unwrap();
+    for name in ["a.png", "unshown.png"] {
+        image::RgbaImage::new(16, 8)
+            .save(dir.join("pictures").join(name))
+            .unwrap();
+    }
+    let shown = r#"{"backend":"cpu","pipeline":"Kulikov","variant":"all optimisations","view":"far",
+        "frame":{"median_ms":1.0,"min_ms":1.0,"max_ms":1.0},"passes":[],"picture":"pictures/a.png"}"#;
+    let skipped = r#"{"backend":"cpu","pipeline":"Kulikov","variant":"no sort","view":"far",
+        "skipped":"x","picture":"pictures/unshown.png"}"#;
+    let text = format!(r#"{{"size":"16x8","frames":1,"warmup":0,"cells":[{shown},{skipped}]}}"#);
+    let json = dir.join("bench.json");
+    std::fs::write(&json, text).unwrap();
+    let other = scratch("report-bigcrop-out");
+    let out = report_from(&json, &other, &["--crop", "32x8"]);
+    let err = words(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("pictures/a.png is 16x8"), "{err}");
+    assert!(!other.join("index.html").exists());
+    let out = report_from(&json, &other, &["--crop", "far=16x4+0+4"]);
+    assert!(out.status.success(), "{}", words(&out));
+    assert_eq!(
+        image::image_dimensions(other.join("pictures/a.png")).unwrap(),
+        (16, 4)
+    );
+    assert!(!other.join("pictures/unshown.png").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&other);
 }

@@ -3,7 +3,7 @@
 //! and backend, with the checks that the pictures it names are there.
 
 use miette::{IntoDiagnostic, Result, WrapErr, miette};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Component, Path};
 
 #[derive(Debug, Deserialize)]
@@ -17,6 +17,24 @@ pub struct Bench {
     #[serde(default)]
     pub notes: Vec<String>,
     pub elapsed_s: Option<f64>,
+    /// Written by `report --crop`: the views whose pictures are crops.
+    #[serde(default)]
+    pub crops: Vec<CropNote>,
+    /// Written by `report --jpeg`: the pictures' JPEG quality.
+    pub jpeg_quality: Option<u8>,
+}
+
+/// A view whose pictures are the `width`x`height` rectangle at (`x`, `y`)
+/// of the bench's frames, which were `frame_width`x`frame_height`.
+#[derive(Debug, Clone, PartialEq, Eq, Deserialize, Serialize)]
+pub struct CropNote {
+    pub view: String,
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+    pub frame_width: u32,
+    pub frame_height: u32,
 }
 
 #[derive(Debug, Deserialize)]
@@ -76,11 +94,31 @@ impl Cell {
     pub fn ms(&self) -> Option<f64> {
         self.frame.as_ref().and_then(|f| f.median_ms)
     }
-    /// The picture files this cell names.
-    pub fn files(&self) -> impl Iterator<Item = &str> {
-        [&self.picture, &self.flip_map, &self.reference_picture]
-            .into_iter()
-            .filter_map(|p| p.as_deref())
+    /// The picture files of this cell that the page shows: a measured
+    /// cell's picture, its reference, and its FLIP map where it has both.
+    pub fn shown(&self) -> Vec<&str> {
+        if !self.measured() {
+            return Vec::new();
+        }
+        let map = self
+            .flip_map
+            .as_deref()
+            .filter(|_| self.reference_picture.is_some());
+        [
+            self.picture.as_deref(),
+            map,
+            self.reference_picture.as_deref(),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+    /// The FLIP map the page shows with the cell's reference.
+    pub fn map_and_reference(&self) -> Option<(&str, &str)> {
+        Some((
+            self.flip_map.as_deref()?,
+            self.reference_picture.as_deref()?,
+        ))
     }
 }
 
@@ -91,6 +129,8 @@ pub struct Section<'a> {
     pub backend: &'a str,
     pub device: Option<&'a Device>,
     pub cells: Vec<&'a Cell>,
+    /// Where the view's pictures are a crop of the frame.
+    pub crop: Option<&'a CropNote>,
 }
 
 impl Section<'_> {
@@ -106,7 +146,7 @@ impl Section<'_> {
     /// Each reference picture once, with its pipeline, in row order.
     pub fn references(&self) -> Vec<(&str, &str)> {
         let mut out: Vec<(&str, &str)> = Vec::new();
-        for c in &self.cells {
+        for c in self.cells.iter().filter(|c| c.measured()) {
             if let Some(r) = c.reference_picture.as_deref()
                 && !out.iter().any(|(_, x)| *x == r)
             {
@@ -130,17 +170,26 @@ pub fn load(path: &Path) -> Result<Bench> {
     })
 }
 
+/// The views of `b`'s cells, in the order they first appear.
+pub fn views(b: &Bench) -> Vec<&str> {
+    let mut views: Vec<&str> = Vec::new();
+    for c in &b.cells {
+        if !views.contains(&c.view.as_str()) {
+            views.push(c.view.as_str());
+        }
+    }
+    views
+}
+
 /// Views in the order they first appear, each with the backends in the
 /// order of `devices` (then of first appearance).
 pub fn sections(b: &Bench) -> Vec<Section<'_>> {
-    let (mut keys, mut views): (Vec<(&str, &str)>, Vec<&str>) = (Vec::new(), Vec::new());
+    let views = views(b);
+    let mut keys: Vec<(&str, &str)> = Vec::new();
     for c in &b.cells {
         let key = (c.view.as_str(), c.backend.as_str());
         if !keys.contains(&key) {
             keys.push(key);
-        }
-        if !views.contains(&key.0) {
-            views.push(key.0);
         }
     }
     // A backend without a device line (it never opened) goes last.
@@ -165,6 +214,7 @@ pub fn sections(b: &Bench) -> Vec<Section<'_>> {
                 backend,
                 device: b.devices.iter().find(|d| d.backend == backend),
                 cells,
+                crop: b.crops.iter().find(|c| c.view == view),
             }
         })
         .collect()
@@ -207,7 +257,7 @@ pub fn check_pictures(b: &Bench, json: &Path) -> Result<()> {
         ));
     }
     for c in &measured {
-        for rel in c.files() {
+        for rel in c.shown() {
             check_relative(json, rel)?;
             if !dir.join(rel).is_file() {
                 return Err(miette!(

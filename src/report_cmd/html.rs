@@ -2,7 +2,7 @@
 //! SVG; pictures by relative path) that opens from disk with no server.
 
 use super::charts::{self, Bar, Point};
-use super::data::{Bench, Cell, Section, frontier, sections};
+use super::data::{Bench, Cell, CropNote, Section, frontier, sections};
 use miette::Result;
 use std::fmt::Write as _;
 
@@ -81,9 +81,15 @@ fn header(b: &Bench, secs: &[Section<'_>], source: &str) -> String {
     let mut o = String::from(
         "<header class=\"top\"><h1>strandgraph report <span>time against quality</span></h1>",
     );
-    let took = b
+    let mut took = b
         .elapsed_s
         .map_or(String::new(), |t| format!(" · bench took {t:.0} s"));
+    if let Some(q) = b.jpeg_quality {
+        let _ = write!(
+            took,
+            " · pictures as JPEG of quality {q} (FLIP is of the lossless frames)"
+        );
+    }
     let _ = write!(
         o,
         "<p class=\"meta\">{} · {} timed frame{} after {} warm-up{took} · from <a href=\"{src}\">{src}</a></p>",
@@ -194,21 +200,36 @@ fn section(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
 /// The large picture: the first row with a reference, else the first
 /// measured row; the script swaps what it shows.
 fn viewer(s: &Section<'_>, counts: &mut Counts) -> String {
+    let shown = |c: &Cell| c.measured() && c.picture.is_some();
     let first = s
         .cells
         .iter()
-        .position(|c| c.reference_picture.is_some())
-        .or_else(|| s.cells.iter().position(|c| c.picture.is_some()));
+        .position(|c| shown(c) && c.reference_picture.is_some())
+        .or_else(|| s.cells.iter().position(|c| shown(c)));
     let Some(i) = first else {
         return "<p class=\"nochart\">Every row was skipped here.</p>".into();
     };
     let pic = esc(s.cells[i].picture.as_deref().unwrap_or_default());
     counts.images += 1;
+    let (class, link) = match s.crop {
+        Some(_) => (" crop", "open"),
+        None => ("", "full size"),
+    };
     format!(
-        "<div class=\"viewer\" data-row=\"{i}\"><div class=\"frame\" title=\"click to flip between the row and its reference\">\
+        "<div class=\"viewer{class}\" data-row=\"{i}\"><div class=\"frame\" title=\"click to flip between the row and its reference\">\
          <img class=\"big\" src=\"{pic}\" alt=\"selected picture\"></div><div class=\"bar\"><span class=\"what\"></span>\
          <button data-mode=\"row\">row</button><button data-mode=\"ref\">reference</button>\
-         <button data-mode=\"map\">FLIP map</button><a class=\"full\" href=\"{pic}\">full size</a></div></div>"
+         <button data-mode=\"map\">FLIP map</button><a class=\"full\" href=\"{pic}\">{link}</a></div></div>{}",
+        s.crop.map_or(String::new(), crop_note)
+    )
+}
+
+/// What a cropped view's pictures are, said next to its viewer.
+fn crop_note(c: &CropNote) -> String {
+    format!(
+        "<p class=\"crop-note\">1:1 crop {}x{} at ({}, {}) of the {}x{} frame; \
+         FLIP and coverage error are over the whole frame.</p>",
+        c.width, c.height, c.x, c.y, c.frame_width, c.frame_height
     )
 }
 
@@ -329,7 +350,9 @@ fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
         );
     }
     for (i, c) in s.cells.iter().enumerate() {
-        let Some(pic) = &c.picture else { continue };
+        let Some(pic) = c.picture.as_ref().filter(|_| c.measured()) else {
+            continue;
+        };
         counts.images += 1;
         let label = esc(&c.label());
         let mut attrs = format!(
@@ -337,7 +360,7 @@ fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
             esc(pic)
         );
         let mut map = String::new();
-        if let (Some(m), Some(r)) = (&c.flip_map, &c.reference_picture) {
+        if let Some((m, r)) = c.map_and_reference() {
             counts.images += 1;
             let _ = write!(attrs, " data-map=\"{}\" data-ref=\"{}\"", esc(m), esc(r));
             map = format!(

@@ -6,21 +6,26 @@
 //! rows' passes as stacked bars.
 //!
 //! `--from` is how a remote GPU's run becomes a page: the bench runs there,
-//! its directory comes back, and the page is drawn here.
+//! its directory comes back, and the page is drawn here. Into another
+//! directory, the pictures the page shows are copied, cut by `--crop` and
+//! re-encoded by `--jpeg` on the way (a report small enough to commit).
 
 mod charts;
+mod crop;
 mod data;
+mod export;
 mod html;
 
 use crate::bench_cmd::{self, Choice};
-use miette::{IntoDiagnostic, Result, WrapErr};
+use miette::{IntoDiagnostic, Result, WrapErr, miette};
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 #[command(after_help = "Examples:
   strandgraph report scenes/distances/*.ron --backend ash -o report/
   strandgraph report scenes/distances/far.ron --quick --row Kulikov -o report/
-  strandgraph report --from h100/bench.json -o h100/   (a `bench --out h100/ --pictures` run)")]
+  strandgraph report --from h100/bench.json -o h100/   (a `bench --out h100/ --pictures` run)
+  strandgraph report --from h100/bench.json -o docs/report/ --crop 960x540 --crop far=480x270 --jpeg 85")]
 pub struct Args {
     /// Scenes to bench, one section each per backend (default: bench's,
     /// scenes/distances/{close,mid,far}.ron then the showcase and the crowd).
@@ -58,10 +63,17 @@ pub struct Args {
     /// The directory for bench.json, pictures/ and index.html.
     #[arg(short = 'o', long = "out")]
     pub out: PathBuf,
+    /// Cut every picture to this 1:1 rectangle, WxH[+X+Y] (default: centred),
+    /// or VIEW=WxH[+X+Y] for one view (repeatable). FLIP stays the whole frame's.
+    #[arg(long, value_name = "[VIEW=]WxH[+X+Y]")]
+    pub crop: Vec<crop::CropArg>,
+    /// Write the pictures as JPEG of this quality (1 to 100) instead of PNG.
+    #[arg(long, value_name = "Q", value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub jpeg: Option<u8>,
 }
 
 /// The bench run `report` makes: its own flags, pictures on, into `out`.
-fn bench_args(args: &Args) -> bench_cmd::Args {
+fn bench_args(args: &Args, out: &Path) -> bench_cmd::Args {
     bench_cmd::Args {
         scenes: args.scenes.clone(),
         backend: args.backend.clone(),
@@ -69,7 +81,7 @@ fn bench_args(args: &Args) -> bench_cmd::Args {
         warmup: args.warmup,
         size: args.size.clone(),
         rows: args.rows.clone(),
-        out: Some(args.out.clone()),
+        out: Some(out.to_path_buf()),
         pictures: true,
         quick: args.quick,
         subgroup: 32,
@@ -78,11 +90,21 @@ fn bench_args(args: &Args) -> bench_cmd::Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    let opts = export::Options {
+        crops: crop::Crops::new(&args.crop)?,
+        jpeg: args.jpeg,
+    };
     let json = match &args.from {
         Some(path) => path.clone(),
         None => {
-            bench_cmd::run(bench_args(&args))?;
-            args.out.join("bench.json")
+            // Cut or re-encoded pictures go beside the bench's own.
+            let run = if opts.transforms() {
+                args.out.join("full")
+            } else {
+                args.out.clone()
+            };
+            bench_cmd::run(bench_args(&args, &run))?;
+            run.join("bench.json")
         }
     };
     let bench = data::load(&json)?;
@@ -90,10 +112,9 @@ pub fn run(args: Args) -> Result<()> {
     std::fs::create_dir_all(&args.out)
         .into_diagnostic()
         .wrap_err_with(|| format!("creating {}", args.out.display()))?;
-    let from_dir = json.parent().unwrap_or(Path::new("."));
-    if !same_dir(from_dir, &args.out)? {
-        copy_run(&bench, &json, &args.out)?;
-    }
+    let page_json = copy_if_elsewhere(&bench, &json, &args.out, &opts)?;
+    let bench = data::load(&page_json)?;
+    data::check_pictures(&bench, &page_json)?;
     let page = html::page(&bench, "bench.json")?;
     let index = args.out.join("index.html");
     std::fs::write(&index, page)
@@ -102,6 +123,30 @@ pub fn run(args: Args) -> Result<()> {
     tracing::info!(sections = data::sections(&bench).len(), "report written");
     println!("wrote {}", index.display());
     Ok(())
+}
+
+/// The run copied into `out` unless it is there already; the bench.json
+/// the page is drawn from.
+fn copy_if_elsewhere(
+    bench: &data::Bench,
+    json: &Path,
+    out: &Path,
+    opts: &export::Options,
+) -> Result<PathBuf> {
+    let from_dir = json.parent().unwrap_or(Path::new("."));
+    if !same_dir(from_dir, out)? {
+        export::export(bench, json, out, opts)?;
+        return Ok(out.join("bench.json"));
+    }
+    if opts.transforms() {
+        return Err(miette!(
+            help =
+                "give -o another directory: the cut or re-encoded pictures and bench.json go there",
+            "--crop and --jpeg would replace the run's own pictures in {}",
+            out.display()
+        ));
+    }
+    Ok(json.to_path_buf())
 }
 
 /// Whether `a` and `b` name one directory (`b` exists by now).
@@ -117,30 +162,4 @@ fn same_dir(a: &Path, b: &Path) -> Result<bool> {
             .wrap_err_with(|| format!("resolving {}", p.display()))
     };
     Ok(canon(a)? == canon(b)?)
-}
-
-/// Copies bench.json and every picture it names into `out`, so the page
-/// there links them by the same relative paths.
-fn copy_run(bench: &data::Bench, json: &Path, out: &Path) -> Result<()> {
-    let from = json.parent().unwrap_or(Path::new("."));
-    let copy = |src: PathBuf, dst: PathBuf| -> Result<()> {
-        if let Some(dir) = dst.parent() {
-            std::fs::create_dir_all(dir)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("creating {}", dir.display()))?;
-        }
-        std::fs::copy(&src, &dst)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("copying {} to {}", src.display(), dst.display()))?;
-        Ok(())
-    };
-    copy(json.to_path_buf(), out.join("bench.json"))?;
-    let mut files: Vec<&str> = bench.cells.iter().flat_map(data::Cell::files).collect();
-    files.sort_unstable();
-    files.dedup();
-    for rel in files {
-        copy(from.join(rel), out.join(rel))?;
-    }
-    tracing::info!(from = %from.display(), to = %out.display(), "copied the run's pictures");
-    Ok(())
 }
