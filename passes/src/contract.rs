@@ -47,9 +47,15 @@ pub enum Dispatch {
     PerElement { quantity: Quantity, per_group: u32 },
     /// The count is the u32 of `binding` at word `word`, written by an earlier pass.
     Indirect { binding: &'static str, word: usize },
-    /// One workgroup per `words_per_group` 32-bit words of the largest written binding.
+    /// One workgroup per `words_per_group` 32-bit words of the largest
+    /// written binding, at most [`MAX_COVER_GROUPS`]: past that the
+    /// kernel's workgroups stride over the rest ([`Dispatch::cover_groups`]).
     CoverWrites { words_per_group: u32 },
 }
+
+/// The most workgroups a [`Dispatch::CoverWrites`] launches: the 65,535 per
+/// dimension Vulkan guarantees (and wgpu allows).
+pub const MAX_COVER_GROUPS: u64 = 65_535;
 
 impl Dispatch {
     /// The workgroups of a direct dispatch, the same on every backend;
@@ -65,9 +71,19 @@ impl Dispatch {
             } => Some(q.count(quantity).div_ceil(u64::from(per_group.max(1)))),
             Dispatch::Indirect { .. } => None,
             Dispatch::CoverWrites { words_per_group } => {
-                Some(largest_words.div_ceil(u64::from(words_per_group.max(1))))
+                Some(Self::cover_groups(largest_words, words_per_group))
             }
         }
+    }
+
+    /// The workgroups that cover `words` at `words_per_group` each, capped
+    /// at [`MAX_COVER_GROUPS`]; a kernel dispatched so strides by the
+    /// dispatched count (a 2.7 GB buffer needs 164,022 groups of 4,096
+    /// words).
+    pub fn cover_groups(words: u64, words_per_group: u32) -> u64 {
+        words
+            .div_ceil(u64::from(words_per_group.max(1)))
+            .min(MAX_COVER_GROUPS)
     }
 }
 
@@ -313,6 +329,8 @@ mod tests {
             words_per_group: 256,
         };
         assert_eq!(cover.direct_groups(&q, 257), Some(2));
+        // The crowd reference's records: 671M words, capped; kernels stride.
+        assert_eq!(cover.direct_groups(&q, 671_000_000), Some(MAX_COVER_GROUPS));
         let indirect = Dispatch::Indirect {
             binding: "args",
             word: 0,

@@ -11,11 +11,12 @@ struct CopyParams {
 @group(0) @binding(2) var<storage, read_write> copy_dst: array<vec4<u32>>;
 
 @compute @workgroup_size(256)
-fn copy(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn copy(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // Binding 0 is part of the pass contract even where nothing is read from it.
     _ = params.unused0;
     let n = min(arrayLength(&copy_src), arrayLength(&copy_dst));
-    if gid.x < n {
-        copy_dst[gid.x] = copy_src[gid.x];
+    // Past 65,535 workgroups (Dispatch::CoverWrites) the lanes stride.
+    for (var i = gid.x; i < n; i += groups.x * 256u) {
+        copy_dst[i] = copy_src[i];
     }
 }

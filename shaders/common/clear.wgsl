@@ -9,17 +9,20 @@ struct ClearParams {
 @group(0) @binding(0) var<uniform> params: ClearParams;
 @group(0) @binding(1) var<storage, read_write> target_words: array<u32>;
 
-// clear::WORDS_PER_LANE words per lane, 256 apart, so a workgroup clears
-// 4096 consecutive words and large buffers stay under 65,535 workgroups.
+// clear::WORDS_PER_LANE words per lane a round, 256 apart: a workgroup
+// clears 4096 consecutive words a round, and the workgroups stride over
+// buffers larger than the 65,535 a dispatch launches.
 const WORDS_PER_LANE: u32 = 16u;
+const SPAN: u32 = 4096u;
 
 @compute @workgroup_size(256)
-fn clear(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let base = wg.x * 256u * WORDS_PER_LANE + lane;
-    for (var k = 0u; k < WORDS_PER_LANE; k++) {
-        let i = base + k * 256u;
-        if i < params.words {
-            target_words[i] = params.value;
+fn clear(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    for (var start = wg.x * SPAN; start < params.words; start += groups.x * SPAN) {
+        for (var k = 0u; k < WORDS_PER_LANE; k++) {
+            let i = start + lane + k * 256u;
+            if i < params.words {
+                target_words[i] = params.value;
+            }
         }
     }
 }

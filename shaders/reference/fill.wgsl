@@ -50,9 +50,11 @@ fn fill_strands(@builtin(global_invocation_id) gid: vec3<u32>) {
     if gid.x >= params.segments {
         return;
     }
-    let records = arrayLength(&reference_ribbons) / 3u;
+    // The graph sizes reference_ribbons for every strand's slots. Not
+    // arrayLength: on the H100 (driver 580) it reads 0 records of the
+    // crowd's 2.7 GB binding, past 2 GiB, and nothing was filled.
     let first = gid.x * STRAND_SLOTS;
-    for (var id = first; id < min(first + STRAND_SLOTS - 1u, records); id++) {
+    for (var id = first; id < first + STRAND_SLOTS - 1u; id++) {
         fill_record(id);
     }
 }

@@ -343,7 +343,7 @@ fn launches(
             if let Some(last) = params.last_mut() {
                 *last = u32::try_from(words).map_err(|_| err(format!("{words} words to clear")))?;
             }
-            let groups = check_groups(words.div_ceil(u64::from(words_per_group.max(1))))?;
+            let groups = check_groups(Dispatch::cover_groups(words, words_per_group))?;
             launches.push(Launch::Direct(groups));
             sets.push(SetPlan {
                 built: index,

@@ -251,7 +251,7 @@ fn build_clear(
             *last =
                 u32::try_from(words).map_err(|_| cx.error(format!("{words} words to clear")))?;
         }
-        let groups = cx.workgroups(words.div_ceil(u64::from(words_per_group.max(1))))?;
+        let groups = cx.workgroups(Dispatch::cover_groups(words, words_per_group))?;
         let params = cx.uniform(&params);
         let bind_group = cx.bind_group(layout, &cx.entries(&params, &[b])?);
         dispatches.push((bind_group, Launch::Direct(groups)));

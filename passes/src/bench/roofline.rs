@@ -201,9 +201,12 @@ impl CpuKernel for CopyKernel {
         let per_group = (GROUP * COPY_WORDS) as usize;
         // Whole vec4s only, as the shader copies array<vec4<u32>>.
         let end = src.len().min(dst.len()) / 4 * 4;
-        let start = (group as usize * per_group).min(end);
-        for i in start..(start + per_group).min(end) {
-            dst.store(i, src.load(i));
+        // Past 65,535 workgroups (Dispatch::CoverWrites) the groups stride.
+        let stride = per_group * ctx.workgroups.max(1) as usize;
+        for start in (group as usize * per_group..end).step_by(stride) {
+            for i in start..(start + per_group).min(end) {
+                dst.store(i, src.load(i));
+            }
         }
     }
 }

@@ -10,10 +10,10 @@ use crate::kernel::Ctx;
 use crate::params::PassParams;
 
 const GROUP: u32 = 256;
-/// Words each lane clears, `GROUP` apart (coalesced). A 1080p 8-sample
-/// G-buffer is 33M words: one word per lane would need 129,600 workgroups,
-/// past the 65,535 per dimension Vulkan guarantees; 16 per lane allow
-/// buffers up to 1 GiB in one dimension.
+/// Words each lane clears per round, `GROUP` apart (coalesced): a
+/// workgroup clears 4,096 consecutive words a round, and the dispatch's
+/// workgroups stride over larger buffers (the reference's records reach
+/// 2.7 GB on the crowd; `Dispatch::CoverWrites` launches at most 65,535).
 pub const WORDS_PER_LANE: u32 = 16;
 
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
@@ -58,11 +58,34 @@ struct ClearKernel {
 impl CpuKernel for ClearKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let span = (GROUP * WORDS_PER_LANE) as usize;
-        let start = group as usize * span;
+        let stride = span * ctx.workgroups.max(1) as usize;
         for words in ctx.bindings.values() {
-            for i in start..(start + span).min(words.len()) {
-                words.store(i, self.value);
+            for start in (group as usize * span..words.len()).step_by(stride) {
+                for i in start..(start + span).min(words.len()) {
+                    words.store(i, self.value);
+                }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contract::PassDef;
+    use crate::kernel::harness::Harness;
+    use strandgraph_graph::Quantities;
+
+    /// Fewer workgroups than the buffer's spans (as past the dispatch cap):
+    /// the groups stride, and every word is written.
+    #[test]
+    fn workgroups_stride_over_buffers_larger_than_the_dispatch() {
+        let mut h = Harness::new(Quantities::default());
+        h.buffer("big", vec![0; 3 * 4096 + 17]);
+        let k = CLEAR
+            .cpu_kernel(&ron::from_str("{\"value\": 7}").unwrap())
+            .unwrap();
+        h.run(k.as_ref(), 2, GROUP);
+        assert!(h.read("big").iter().all(|&w| w == 7));
     }
 }
