@@ -117,11 +117,13 @@ fn check_page(index: &Path, json: &serde_json::Value) -> String {
         .parse()
         .unwrap();
     // Two sections (cpu, wgpu), each with a Pareto chart (Kulikov has a
-    // reference) and per-pass bars.
+    // reference) and per-pass bars for each of its two pipelines.
+    let (pareto, passes) = expected_charts(json);
     assert_eq!(images, expected_images(json), "{}", index.display());
-    assert_eq!(charts, 2 * 2, "{}", index.display());
-    assert_eq!(dom.matches("data-chart=\"pareto\"").count(), 2);
-    assert_eq!(dom.matches("data-chart=\"passes\"").count(), 2);
+    assert_eq!((pareto, passes), (2, 2 * 2), "{}", index.display());
+    assert_eq!(charts, pareto + passes, "{}", index.display());
+    assert_eq!(dom.matches("data-chart=\"pareto\"").count(), pareto);
+    assert_eq!(dom.matches("data-chart=\"passes\"").count(), passes);
     // A row without a reference shows its time and no FLIP.
     let unreferenced = json["cells"]
         .as_array()
@@ -215,27 +217,56 @@ fn check_cropped(run: &Path) {
     let _ = std::fs::remove_dir_all(&small);
 }
 
+/// The cells' sections, as (view, backend), in order of appearance.
+fn section_of(c: &serde_json::Value) -> (&str, &str) {
+    (c["view"].as_str().unwrap(), c["backend"].as_str().unwrap())
+}
+
 /// The pictures the page should hold, counted from bench.json: per view
-/// and backend the viewer, each reference once, and every cell's picture
-/// and FLIP map.
+/// and backend the viewer, each reference once (pipelines sharing a
+/// reference graph share its picture), and every cell's picture and FLIP
+/// map.
 fn expected_images(json: &serde_json::Value) -> usize {
     let cells = json["cells"].as_array().unwrap();
     let mut sections: Vec<(&str, &str)> = Vec::new();
-    let mut references: Vec<(&str, &str, &str)> = Vec::new();
+    let mut references: Vec<((&str, &str), &str)> = Vec::new();
     let mut n = 0;
     for c in cells {
-        let (view, backend) = (c["view"].as_str().unwrap(), c["backend"].as_str().unwrap());
-        if !sections.contains(&(view, backend)) {
-            sections.push((view, backend));
+        let section = section_of(c);
+        if !sections.contains(&section) {
+            sections.push(section);
         }
-        if let Some(r) = c["reference_picture"].as_str()
-            && !references.contains(&(view, backend, r))
-        {
-            references.push((view, backend, r));
+        if let Some(r) = c["reference_picture"].as_str() {
+            let key = c["flip_reference"].as_str().unwrap_or(r);
+            if !references.contains(&(section, key)) {
+                references.push((section, key));
+            }
         }
         n += usize::from(c["picture"].is_string()) + usize::from(c["flip_map"].is_string());
     }
     n + sections.len() + references.len()
+}
+
+/// The charts the page should hold, counted from bench.json: per view and
+/// backend a time-versus-FLIP chart where a row has a FLIP, and per-pass
+/// bars for each pipeline whose measured rows have passes.
+fn expected_charts(json: &serde_json::Value) -> (usize, usize) {
+    let cells = json["cells"].as_array().unwrap();
+    let measured = |c: &&serde_json::Value| c["skipped"].is_null();
+    let mut pareto: Vec<(&str, &str)> = Vec::new();
+    let mut passes: Vec<((&str, &str), &str)> = Vec::new();
+    for c in cells.iter().filter(measured) {
+        let section = section_of(c);
+        if c["flip"].is_number() && !pareto.contains(&section) {
+            pareto.push(section);
+        }
+        let pipeline = (section, c["pipeline"].as_str().unwrap());
+        let has_passes = c["passes"].as_array().is_some_and(|p| !p.is_empty());
+        if has_passes && !passes.contains(&pipeline) {
+            passes.push(pipeline);
+        }
+    }
+    (pareto.len(), passes.len())
 }
 
 #[test]

@@ -73,6 +73,9 @@ pub struct Cell {
     pub frame: Option<Spread>,
     pub raster: Option<Spread>,
     pub flip: Option<f64>,
+    /// The reference graph FLIP is measured against
+    /// (`scenes/graphs/lipp_reference.ron`); pipelines may share one.
+    pub flip_reference: Option<String>,
     /// Relative error of the summed coverage against the reference, where
     /// the bench measures it.
     pub coverage_error: Option<f64>,
@@ -113,6 +116,19 @@ impl Cell {
         .flatten()
         .collect()
     }
+    /// What the cell is judged against: its reference graph, else (a
+    /// bench.json from before `flip_reference`) its reference picture.
+    pub fn reference_key(&self) -> Option<&str> {
+        self.flip_reference
+            .as_deref()
+            .or(self.reference_picture.as_deref())
+    }
+    /// The key of the reference a measured cell is judged against (`""`
+    /// where it has a FLIP but names none); `None` without a reference.
+    pub fn judged_by(&self) -> Option<&str> {
+        let judged = self.measured() && (self.flip.is_some() || self.reference_picture.is_some());
+        judged.then(|| self.reference_key().unwrap_or(""))
+    }
     /// The FLIP map the page shows with the cell's reference.
     pub fn map_and_reference(&self) -> Option<(&str, &str)> {
         Some((
@@ -143,17 +159,57 @@ impl Section<'_> {
         };
         format!("{}-{}", slug(self.view), slug(self.backend))
     }
-    /// Each reference picture once, with its pipeline, in row order.
-    pub fn references(&self) -> Vec<(&str, &str)> {
-        let mut out: Vec<(&str, &str)> = Vec::new();
-        for c in self.cells.iter().filter(|c| c.measured()) {
-            if let Some(r) = c.reference_picture.as_deref()
-                && !out.iter().any(|(_, x)| *x == r)
-            {
-                out.push((c.pipeline.as_str(), r));
+    /// Each reference the measured rows are judged against, once, in row
+    /// order: pipelines sharing a reference graph share its entry.
+    pub fn references(&self) -> Vec<Reference<'_>> {
+        let mut out: Vec<Reference> = Vec::new();
+        for c in &self.cells {
+            let Some(key) = c.judged_by() else {
+                continue;
+            };
+            let at = match out.iter().position(|r| r.key == key) {
+                Some(i) => i,
+                None => {
+                    out.push(Reference {
+                        key,
+                        picture: None,
+                        pipelines: Vec::new(),
+                    });
+                    out.len() - 1
+                }
+            };
+            let r = &mut out[at];
+            r.picture = r.picture.or(c.reference_picture.as_deref());
+            if !r.pipelines.contains(&c.pipeline.as_str()) {
+                r.pipelines.push(c.pipeline.as_str());
             }
         }
         out
+    }
+}
+
+/// One reference of a section: the graph (or picture) that identifies
+/// it, the picture it rendered, and the pipelines judged against it.
+pub struct Reference<'a> {
+    pub key: &'a str,
+    pub picture: Option<&'a str>,
+    pub pipelines: Vec<&'a str>,
+}
+
+impl Reference<'_> {
+    /// The graph's name (`lipp_reference`), or the picture's.
+    pub fn name(&self) -> &str {
+        if self.key.is_empty() {
+            return "reference";
+        }
+        Path::new(self.key)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or(self.key)
+    }
+    /// `lipp_reference (Lipp, HW strands, HW mesh)`.
+    pub fn label(&self) -> String {
+        format!("{} ({})", self.name(), self.pipelines.join(", "))
     }
 }
 
@@ -295,6 +351,35 @@ mod tests {
     fn frontier_keeps_the_undominated() {
         let pts = [(1.0, 0.5), (2.0, 0.2), (3.0, 0.3), (2.0, 0.2), (4.0, 0.1)];
         assert_eq!(frontier(&pts), [true, true, false, true, true]);
+    }
+
+    #[test]
+    fn pipelines_sharing_a_reference_graph_share_one_reference() {
+        let cell = |pipeline: &str, graph: &str, picture: &str| {
+            format!(
+                r#"{{"backend":"ash","pipeline":"{pipeline}","variant":"v","view":"far","flip":0.1,
+                "flip_reference":"scenes/graphs/{graph}.ron","reference_picture":"{picture}"}}"#
+            )
+        };
+        let json = format!(
+            r#"{{"size":"s","frames":1,"warmup":0,"cells":[{},{},{},{}]}}"#,
+            cell("Kulikov", "kulikov_reference", "k.png"),
+            cell("Lipp", "lipp_reference", "l.png"),
+            cell("HW strands", "lipp_reference", "hw.png"),
+            cell("Lipp", "lipp_reference", "l.png")
+        );
+        let b: Bench = serde_json::from_str(&json).unwrap();
+        let secs = sections(&b);
+        let refs = secs[0].references();
+        let labels: Vec<String> = refs.iter().map(Reference::label).collect();
+        assert_eq!(
+            labels,
+            [
+                "kulikov_reference (Kulikov)",
+                "lipp_reference (Lipp, HW strands)"
+            ]
+        );
+        assert_eq!(refs[1].picture, Some("l.png"));
     }
 
     #[test]

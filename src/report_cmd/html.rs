@@ -1,8 +1,9 @@
 //! The report page: one self-contained HTML file (inline CSS, script and
 //! SVG; pictures by relative path) that opens from disk with no server.
 
-use super::charts::{self, Bar, Point};
-use super::data::{Bench, Cell, CropNote, Section, frontier, sections};
+use super::charts;
+use super::data::{Bench, Cell, CropNote, Reference, Section, sections};
+use super::figures::{self, fronts};
 use miette::Result;
 use std::fmt::Write as _;
 
@@ -16,9 +17,9 @@ window.addEventListener("unhandledrejection", (e) => window.reportErrors.push(St
 
 /// What the page holds, for its self-check.
 #[derive(Default)]
-struct Counts {
-    images: usize,
-    charts: usize,
+pub(super) struct Counts {
+    pub images: usize,
+    pub charts: usize,
 }
 
 pub fn esc(s: &str) -> String {
@@ -123,8 +124,8 @@ fn header(b: &Bench, secs: &[Section<'_>], source: &str) -> String {
         "</nav><p class=\"howto\">Click a row or a picture to show it large; click the large picture \
          (or press space) to flip between the row and its pipeline's reference; hover a picture for \
          its FLIP error map (magma: black is no error, yellow the largest). FLIP is the mean over the \
-         last timed frame against the reference, both through ACES at 0 EV; ◆ marks the rows on the \
-         time-versus-FLIP Pareto frontier.</p></header>\n",
+         last timed frame against the row's reference (pipelines may share one), both through ACES at \
+         0 EV; ◆ marks the rows on their own reference's time-versus-FLIP Pareto frontier.</p></header>\n",
     );
     o
 }
@@ -153,22 +154,6 @@ fn pipelines<'a>(s: &Section<'a>) -> Vec<&'a str> {
     out
 }
 
-/// Each cell's place on the frontier (`None`: no FLIP to place it by).
-fn fronts(s: &Section<'_>) -> Vec<Option<bool>> {
-    let placed: Vec<(usize, (f64, f64))> = s
-        .cells
-        .iter()
-        .enumerate()
-        .filter_map(|(i, c)| Some((i, (c.ms()?, c.flip?))))
-        .collect();
-    let pts: Vec<(f64, f64)> = placed.iter().map(|p| p.1).collect();
-    let mut out = vec![None; s.cells.len()];
-    for ((i, _), f) in placed.iter().zip(frontier(&pts)) {
-        out[*i] = Some(f);
-    }
-    out
-}
-
 fn section(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
     let mut o = String::new();
     let device = s
@@ -184,15 +169,16 @@ fn section(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
         esc(s.scene)
     );
     let pipes = pipelines(s);
-    let fronts = fronts(s);
+    let refs = s.references();
+    let fronts = fronts(s, &refs);
     o.push_str("<div class=\"grid\"><div>");
     o.push_str(&viewer(s, counts));
     o.push_str("</div><div>");
-    o.push_str(&pareto(s, &pipes, &fronts, counts)?);
+    o.push_str(&figures::pareto(s, &pipes, &refs, &fronts, counts)?);
     o.push_str("</div></div>");
     o.push_str(&table(s, &pipes, &fronts));
-    o.push_str(&thumbs(s, counts));
-    o.push_str(&bars(s, counts)?);
+    o.push_str(&thumbs(s, &refs, counts));
+    o.push_str(&figures::bars(s, &pipes, counts)?);
     o.push_str("</section>\n");
     Ok(o)
 }
@@ -233,52 +219,8 @@ fn crop_note(c: &CropNote) -> String {
     )
 }
 
-fn pareto(
-    s: &Section<'_>,
-    pipes: &[&str],
-    fronts: &[Option<bool>],
-    counts: &mut Counts,
-) -> Result<String> {
-    let points: Vec<Point> = s
-        .cells
-        .iter()
-        .zip(fronts)
-        .filter_map(|(c, f)| {
-            Some(Point {
-                label: c.variant.clone(),
-                pipeline: pipes.iter().position(|p| *p == c.pipeline)?,
-                ms: c.ms()?,
-                flip: c.flip?,
-                front: (*f)?,
-            })
-        })
-        .collect();
-    if points.is_empty() {
-        return Ok(
-            "<p class=\"nochart\">No row here has a reference, so there is no FLIP to chart: \
-                   the table gives their times.</p>"
-                .into(),
-        );
-    }
-    let with: Vec<(&str, usize)> = pipes
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| points.iter().any(|p| p.pipeline == *i))
-        .map(|(i, p)| (*p, i))
-        .collect();
-    let svg = charts::pareto(&points, &with)?;
-    counts.charts += 1;
-    Ok(format!(
-        "<figure class=\"chart\" data-chart=\"pareto\">{}<figcaption>Median frame time against mean FLIP, \
-         each row against its own pipeline's reference ({}); amber: the Pareto frontier (no other row is \
-         both faster and closer).</figcaption></figure>",
-        inline_svg(&svg),
-        esc(&with.iter().map(|w| w.0).collect::<Vec<_>>().join(", "))
-    ))
-}
-
 /// plotters' SVG as an inline element (its XML prologue, if any, dropped).
-fn inline_svg(svg: &str) -> &str {
+pub(super) fn inline_svg(svg: &str) -> &str {
     svg.find("<svg").map_or(svg, |i| &svg[i..])
 }
 
@@ -292,7 +234,7 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
     let (best_ms, best_flip) = (best(Cell::ms), best(|c| c.flip));
     let mut o = String::from(
         "<table class=\"rows\"><thead><tr><th>row</th><th>frame ms</th><th>min–max</th>\
-         <th>raster ms</th><th>FLIP</th><th>coverage err.</th><th title=\"on the Pareto frontier\">◆</th></tr></thead><tbody>",
+         <th>raster ms</th><th>FLIP</th><th>coverage err.</th><th title=\"on the Pareto frontier of the rows judged against the same reference\">◆</th></tr></thead><tbody>",
     );
     for (i, c) in s.cells.iter().enumerate() {
         let colour = charts::pipeline_css(pipes.iter().position(|p| *p == c.pipeline).unwrap_or(0));
@@ -334,21 +276,33 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
     o
 }
 
-/// The references first, then every measured row; each picture with its
-/// FLIP map stacked over it (shown on hover).
-fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
-    let mut o = String::from("<div class=\"thumbs\">");
-    for (k, (pipeline, path)) in s.references().into_iter().enumerate() {
+/// Each distinct reference once (pipelines sharing a reference graph
+/// share its picture), named by its graph and the pipelines judged
+/// against it.
+fn reference_thumbs(refs: &[Reference<'_>], counts: &mut Counts) -> String {
+    let mut o = String::new();
+    for (k, r) in refs.iter().enumerate() {
+        let Some(path) = r.picture else {
+            continue;
+        };
         counts.images += 1;
         let _ = write!(
             o,
-            "<figure class=\"thumb reference\" data-row=\"ref{k}\" data-pic=\"{p}\" data-label=\"{pipe}\">\
-             <div class=\"stack\"><img src=\"{p}\" alt=\"reference of {pipe}\"></div>\
-             <figcaption><span class=\"name\">reference · {pipe}</span><span class=\"num\">ground truth</span></figcaption></figure>",
+            "<figure class=\"thumb reference\" data-row=\"ref{k}\" data-pic=\"{p}\" data-label=\"{label}\">\
+             <div class=\"stack\"><img src=\"{p}\" alt=\"reference {label}\"></div>\
+             <figcaption><span class=\"name\">reference · {label}</span><span class=\"num\">ground truth</span></figcaption></figure>",
             p = esc(path),
-            pipe = esc(pipeline)
+            label = esc(&r.label())
         );
     }
+    o
+}
+
+/// The references first, then every measured row; each picture with its
+/// FLIP map stacked over it (shown on hover).
+fn thumbs(s: &Section<'_>, refs: &[Reference<'_>], counts: &mut Counts) -> String {
+    let mut o = String::from("<div class=\"thumbs\">");
+    o.push_str(&reference_thumbs(refs, counts));
     for (i, c) in s.cells.iter().enumerate() {
         let Some(pic) = c.picture.as_ref().filter(|_| c.measured()) else {
             continue;
@@ -381,33 +335,4 @@ fn thumbs(s: &Section<'_>, counts: &mut Counts) -> String {
     }
     o.push_str("</div>");
     o
-}
-
-/// Per-pass stacked bars of the measured rows.
-fn bars(s: &Section<'_>, counts: &mut Counts) -> Result<String> {
-    let bars: Vec<Bar> = s
-        .cells
-        .iter()
-        .filter(|c| c.measured() && !c.passes.is_empty())
-        .map(|c| Bar {
-            label: c.label(),
-            passes: c
-                .passes
-                .iter()
-                .map(|p| (p.pass.clone(), p.median_ms.unwrap_or(0.0)))
-                .collect(),
-            frame_ms: c.ms(),
-        })
-        .collect();
-    if bars.is_empty() {
-        return Ok(String::new());
-    }
-    let svg = charts::pass_bars(&bars)?;
-    counts.charts += 1;
-    Ok(format!(
-        "<figure class=\"chart\" data-chart=\"passes\">{}<figcaption>Where each row's time goes: its passes' \
-         median times stacked in plan order (passes under 2% of every row's sum are \"other passes\"); the \
-         white tick is the median frame time, shorter than the sum where queues overlap (ash).</figcaption></figure>",
-        inline_svg(&svg)
-    ))
 }

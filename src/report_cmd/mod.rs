@@ -2,8 +2,9 @@
 //! `strandgraph bench --pictures` into a directory (or takes an earlier
 //! run's bench.json) and writes `index.html` there: per view and backend
 //! the rows' pictures beside their reference with FLIP maps, a table of
-//! time, FLIP and coverage error, a time-versus-FLIP Pareto chart and the
-//! rows' passes as stacked bars.
+//! time, FLIP and coverage error, a time-versus-FLIP chart with a Pareto
+//! frontier per reference, and each pipeline's rows' passes as stacked
+//! bars.
 //!
 //! `--from` is how a remote GPU's run becomes a page: the bench runs there,
 //! its directory comes back, and the page is drawn here. Into another
@@ -14,6 +15,7 @@ mod charts;
 mod crop;
 mod data;
 mod export;
+mod figures;
 mod html;
 
 use crate::bench_cmd::{self, Choice};
