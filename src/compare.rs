@@ -30,6 +30,17 @@ fn rgb(img: &RgbaImage) -> nv_flip::FlipImageRgb8 {
     nv_flip::FlipImageRgb8::with_data(img.width(), img.height(), &data)
 }
 
+/// A mean FLIP for tables: three significant digits, so the far view's
+/// errors (hair on a few thousand pixels, means near 4e-4) stay as
+/// comparable as the close view's.
+pub fn flip_text(x: f64) -> String {
+    if !(x.is_finite() && x > 0.0) {
+        return format!("{x}");
+    }
+    let decimals = (2 - x.log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
 /// FLIP of `test` against `reference` at the default 67 pixels per degree
 /// (a 0.7 m viewing distance from a 24" 4K screen, FLIP's default).
 /// `None` when the sizes differ.
@@ -66,6 +77,13 @@ pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> Option<ImageDiff> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn flip_text_keeps_three_significant_digits() {
+        assert_eq!(super::flip_text(0.031_73), "0.0317");
+        assert_eq!(super::flip_text(0.000_404_4), "0.000404");
+        assert_eq!(super::flip_text(0.0), "0");
+    }
+
     use super::*;
 
     #[test]

@@ -295,7 +295,9 @@ impl Report {
                     Some(Cell::Measured(st)) => st.flip,
                     _ => None,
                 };
-                let text = flip.map_or("-".into(), |f| format!("{f:.4}"));
+                let text = flip.map_or("-".into(), |f| {
+                    strandgraph::compare::flip_text(f64::from(f))
+                });
                 let _ = write!(o, " {text:>w$}");
             }
             let _ = writeln!(o);

@@ -160,6 +160,23 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // The filter without §3.3.2's strand connection: conservative-only
+    // pixels are not promoted and no flyaway is overlaid (the bilateral
+    // filter and the opacity estimate stay). Against the reference it is
+    // the only filter setting that beats SWR 1 at every view
+    // (benches/results/lipp-filter-sweep-h100.txt).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F, no strand connection",
+        graph: LIPP,
+        overrides: &[
+            "lod.enabled=false",
+            "shadow_lod.enabled=false",
+            "filter.reconnect=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+L",

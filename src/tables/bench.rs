@@ -150,8 +150,8 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
                 &views,
                 |c| {
                     format!(
-                        "{:.4} ({:.2})",
-                        c["flip"].as_f64().unwrap_or(f64::NAN),
+                        "{} ({:.2})",
+                        crate::compare::flip_text(c["flip"].as_f64().unwrap_or(f64::NAN)),
                         c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
                     )
                 },
