@@ -10,27 +10,8 @@
 #define DOM_DEPTH_BINDING 7
 #define DOM_LAYERS_BINDING 8
 #define ENV_PREFILTERED_BINDING 10
-#import strandgraph::lipp_shading::{Shading, shade_point, depth_correction}
+#import strandgraph::lipp_shading::{ShadeParams, Shading, shading_of, shade_point, depth_correction}
 #import strandgraph::half::pack_radiance
-
-// ShadeGpu in passes/src/lipp/shade.rs (lipp.shade's parameters).
-struct ShadeParams {
-    multiple_scattering: u32,
-    probe_lighting: u32,
-    specular: f32,
-    width: u32,
-    height: u32,
-    lights: u32,
-    dom_shadows: u32,
-    lod_depth_correction: u32,
-    dom_resolution: u32,
-    dom_layers: u32,
-    dom_layer_thickness: f32,
-    model_index: u32,
-    probe_specular: u32,
-    // Slots to shade: the mesh strands × MAX_CONTROL_POINTS.
-    slots: u32,
-}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> reference_points: array<vec4<u32>>;
@@ -63,16 +44,7 @@ fn reference_shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocati
     if params.lod_depth_correction != 0u {
         delta = depth_correction(raster_args[3], raster_args[4]);
     }
-    let s = Shading(
-        params.multiple_scattering,
-        params.probe_lighting,
-        params.probe_specular,
-        params.specular,
-        params.dom_shadows,
-        params.dom_resolution,
-        params.dom_layers,
-        params.dom_layer_thickness,
-    );
+    let s = shading_of(params);
     let first = wg.x * SLOTS_PER_GROUP;
     let end = min(first + SLOTS_PER_GROUP, min(params.slots, arrayLength(&vertex_lighting)));
     for (var slot = first + lane; slot < end; slot += SHADE_LANES) {

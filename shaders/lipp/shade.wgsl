@@ -13,28 +13,7 @@
 #define ENV_PREFILTERED_BINDING 10
 #import strandgraph::lipp_dom::frame
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample}
-#import strandgraph::lipp_shading::{Shading, shade_point, depth_correction}
-
-// ShadeParams (booleans as 0/1).
-struct ShadeParams {
-    multiple_scattering: u32,
-    probe_lighting: u32,
-    specular: f32,
-    // Scene quantities.
-    width: u32,
-    height: u32,
-    lights: u32,
-    dom_shadows: u32,
-    lod_depth_correction: u32,
-    dom_resolution: u32,
-    dom_layers: u32,
-    dom_layer_thickness: f32,
-    // The groom shaded (its material), in the per-model block.
-    model_index: u32,
-    probe_specular: u32,
-    // lipp.reference_shade only (0 here).
-    slots: u32,
-}
+#import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
@@ -51,17 +30,7 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
     if params.lod_depth_correction != 0u {
         delta = depth_correction(raster_args[3], raster_args[4]);
     }
-    let s = Shading(
-        params.multiple_scattering,
-        params.probe_lighting,
-        params.probe_specular,
-        params.specular,
-        params.dom_shadows,
-        params.dom_resolution,
-        params.dom_layers,
-        params.dom_layer_thickness,
-    );
-    return shade_point(s, pos, sm.tangent, strand, sm.ao, params.model_index, delta);
+    return shade_point(shading_of(params), pos, sm.tangent, strand, sm.ao, params.model_index, delta);
 }
 
 @compute @workgroup_size(64)

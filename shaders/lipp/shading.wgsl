@@ -13,7 +13,7 @@
 //   #define DOM_DEPTH_BINDING 7
 //   #define DOM_LAYERS_BINDING 8
 //   #define ENV_PREFILTERED_BINDING 10
-//   #import strandgraph::lipp_shading::{Shading, shade_point, depth_correction}
+//   #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
 #define_import_path strandgraph::lipp_shading
 
 #import strandgraph::lipp_dom
@@ -29,6 +29,28 @@
 // probe.rs's layout: 6 lat-long levels of rgba32f, back to back.
 @group(0) @binding(#{ENV_PREFILTERED_BINDING}) var<storage, read> env_prefiltered: array<vec4<f32>>;
 
+// shade::ShadeGpu: the parameters of lipp.shade and lipp.reference_shade
+// (booleans as 0/1).
+struct ShadeParams {
+    multiple_scattering: u32,
+    probe_lighting: u32,
+    specular: f32,
+    // Scene quantities.
+    width: u32,
+    height: u32,
+    lights: u32,
+    dom_shadows: u32,
+    lod_depth_correction: u32,
+    dom_resolution: u32,
+    dom_layers: u32,
+    dom_layer_thickness: f32,
+    // lipp.shade: the groom shaded (its material), in the per-model block.
+    model_index: u32,
+    probe_specular: u32,
+    // lipp.reference_shade: the point slots to shade (0 in lipp.shade).
+    slots: u32,
+}
+
 // shade::ShadeParams as the shading reads it (booleans as 0/1).
 struct Shading {
     multiple_scattering: u32,
@@ -41,6 +63,20 @@ struct Shading {
     map_resolution: u32,
     map_layers: u32,
     map_layer_thickness: f32,
+}
+
+// The shading's part of the passes' parameters.
+fn shading_of(p: ShadeParams) -> Shading {
+    return Shading(
+        p.multiple_scattering,
+        p.probe_lighting,
+        p.probe_specular,
+        p.specular,
+        p.dom_shadows,
+        p.dom_resolution,
+        p.dom_layers,
+        p.dom_layer_thickness,
+    );
 }
 
 // shade::depth_correction (Lipp Eq. 8): Δ = −log β.
