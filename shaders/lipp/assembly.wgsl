@@ -163,6 +163,8 @@ struct Strand {
     // N / N_LOD of the strand's bundle (the DOM's density compensation).
     thinning: f32,
     styling: bool,
+    // The strand's bundle (its record in bundle_lod and hairmesh.bundles).
+    bundle_index: u32,
 }
 
 fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
@@ -172,7 +174,7 @@ fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
     let b = load_bundle(bi);
     let k = s - bundle_lod[bi * LOD_WORDS + 2u];
     let full = hairmesh_bundles[bi * BUNDLE_WORDS + 2u];
-    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling);
+    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling, bi);
 }
 
 // Whether this lane's shuffle partners are its index neighbours.

@@ -5,11 +5,14 @@
 // not snapped) with +1 in each 8x8 tile it may reach, as reference.count
 // does for a groom. Port of passes/src/lipp/reference/strands.rs.
 
+#define REFERENCE_COUNTS_BINDING 8
+#define REFERENCE_RIBBONS_BINDING 9
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{quantize, LOD_WORDS, BUNDLE_WORDS, MAX_CONTROL_POINTS}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, ControlPoint, Strand, Strip, load_strand, bundle_of_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
-#import strandgraph::reference::{Ribbon, ribbon_of, ribbon_pack, ribbon_tiles, ribbon_reaches_tile}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
+#import strandgraph::reference::ribbon_of
+#import strandgraph::reference_bins::store_ribbon
 
 // StrandsGpu in passes/src/lipp/reference/strands.rs.
 struct StrandsParams {
@@ -29,8 +32,7 @@ struct StrandsParams {
 // are declared in assembly.wgsl.
 @group(0) @binding(6) var<storage, read> models: array<ModelData>;
 @group(0) @binding(7) var<storage, read> groom_vertices: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read_write> reference_counts: array<atomic<u32>>;
-@group(0) @binding(9) var<storage, read_write> reference_ribbons: array<vec4<u32>>;
+// Bindings 8 (reference_counts) and 9 (reference_ribbons) are bins.wgsl's.
 @group(0) @binding(10) var<storage, read_write> reference_points: array<vec4<u32>>;
 
 // strands::{MODEL_SHIFT, VALID}: the point record's model index above
@@ -45,9 +47,8 @@ struct Meta {
     thickness: f32,
 }
 
-fn strand_meta(count: u32, s: u32, st: Strand) -> Meta {
-    let bi = bundle_of_strand(count, s);
-    let model = min(hairmesh_bundles[bi * BUNDLE_WORDS + 3u], arrayLength(&models) - 1u);
+fn strand_meta(st: Strand) -> Meta {
+    let model = min(hairmesh_bundles[st.bundle_index * BUNDLE_WORDS + 3u], arrayLength(&models) - 1u);
     let first = models[model].vertex_first;
     var thickness = 0.0;
     if first < arrayLength(&groom_vertices) {
@@ -75,21 +76,7 @@ fn store_segment(slot: u32, a: ControlPoint, b: ControlPoint, m: u32, c: u32, th
         m > 0u, m + 2u < c, slot, slot + 1u,
         frame.near, frame.screen.xy, frame.pixels_per_unit,
     );
-    let words = ribbon_pack(r);
-    reference_ribbons[3u * slot] = words[0];
-    reference_ribbons[3u * slot + 1u] = words[1];
-    reference_ribbons[3u * slot + 2u] = words[2];
-    if !r.valid {
-        return;
-    }
-    let t = ribbon_tiles(r, params.width, params.height);
-    for (var ty = t.y; ty <= t.w; ty++) {
-        for (var tx = t.x; tx <= t.z; tx++) {
-            if ribbon_reaches_tile(r, tx, ty) {
-                atomicAdd(&reference_counts[ty * params.tiles_x + tx], 1u);
-            }
-        }
-    }
+    store_ribbon(slot, r, params.width, params.height, params.tiles_x);
 }
 
 @compute @workgroup_size(32)
@@ -109,7 +96,7 @@ fn reference_strands(
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
-        let m = strand_meta(count, s, st);
+        let m = strand_meta(st);
         // assembly::pass_two: this lane's points start at lane * S.
         let first = lane * ((st.c - 1u + 31u) / 32u);
         let base = s * MAX_CONTROL_POINTS + first;

@@ -5,16 +5,18 @@
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
 #define LOD_MODELS_BINDING 3
+#define REFERENCE_COUNTS_BINDING 7
+#define REFERENCE_RIBBONS_BINDING 8
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::kulikov::load_lod
-#import strandgraph::reference::{BinParams, Ribbon, ribbon_of, ribbon_pack, ribbon_tiles, ribbon_reaches_tile}
+#import strandgraph::reference::{BinParams, Ribbon, ribbon_of}
+#import strandgraph::reference_bins::store_ribbon
 
 @group(0) @binding(0) var<uniform> params: BinParams;
 @group(0) @binding(4) var<storage, read> segment_visibility: array<u32>;
 @group(0) @binding(5) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> groom_vertices: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read_write> reference_counts: array<atomic<u32>>;
-@group(0) @binding(8) var<storage, read_write> reference_ribbons: array<vec4<u32>>;
+// Bindings 7 (reference_counts) and 8 (reference_ribbons) are bins.wgsl's.
 
 // reference::segment_ribbon: not drawn when culled, dropped by the LOD or
 // crossing the near plane; joined to its neighbours but at root and tip.
@@ -46,20 +48,5 @@ fn count(@builtin(global_invocation_id) gid: vec3<u32>) {
     if id >= params.segments {
         return;
     }
-    let r = segment_ribbon(id);
-    let words = ribbon_pack(r);
-    reference_ribbons[3u * id] = words[0];
-    reference_ribbons[3u * id + 1u] = words[1];
-    reference_ribbons[3u * id + 2u] = words[2];
-    if !r.valid {
-        return;
-    }
-    let t = ribbon_tiles(r, params.width, params.height);
-    for (var ty = t.y; ty <= t.w; ty++) {
-        for (var tx = t.x; tx <= t.z; tx++) {
-            if ribbon_reaches_tile(r, tx, ty) {
-                atomicAdd(&reference_counts[ty * params.tiles_x + tx], 1u);
-            }
-        }
-    }
+    store_ribbon(id, segment_ribbon(id), params.width, params.height, params.tiles_x);
 }

@@ -16,7 +16,7 @@ use super::ribbon::{RECORD_WORDS, Record, Ribbon};
 use super::{TILE, segment_ribbon, tiles};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
-use crate::kernel::Ctx;
+use crate::kernel::{Ctx, Words};
 use crate::kulikov::Scene;
 use crate::lipp::MAX_CONTROL_POINTS;
 use crate::params::NoParams;
@@ -118,6 +118,23 @@ pub fn reached_tiles(ribbon: &Ribbon, width: u32, height: u32) -> Vec<u32> {
     out
 }
 
+/// `record` (or "not drawn") at `id` of `records`, and +1 in `counts` for
+/// every tile it reaches: what both counting passes do with a segment
+/// (`reference.count`, `lipp.reference_strands`; shaders/reference/bins.wgsl).
+pub fn store_ribbon(
+    record: Option<&Record>,
+    id: u32,
+    records: &Words<'_>,
+    counts: &Words<'_>,
+    width: u32,
+    height: u32,
+) {
+    Record::store(record, records, id as usize);
+    for t in record.map_or_else(Vec::new, |r| reached_tiles(&r.ribbon, width, height)) {
+        counts.fetch_add(t as usize, 1);
+    }
+}
+
 /// The segments of workgroup `group` that exist.
 fn lanes(group: u32, q: Quantities) -> impl Iterator<Item = u32> {
     let first = group * GROUP;
@@ -138,10 +155,7 @@ impl CpuKernel for CountKernel {
         );
         for id in lanes(group, q) {
             let record = segment_ribbon(&scene, &lods, ctx, id);
-            Record::store(record.as_ref(), &records, id as usize);
-            for t in record.map_or_else(Vec::new, |r| reached_tiles(&r.ribbon, q.width, q.height)) {
-                counts.fetch_add(t as usize, 1);
-            }
+            store_ribbon(record.as_ref(), id, &records, &counts, q.width, q.height);
         }
     }
 }

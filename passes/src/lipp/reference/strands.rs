@@ -20,7 +20,7 @@ use crate::lipp::payload::quantize;
 use crate::lipp::strand::{ControlPoint, strand_uv};
 use crate::lipp::{MAX_CONTROL_POINTS, RASTER_GROUP, frame};
 use crate::params::{Invalid, PassParams};
-use crate::reference::bin::reached_tiles;
+use crate::reference::bin::store_ribbon;
 use crate::reference::ribbon::{Record, Ribbon};
 use crate::reference::tiles;
 
@@ -138,12 +138,14 @@ impl Writer<'_> {
             ribbon,
             vertices: [slot, slot + 1],
         });
-        Record::store(record.as_ref(), &self.records, slot as usize);
-        for t in record.map_or_else(Vec::new, |r| {
-            reached_tiles(&r.ribbon, self.width, self.height)
-        }) {
-            self.counts.fetch_add(t as usize, 1);
-        }
+        store_ribbon(
+            record.as_ref(),
+            slot,
+            &self.records,
+            &self.counts,
+            self.width,
+            self.height,
+        );
     }
 }
 
@@ -167,6 +169,7 @@ impl CpuKernel for StrandsKernel {
         let f = frame(ctx);
         let strands = Strands::load(ctx);
         let model_count = (ctx.words("models").len() / 64).max(1) as u32;
+        let widths: Vec<f32> = (0..model_count).map(|m| thickness(ctx, m)).collect();
         let writer = Writer {
             f: &f,
             width: ctx.quantities.width,
@@ -188,7 +191,7 @@ impl CpuKernel for StrandsKernel {
                 strand: [quantize(uv[0], 63.0), quantize(uv[1], 63.0)],
                 model: rec.model.min(model_count - 1),
             };
-            let width = thickness(ctx, template.model);
+            let width = widths[template.model as usize];
             let base = s * SLOTS;
             // `assemble` hands the segments over in order, root first.
             let mut m = 0;
@@ -217,6 +220,7 @@ mod tests {
     use crate::layout::words_of;
     use crate::lipp::payload::EMPTY;
     use crate::lipp::raster::tests::{frame as test_frame, harness};
+    use crate::reference::bin::reached_tiles;
     use crate::reference::ribbon::RECORD_WORDS;
     use bytemuck::Zeroable;
     use std::sync::atomic::{AtomicU32, AtomicU64};
