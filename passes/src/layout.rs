@@ -58,7 +58,10 @@ pub struct ModelData {
     pub min_fraction: f32,
     /// Cuticle tilt α in radians (the material's `highlight_shift_deg`).
     pub highlight_shift: f32,
-    pub _pad: [u32; 2],
+    /// Strand thickness in metres (the groom's first vertex's): the width
+    /// `lipp.filter` converts its opacity estimate to (`true_width`).
+    pub thickness: f32,
+    pub _pad: u32,
 }
 
 pub const MODEL_LOD_ENABLED: u32 = 1;

@@ -203,4 +203,31 @@ mod tests {
             "expected the kulikov and lipp graphs, found {seen}"
         );
     }
+
+    /// `lipp.filter`'s `centre_diameter` restates `lipp.raster`'s: the width
+    /// of the lines whose coverage its hit ratio measures.
+    #[test]
+    fn shipped_filters_know_the_raster_line_width() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/graphs");
+        let mut checked = 0;
+        for graph in ["lipp.ron", "lipp_msaa.ron"] {
+            let plan = strandgraph_graph::compile_file(
+                std::path::Path::new(&format!("{dir}/{graph}")),
+                &Registry,
+                1,
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+            let of = |kind: &str| {
+                let pass = plan.graph.passes.iter().find(|p| p.kind == kind);
+                pass.unwrap_or_else(|| panic!("{graph} has no {kind}"))
+                    .params
+                    .clone()
+            };
+            let raster = lipp::raster::RASTER.params(&of("lipp.raster")).unwrap();
+            let filter = lipp::filter::FILTER.params(&of("lipp.filter")).unwrap();
+            assert_eq!(raster.centre_diameter, filter.centre_diameter, "{graph}");
+            checked += 1;
+        }
+        assert_eq!(checked, 2);
+    }
 }

@@ -238,7 +238,8 @@ impl PackedGrooms {
             }),
             min_fraction: g.lod.min_fraction,
             highlight_shift: g.material.highlight_shift_deg.to_radians(),
-            _pad: [0; 2],
+            thickness: groom.thickness.first().copied().unwrap_or(0.0),
+            _pad: 0,
         }
     }
 

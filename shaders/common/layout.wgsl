@@ -47,7 +47,9 @@ struct ModelData {
     min_fraction: f32,
     // Cuticle tilt α, radians (the material's highlight_shift_deg).
     highlight_shift: f32,
-    _pad: array<u32, 2>,
+    // Strand thickness in metres (the groom's first vertex's).
+    thickness: f32,
+    _pad: u32,
 }
 
 const MODEL_LOD_ENABLED: u32 = 1u;

@@ -3,7 +3,7 @@
 // `output`. Port of passes/src/lipp/filter.rs (see its deviations).
 // `output` is Rgba16Float, read and written: a read_write storage texture.
 
-#import strandgraph::layout::FrameData
+#import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample}
 
@@ -26,6 +26,11 @@ struct FilterParams {
     msaa: u32,
     // Pixels at least this opaque write their hair depth (Lipp §3.5).
     depth_alpha: f32,
+    // Ours: convert the hit ratio to the strands' own width (filter.rs).
+    true_width: u32,
+    // lipp.raster's centre_diameter, pixels.
+    centre_diameter: f32,
+    model_index: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -35,6 +40,7 @@ struct FilterParams {
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, read_write>;
 // NDC depth (f32 bits) the next groom's rasterizer is tested against.
 @group(0) @binding(5) var<storage, read_write> hair_depth: array<u32>;
+@group(0) @binding(6) var<storage, read> models: array<ModelData>;
 
 fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
@@ -131,8 +137,21 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
     var alpha = 1.0;
     if params.opacity_reconstruction != 0u && hc + hcons > 0.0 {
         alpha = hc / (hc + hcons);
+        if params.true_width != 0u {
+            let width = models[params.model_index].thickness * frame.pixels_per_unit / d_ref;
+            alpha = true_width_alpha(alpha, params.centre_diameter, width);
+        }
     }
     return vec4<f32>(c, alpha);
+}
+
+// filter::true_width_alpha.
+fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
+    if f >= 1.0 {
+        return 1.0;
+    }
+    let k = log(1.0 - clamp(width, 0.0, 0.99)) / log(1.0 - line);
+    return 1.0 - pow(1.0 - f, k);
 }
 
 @compute @workgroup_size(64)
@@ -186,7 +205,13 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
             // A flyaway in front of the centre hit: blended over it, opacity 1.
             let sa = unpack_payload(a);
             let f = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
-            out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
+            if params.true_width == 0u {
+                out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
+            } else {
+                // Both strands with their own opacity: the flyaway over the centre.
+                let a = f.w + out.w * (1.0 - f.w);
+                out = vec4<f32>((f.xyz * f.w + out.xyz * out.w * (1.0 - f.w)) / a, a);
+            }
             depth = sa.depth;
         }
     } else if cons && params.reconnect != 0u {

@@ -22,9 +22,26 @@
 //!   `depth_alpha` opaque, the pixel's hair depth goes into `hair_depth`
 //!   (in place, min), which the next groom's rasterizer tests against.
 //!
+//! - true width (ours, `true_width`): the hit ratio above measures the
+//!   coverage of lines `centre_diameter` pixels wide (the raster's centre
+//!   test), over-covering strands thinner than that by their width ratio
+//!   (70 µm is 0.15 px at the close view, 0.03 px at the far). Reading the
+//!   ratio f as the coverage 1 − (1 − d)^N of N such lines, the strands'
+//!   own coverage is 1 − (1 − w)^N = 1 − (1 − f)^k, k = ln(1 − w) / ln(1 − d),
+//!   with w the groom's thickness in pixels at the sample's depth: one
+//!   isolated strand gets its width, dense hair (f = 1) stays opaque.
+//!   A flyaway in front is then blended with its own opacity rather than
+//!   forcing 1.
+//!
 //! Deviations: depths are compared as linear view depth in metres
-//! (`depth_threshold` 0.05, `front_threshold` 0.01): the paper's 1.45e-3 and
-//! 5e-4 are in an unstated depth space. Code 2 counts strip hits with P's own
+//! (`depth_threshold` 0.05, `front_threshold` 0.01). The paper's 1.45e-3 and
+//! 5e-4 are read here as differences of the payload's NDC depth (the only
+//! depth its G-buffer holds): z_ndc = f(z − n) / (z(f − n)) changes by
+//! n f / ((f − n) z²) ≈ n / z² per metre, so with our near plane (0.02 m)
+//! they are 3.6 cm and 1.2 cm at the close view (0.7 m), 45 and 16 cm at
+//! the mid (2.5 m) and 7 and 2.5 m at the far (10 m), where they would
+//! reject nothing. We keep the close view's values, rounded, at every
+//! distance. Code 2 counts strip hits with P's own
 //! flags (`isCenter`), which the text contradicts; we count Q's. A promoted
 //! pixel with no centre-hit neighbour keeps its own conservative shading.
 //! With `enabled: false` the centre layer is composited as is (SWR 1); with
@@ -38,7 +55,7 @@ use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
-use crate::layout::FrameData;
+use crate::layout::{FrameData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
 use strandgraph_graph::schema::Quantity;
 
@@ -64,6 +81,13 @@ pub struct FilterParams {
     /// Pixels at least this opaque write their hair depth to `hair_depth`,
     /// which the next groom's rasterizer tests against (Lipp §3.5).
     pub depth_alpha: f32,
+    /// Convert the hit ratio to the strands' own width (ours; see above).
+    pub true_width: bool,
+    /// Pixels; `lipp.raster`'s `centre_diameter`, the line width the hit
+    /// ratio measures (tests/shipped_graphs.rs checks the graphs agree).
+    pub centre_diameter: f32,
+    /// The groom being filtered (set by the graph's per-model repeat).
+    pub model_index: u32,
 }
 
 impl Default for FilterParams {
@@ -81,6 +105,9 @@ impl Default for FilterParams {
             front_threshold: 0.01,
             msaa: 0,
             depth_alpha: 0.5,
+            true_width: true,
+            centre_diameter: 0.5,
+            model_index: 0,
         }
     }
 }
@@ -94,6 +121,12 @@ impl PassParams for FilterParams {
             ));
         }
         in_range("radius", self.radius, 1..=MAX_RADIUS)?;
+        if !(self.centre_diameter > 0.0 && self.centre_diameter < 1.0) {
+            return Err(Invalid::new(
+                "centre_diameter",
+                format!("{} is not in (0, 1) pixels", self.centre_diameter),
+            ));
+        }
         for (name, v) in [
             ("s_parallel", self.s_parallel),
             ("s_perp", self.s_perp),
@@ -125,6 +158,9 @@ crate::gpu_block! {
         height: u32,
         msaa: u32,
         depth_alpha: f32,
+        true_width: u32,
+        centre_diameter: f32,
+        model_index: u32,
     }
 }
 
@@ -138,6 +174,7 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         Binding::read("shaded"),
         Binding::write("output"),
         Binding::write("hair_depth"),
+        Binding::read("models"),
     ]),
     workgroup_size: FILTER_GROUP,
     dispatch: Dispatch::PerElement {
@@ -161,6 +198,9 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         height: q.height,
         msaa: p.msaa,
         depth_alpha: p.depth_alpha,
+        true_width: flag(p.true_width),
+        centre_diameter: p.centre_diameter,
+        model_index: p.model_index,
     },
     raster: None,
 };
@@ -201,6 +241,8 @@ pub struct View<'a> {
     pub height: u32,
     pub gbuffer: Words<'a>,
     pub shaded: Words<'a>,
+    /// The groom's strand thickness, metres.
+    pub thickness: f32,
 }
 
 impl View<'_> {
@@ -300,12 +342,25 @@ pub fn reconstruct(
     } else {
         [cp[0], cp[1], cp[2]]
     };
-    let alpha = if p.opacity_reconstruction && hc + hcons > 0.0 {
-        hc / (hc + hcons)
-    } else {
+    let alpha = if !p.opacity_reconstruction || hc + hcons == 0.0 {
         1.0
+    } else if p.true_width {
+        let width = v.thickness * v.f.pixels_per_unit / d_ref;
+        true_width_alpha(hc / (hc + hcons), p.centre_diameter, width)
+    } else {
+        hc / (hc + hcons)
     };
     (c, alpha)
+}
+
+/// The coverage of strands `width` pixels wide where lines `line` pixels
+/// wide cover `f` of the pixels (`true_width` in the module comment).
+pub fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
+    if f >= 1.0 {
+        return 1.0;
+    }
+    let k = (1.0 - width.clamp(0.0, 0.99)).ln() / (1.0 - line).ln();
+    1.0 - (1.0 - f).powf(k)
 }
 
 /// What the filter puts over one pixel.
@@ -391,8 +446,14 @@ pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Ha
             let sa = unpack(a);
             let ca = v.color(1, i);
             let (f, fa) = reconstruct(p, v, x, y, &Reference::of(v, x, y, &sa, ca, true));
-            let mixed = [0, 1, 2].map(|k| f[k] * fa + c[k] * (1.0 - fa));
-            return hair(mixed, 1.0, sa.depth);
+            if !p.true_width {
+                let mixed = [0, 1, 2].map(|k| f[k] * fa + c[k] * (1.0 - fa));
+                return hair(mixed, 1.0, sa.depth);
+            }
+            // Both strands with their own opacity: the flyaway over the centre.
+            let a = fa + alpha * (1.0 - fa);
+            let mixed = [0, 1, 2].map(|k| (f[k] * fa + c[k] * alpha * (1.0 - fa)) / a);
+            return hair(mixed, a, sa.depth);
         }
         return hair(c, alpha, sg.depth);
     }
@@ -417,6 +478,8 @@ impl CpuKernel for FilterKernel {
             height: h,
             gbuffer,
             shaded,
+            thickness: read::<ModelData>(&ctx.words("models"), self.0.model_index as usize)
+                .thickness,
         };
         let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
         for i in group * FILTER_GROUP..((group + 1) * FILTER_GROUP).min(w * h) {
@@ -444,5 +507,29 @@ mod tests {
         assert!(FILTER.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"sigma_c": 0.0}"#).unwrap();
         assert!(FILTER.params(&v).is_err());
+        let v: ron::Value = ron::from_str(r#"{"centre_diameter": 1.0}"#).unwrap();
+        assert!(FILTER.params(&v).is_err());
+    }
+
+    #[test]
+    fn true_width_keeps_dense_hair_opaque_and_thins_one_strand() {
+        // Dense: every strip pixel a centre hit.
+        assert_eq!(true_width_alpha(1.0, 0.5, 0.03), 1.0);
+        // Strands as wide as the line: the paper's estimate unchanged.
+        assert!((true_width_alpha(0.3, 0.5, 0.5) - 0.3).abs() < 1e-6);
+        // One isolated strand (f small): its coverage scales with its width.
+        let a = true_width_alpha(0.1, 0.5, 0.05);
+        let linear = 0.1 * (0.95f32.ln() / 0.5f32.ln());
+        assert!((a - linear).abs() < 0.1 * linear, "{a} vs {linear}");
+        // N lines of width d cover 1 − (1 − d)^N; strands of width w, 1 − (1 − w)^N.
+        let n = 3;
+        let f = 1.0 - 0.5f32.powi(n);
+        let want = 1.0 - 0.85f32.powi(n);
+        assert!((true_width_alpha(f, 0.5, 0.15) - want).abs() < 1e-5);
+        // Monotonic in the hit ratio.
+        let steps: Vec<f32> = (0..=10)
+            .map(|i| true_width_alpha(i as f32 / 10.0, 0.5, 0.1))
+            .collect();
+        assert!(steps.windows(2).all(|w| w[0] < w[1]), "{steps:?}");
     }
 }
