@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
-use strandgraph::images::main_picture;
+use strandgraph::images::{Picture, main_picture};
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -351,12 +351,13 @@ pub fn run(mut args: Args) -> Result<()> {
                                 .judge(backend, s, &setup, v, &img)
                                 .map_err(|e| miette!("{}: {}: {e}", v.pipeline, v.name))?;
                             stats.flip = judged.as_ref().map(|j| j.diff.mean);
+                            stats.coverage_error = judged.as_ref().and_then(|j| j.coverage_error);
                             if let Some(saver) = &mut saver {
                                 let saved = saver.save(
                                     backend,
                                     &report.views[s],
                                     v,
-                                    &img,
+                                    &img.image,
                                     judged.as_ref(),
                                 )?;
                                 stats.pictures = Some(saved);
@@ -470,7 +471,7 @@ fn measure(
     args: &Args,
     cpu: CpuOptions,
     atomics: u64,
-) -> Result<(String, Vec<String>, Stats, Option<image::RgbaImage>)> {
+) -> Result<(String, Vec<String>, Stats, Option<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;

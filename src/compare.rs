@@ -30,6 +30,23 @@ fn rgb(img: &RgbaImage) -> nv_flip::FlipImageRgb8 {
     nv_flip::FlipImageRgb8::with_data(img.width(), img.height(), &data)
 }
 
+/// Coverage error: the mean absolute difference of two coverage (alpha)
+/// maps over the pixels where either has hair; 0 where neither has any,
+/// `None` when the sizes differ.
+pub fn coverage_error(reference: &[f32], test: &[f32]) -> Option<f32> {
+    if reference.len() != test.len() {
+        return None;
+    }
+    let (sum, n) = reference
+        .iter()
+        .zip(test)
+        .filter(|(r, t)| **r > 0.0 || **t > 0.0)
+        .fold((0.0f64, 0u64), |(s, n), (r, t)| {
+            (s + f64::from((r - t).abs()), n + 1)
+        });
+    Some(if n == 0 { 0.0 } else { (sum / n as f64) as f32 })
+}
+
 /// A mean FLIP for tables: three significant digits, so the far view's
 /// errors (hair on a few thousand pixels, means near 4e-4) stay as
 /// comparable as the close view's.
@@ -82,6 +99,15 @@ mod tests {
         assert_eq!(super::flip_text(0.031_73), "0.0317");
         assert_eq!(super::flip_text(0.000_404_4), "0.000404");
         assert_eq!(super::flip_text(0.0), "0");
+    }
+
+    #[test]
+    fn coverage_error_counts_only_pixels_with_hair() {
+        assert_eq!(super::coverage_error(&[0.0, 0.0], &[0.0, 0.0]), Some(0.0));
+        // One pixel with hair in the reference only, one in both.
+        let e = super::coverage_error(&[0.5, 1.0, 0.0], &[0.0, 0.75, 0.0]).unwrap();
+        assert!((e - 0.375).abs() < 1e-6, "{e}");
+        assert_eq!(super::coverage_error(&[0.0], &[0.0, 1.0]), None);
     }
 
     use super::*;

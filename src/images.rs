@@ -134,10 +134,43 @@ pub fn main_picture(
     height: u32,
     display: Display,
     read: impl Fn(&str) -> Option<Vec<u32>>,
-) -> Option<RgbaImage> {
+) -> Option<Picture> {
     plan.graph.outputs.iter().find_map(|&(r, _)| {
         let words = read(&plan.graph.resources[r].name)?;
-        to_picture(plan, r, &words, width, height, display)
+        Some(Picture {
+            image: to_picture(plan, r, &words, width, height, display)?,
+            coverage: coverage(plan, r, &words, width, height),
+        })
+    })
+}
+
+/// A graph's main image as a viewer sees it, and the hair's coverage.
+#[derive(Debug, Clone)]
+pub struct Picture {
+    pub image: RgbaImage,
+    /// Per pixel, row by row: the image's alpha, which every pipeline keeps
+    /// as the coverage of its hair (0 where the opaque scene shows, 1 under
+    /// opaque hair; docs/reference.md). `None` for an image without alpha.
+    pub coverage: Option<Vec<f32>>,
+}
+
+/// The alpha channel of an `Rgba16Float` image resource.
+pub fn coverage(
+    plan: &Plan,
+    resource: usize,
+    words: &[u32],
+    width: u32,
+    height: u32,
+) -> Option<Vec<f32>> {
+    let r = plan.graph.physical(resource);
+    let ResourceDecl::Image { format, .. } = plan.graph.resources[r].decl else {
+        return None;
+    };
+    let texels = (width * height) as usize;
+    (format == ImageFormat::Rgba16Float && words.len() >= 2 * texels).then(|| {
+        (0..texels)
+            .map(|i| f16::from_bits((words[2 * i + 1] >> 16) as u16).to_f32())
+            .collect()
     })
 }
 

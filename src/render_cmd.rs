@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::demo::Demo;
 use strandgraph::frame::{Prepared, parse_size, prepare_with};
-use strandgraph::images::{Display, Tonemap, depth_to_view, motion_image, to_linear, to_picture};
+use strandgraph::images::{
+    Display, Tonemap, coverage, depth_to_view, motion_image, to_linear, to_picture,
+};
 use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
 use strandgraph_passes::backend::Clock;
@@ -45,6 +47,10 @@ pub struct Args {
     /// session for motion that is not zero (tests/motion.rs does).
     #[arg(long, value_name = "FILE.exr")]
     pub motion: Option<PathBuf>,
+    /// Also write the hair's coverage under the main image (its alpha, a
+    /// matte: 0 where no hair, 1 under opaque hair) here, as a 16-bit PNG.
+    #[arg(long, value_name = "FILE.png")]
+    pub coverage: Option<PathBuf>,
     /// Run this graph instead of the scene's (A/B-test pipelines on one scene).
     #[arg(long)]
     pub graph: Option<PathBuf>,
@@ -154,6 +160,7 @@ pub fn run(args: Args) -> Result<()> {
 struct Extras {
     depth: Option<PathBuf>,
     motion: Option<PathBuf>,
+    coverage: Option<PathBuf>,
     display: Display,
 }
 
@@ -162,6 +169,7 @@ impl Extras {
         Self {
             depth: args.depth.as_deref().map(|p| tagged(p, tag)),
             motion: args.motion.as_deref().map(|p| tagged(p, tag)),
+            coverage: args.coverage.as_deref().map(|p| tagged(p, tag)),
             display: Display {
                 tonemap: args.tonemap,
                 exposure: args.exposure,
@@ -187,6 +195,25 @@ fn tagged(path: &Path, tag: Option<&str>) -> PathBuf {
 const DEPTHS: [&str; 2] = ["hair_depth", "scene.depth"];
 /// Per-pixel motion (kulikov.pixel_motion).
 const MOTION: &str = "pixel_motion";
+
+/// The main image's alpha (the hair's coverage) as a 16-bit grey PNG.
+fn write_coverage(p: &Prepared, r: usize, words: &[u32], path: &Path) -> Result<()> {
+    let q = p.upload.quantities;
+    let alpha = coverage(&p.plan, r, words, q.width, q.height).ok_or_else(|| {
+        miette::miette!("--coverage: the main image has no alpha (not Rgba16Float)")
+    })?;
+    let grey: Vec<u16> = alpha
+        .iter()
+        .map(|a| (a.clamp(0.0, 1.0) * 65535.0).round() as u16)
+        .collect();
+    image::ImageBuffer::<image::Luma<u16>, _>::from_raw(q.width, q.height, grey)
+        .expect("one value per pixel")
+        .save(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("writing {}", path.display()))?;
+    println!("wrote {} (hair coverage)", path.display());
+    Ok(())
+}
 
 fn write_outputs(
     p: &Prepared,
@@ -223,6 +250,9 @@ fn write_outputs(
             .into_diagnostic()
             .wrap_err_with(|| format!("writing {}", path.display()))?;
         println!("wrote {} ({name})", path.display());
+        if let (false, Some(matte)) = (wrote_main, &extras.coverage) {
+            write_coverage(p, r, &words, matte)?;
+        }
         wrote_main = true;
     }
     if let Some(motion_path) = &extras.motion {

@@ -79,9 +79,10 @@ pub struct Draw {
 pub enum Blend {
     /// The fragment replaces the attachment.
     Replace,
-    /// Premultiplied "over": colour = src + (1 − src.a) · dst; the
-    /// attachment's alpha stays (the opaque image's alpha is its coverage).
-    PremultipliedOverKeepAlpha,
+    /// Premultiplied "over", alpha included: colour = src + (1 − src.a) · dst,
+    /// alpha = src.a + (1 − src.a) · dst.a (`output`'s alpha is the hair's
+    /// coverage, docs/reference.md).
+    PremultipliedOver,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

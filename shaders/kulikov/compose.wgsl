@@ -277,7 +277,7 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
         if h.alpha <= 0.0 && h.front_w <= 0.0 {
             continue;
         }
-        color = vec4<f32>(h.color + (1.0 - h.alpha) * color.rgb, color.a);
+        color = vec4<f32>(h.color + (1.0 - h.alpha) * color.rgb, h.alpha + (1.0 - h.alpha) * color.a);
         touched = true;
         // compose::ndc_depth of the front layer, where nearer.
         if h.alpha >= params.depth_threshold && h.front_w > 0.0 {

@@ -51,7 +51,7 @@ fn resolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
             color.x * (1.0 - alpha) + c.x * alpha,
             color.y * (1.0 - alpha) + c.y * alpha,
             color.z * (1.0 - alpha) + c.z * alpha,
-            color.w,
+            color.w * (1.0 - alpha) + alpha,
         );
         if debug == 0u {
             var d = vec3<u32>(0u);

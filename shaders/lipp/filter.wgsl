@@ -223,7 +223,7 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let alpha = out.w;
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), scene.w));
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), alpha + scene.w * (1.0 - alpha)));
     if alpha >= params.depth_alpha {
         hair_depth[i] = bitcast<u32>(min(bitcast<f32>(hair_depth[i]), depth));
     }

@@ -117,5 +117,6 @@ fn opaque(@builtin(global_invocation_id) id: vec3<u32>) {
             color = lit;
         }
     }
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(color, 1.0));
+    // Alpha 0: no hair yet (`output`'s alpha is the hair's coverage).
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(color, 0.0));
 }

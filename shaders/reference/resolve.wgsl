@@ -144,5 +144,5 @@ fn resolve(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     let hair = sum * inv;
     let uncovered = f32(bare) * inv;
     let bg = textureLoad(output, vec2<u32>(x, y));
-    textureStore(output, vec2<u32>(x, y), vec4<f32>(hair + uncovered * bg.rgb, bg.a));
+    textureStore(output, vec2<u32>(x, y), vec4<f32>(hair + uncovered * bg.rgb, 1.0 - uncovered * (1.0 - bg.a)));
 }

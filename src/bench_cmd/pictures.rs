@@ -100,7 +100,7 @@ impl Saver {
             let map = self.claim(backend, view, &format!("{stem}-flip"));
             self.write(&map, &j.diff.error_map)?;
             flip_map = Some(map);
-            reference = Some(self.reference(backend, view, v.pipeline, &j.reference)?);
+            reference = Some(self.reference(backend, view, v.pipeline, &j.reference.image)?);
         }
         Ok(Saved {
             picture: rel,

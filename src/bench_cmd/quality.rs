@@ -1,6 +1,6 @@
 //! The bench's quality axis: each row's image against its pipeline's
-//! ground-truth reference (docs/reference.md), as mean FLIP (src/compare.rs)
-//! next to the time.
+//! ground-truth reference (docs/reference.md), as mean FLIP and coverage
+//! error (src/compare.rs) next to the time.
 //!
 //! The reference of a scene is rendered once per backend, on that backend,
 //! and the row's last timed frame is compared with it. Both go through the
@@ -10,12 +10,11 @@
 //! agrees with the GPUs (tests/agree.rs), and the table says so.
 
 use super::{Variant, prepare_graph};
-use image::RgbaImage;
 use miette::Result;
 use std::collections::BTreeMap;
 use std::path::Path;
-use strandgraph::compare::{ImageDiff, flip};
-use strandgraph::images::{Display, main_picture};
+use strandgraph::compare::{ImageDiff, coverage_error, flip};
+use strandgraph::images::{Display, Picture, main_picture};
 use strandgraph::runner::{self, Backend, CpuOptions};
 
 /// The ground truth a pipeline's rows are measured against, if it has one.
@@ -37,7 +36,7 @@ pub const DISPLAY: Display = Display {
 /// References rendered so far, by backend, scene and graph.
 #[derive(Default)]
 pub struct References {
-    images: BTreeMap<(Backend, usize, &'static str), Result<RgbaImage, String>>,
+    images: BTreeMap<(Backend, usize, &'static str), Result<Picture, String>>,
     /// Lines for the report: where a reference came from another backend.
     pub notes: Vec<String>,
 }
@@ -51,11 +50,12 @@ pub struct Setup<'a> {
 }
 
 /// A row's picture against its pipeline's reference: the reference (kept
-/// for `bench --pictures`) and the FLIP difference (its mean is the
-/// table's FLIP, its error map the report's heat map).
+/// for `bench --pictures`), the FLIP difference (its mean is the table's
+/// FLIP, its error map the report's heat map) and the coverage error.
 pub struct Judged {
-    pub reference: RgbaImage,
+    pub reference: Picture,
     pub diff: ImageDiff,
+    pub coverage_error: Option<f32>,
 }
 
 impl References {
@@ -67,15 +67,23 @@ impl References {
         s: usize,
         setup: &Setup<'_>,
         v: &Variant,
-        image: &RgbaImage,
+        picture: &Picture,
     ) -> Result<Option<Judged>, String> {
         let Some(graph) = reference_graph(v.pipeline) else {
             return Ok(None);
         };
         let reference = self.reference(backend, s, setup, graph)?;
-        let diff = flip(&reference, image)
+        let diff = flip(&reference.image, &picture.image)
             .ok_or_else(|| format!("{graph}: the reference and the row differ in size"))?;
-        Ok(Some(Judged { reference, diff }))
+        let coverage_error = match (&reference.coverage, &picture.coverage) {
+            (Some(r), Some(t)) => coverage_error(r, t),
+            _ => None,
+        };
+        Ok(Some(Judged {
+            reference,
+            diff,
+            coverage_error,
+        }))
     }
 
     /// The reference of scene `s` on `backend`, else (once, shared by
@@ -86,7 +94,7 @@ impl References {
         s: usize,
         setup: &Setup<'_>,
         graph: &'static str,
-    ) -> Result<RgbaImage, String> {
+    ) -> Result<Picture, String> {
         if let Some(r) = self.images.get(&(backend, s, graph)) {
             return r.clone();
         }
@@ -105,7 +113,7 @@ impl References {
 }
 
 /// One frame of `graph` on `backend`, as a picture.
-fn render(backend: Backend, setup: &Setup<'_>, graph: &str) -> Result<RgbaImage> {
+fn render(backend: Backend, setup: &Setup<'_>, graph: &str) -> Result<Picture> {
     let p = prepare_graph(setup.scene, &super::locate(graph), setup.size, setup.quick)?;
     let mut session = runner::open(backend, &p.plan, &p.instance, setup.cpu)?;
     session.run(&p.upload)?;

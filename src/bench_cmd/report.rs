@@ -61,6 +61,8 @@ pub struct Stats {
     pub per_frame: Vec<Vec<f64>>,
     /// Mean FLIP of the last frame against the pipeline's reference.
     pub flip: Option<f32>,
+    /// Its coverage error against the reference (compare::coverage_error).
+    pub coverage_error: Option<f32>,
     /// Where `--pictures` saved the last frame, its FLIP map and reference.
     pub pictures: Option<Saved>,
 }
@@ -99,6 +101,7 @@ impl Stats {
                 .map(|f| f.iter().map(|t| t.millis.unwrap_or(f64::NAN)).collect())
                 .collect(),
             flip: None,
+            coverage_error: None,
             pictures: None,
         }
     }
@@ -268,21 +271,38 @@ impl Report {
     /// Mean FLIP per row and view, for the rows whose pipeline has a
     /// reference; empty when none has.
     fn quality_table(&self, rows: &[(Backend, Variant)]) -> String {
-        let mut o = String::new();
-        let w = 12;
         let with: Vec<&(Backend, Variant)> = rows
             .iter()
             .filter(|(_, v)| quality::reference_graph(v.pipeline).is_some())
             .collect();
         if with.is_empty() {
-            return o;
+            return String::new();
         }
-        let _ = writeln!(
-            o,
-            "\nQuality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)"
+        let mut o = self.metric_table(
+            &with,
+            "Quality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)",
+            |st| st.flip,
         );
+        o += &self.metric_table(
+            &with,
+            "Coverage error: mean |alpha - reference alpha| over the pixels with hair in either",
+            |st| st.coverage_error,
+        );
+        o
+    }
+
+    /// One line per row of `metric` at every view (three significant digits).
+    fn metric_table(
+        &self,
+        rows: &[&(Backend, Variant)],
+        title: &str,
+        metric: impl Fn(&Stats) -> Option<f32>,
+    ) -> String {
+        let mut o = String::new();
+        let w = 12;
+        let _ = writeln!(o, "\n{title}");
         self.header(&mut o, w);
-        for (b, v) in with {
+        for (b, v) in rows {
             let _ = write!(
                 o,
                 "  {:<5} {:<lw$}",
@@ -291,11 +311,11 @@ impl Report {
                 lw = label_width()
             );
             for s in 0..self.views.len() {
-                let flip = match self.cell_at(*b, v, s) {
-                    Some(Cell::Measured(st)) => st.flip,
+                let value = match self.cell_at(*b, v, s) {
+                    Some(Cell::Measured(st)) => metric(st),
                     _ => None,
                 };
-                let text = flip.map_or("-".into(), |f| {
+                let text = value.map_or("-".into(), |f| {
                     strandgraph::compare::flip_text(f64::from(f))
                 });
                 let _ = write!(o, " {text:>w$}");
@@ -498,6 +518,9 @@ impl Report {
                         if let Some(f) = st.flip {
                             j["flip"] = json!(f);
                             j["flip_reference"] = json!(quality::reference_graph(v.pipeline));
+                        }
+                        if let Some(e) = st.coverage_error {
+                            j["coverage_error"] = json!(e);
                         }
                         if let Some(p) = &st.pictures {
                             j["picture"] = json!(p.picture);

@@ -76,8 +76,8 @@ pub struct Cell {
     /// The reference graph FLIP is measured against
     /// (`scenes/graphs/lipp_reference.ron`); pipelines may share one.
     pub flip_reference: Option<String>,
-    /// Relative error of the summed coverage against the reference, where
-    /// the bench measures it.
+    /// Mean |alpha − reference alpha| over the pixels with hair in either
+    /// (compare::coverage_error).
     pub coverage_error: Option<f64>,
     #[serde(default)]
     pub passes: Vec<Pass>,

@@ -214,7 +214,7 @@ fn viewer(s: &Section<'_>, counts: &mut Counts) -> String {
 fn crop_note(c: &CropNote) -> String {
     format!(
         "<p class=\"crop-note\">1:1 crop {}x{} at ({}, {}) of the {}x{} frame; \
-         FLIP and coverage error are over the whole frame.</p>",
+         FLIP is over the whole frame, coverage error over its pixels with hair.</p>",
         c.width, c.height, c.x, c.y, c.frame_width, c.frame_height
     )
 }

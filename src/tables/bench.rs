@@ -124,7 +124,8 @@ pub fn frame_table(json: &Value) -> Result<String, String> {
 }
 
 /// Per backend and reference: a row per variant measured against it, a
-/// column per view; each cell the mean FLIP and the frame median.
+/// column per view; each cell the mean FLIP, the coverage error where
+/// measured, and the frame median.
 pub fn flip_table(json: &Value) -> Result<String, String> {
     let mut md = String::new();
     for (backend, device) in devices(json)? {
@@ -140,7 +141,7 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
             let rows = distinct(with(), label);
             let _ = writeln!(
                 md,
-                "{}; mean FLIP against `{reference}` (ACES, 0 EV; 0 is identical), then the median frame in ms:\n",
+                "{}; mean FLIP against `{reference}` (ACES, 0 EV; 0 is identical) / coverage error (mean \\|α − α<sub>ref</sub>\\| over the pixels with hair in either), then the median frame in ms:\n",
                 caption(json, &backend, &device)
             );
             grid(
@@ -149,9 +150,16 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
                 &rows,
                 &views,
                 |c| {
+                    let text = |key: &str| {
+                        crate::compare::flip_text(c[key].as_f64().unwrap_or(f64::NAN))
+                    };
+                    let coverage = c["coverage_error"]
+                        .is_number()
+                        .then(|| format!(" / {}", text("coverage_error")))
+                        .unwrap_or_default();
                     format!(
-                        "{} ({:.2})",
-                        crate::compare::flip_text(c["flip"].as_f64().unwrap_or(f64::NAN)),
+                        "{}{coverage} ({:.2})",
+                        text("flip"),
                         c["frame"]["median_ms"].as_f64().unwrap_or(f64::NAN)
                     )
                 },

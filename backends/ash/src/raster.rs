@@ -176,14 +176,14 @@ fn blend_attachment(draw: &Draw) -> vk::PipelineColorBlendAttachmentState {
     let a = vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask);
     match draw.blend {
         Blend::Replace => a,
-        // colour = src + (1 − src.a)·dst; the attachment's alpha stays.
-        Blend::PremultipliedOverKeepAlpha => a
+        // colour = src + (1 − src.a)·dst, alpha likewise.
+        Blend::PremultipliedOver => a
             .blend_enable(true)
             .src_color_blend_factor(vk::BlendFactor::ONE)
             .dst_color_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
             .color_blend_op(vk::BlendOp::ADD)
-            .src_alpha_blend_factor(vk::BlendFactor::ZERO)
-            .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+            .src_alpha_blend_factor(vk::BlendFactor::ONE)
+            .dst_alpha_blend_factor(vk::BlendFactor::ONE_MINUS_SRC_ALPHA)
             .alpha_blend_op(vk::BlendOp::ADD),
     }
 }

@@ -94,6 +94,7 @@ impl CpuKernel for ResolveKernel {
                 for k in 0..3 {
                     color[k] = color[k] * (1.0 - alpha) + c[k] * alpha;
                 }
+                color[3] = color[3] * (1.0 - alpha) + alpha;
                 if debug == 0 {
                     let depth = |l: usize| {
                         let p = vis.load(texel as usize + l * stride);

@@ -373,7 +373,8 @@ pub struct Hair {
 }
 
 impl Hair {
-    /// This colour blended over `scene` (which keeps its alpha).
+    /// This colour blended over `scene`, alpha included (`output`'s alpha
+    /// is the hair's coverage).
     pub fn over(&self, scene: [f32; 4]) -> [f32; 4] {
         let a = self.alpha;
         let c = self.color;
@@ -381,7 +382,7 @@ impl Hair {
             c[0] * a + scene[0] * (1.0 - a),
             c[1] * a + scene[1] * (1.0 - a),
             c[2] * a + scene[2] * (1.0 - a),
-            scene[3],
+            a + scene[3] * (1.0 - a),
         ]
     }
 }

@@ -239,7 +239,8 @@ impl CpuKernel for OpaqueKernel {
             let c = unpack(vis.load_u64(i))
                 .and_then(|(t, _)| self.shade_pixel(&view, &lights, t, xy, mask.load(i)))
                 .unwrap_or(background);
-            let [w0, w1] = pack([c.x, c.y, c.z, 1.0]);
+            // Alpha 0: no hair yet (`output`'s alpha is the hair's coverage).
+            let [w0, w1] = pack([c.x, c.y, c.z, 0.0]);
             out.store(2 * i, w0);
             out.store(2 * i + 1, w1);
             local.pixels_written += 1;

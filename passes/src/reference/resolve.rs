@@ -231,7 +231,7 @@ impl CpuKernel for ResolveKernel {
             let (hair, open) = resolve_pixel(&px, &list, lighting);
             let bg = load_rgba16f(&out, texel);
             let c = [0, 1, 2].map(|k| hair[k] + open * bg[k]);
-            store_rgba16f(&out, texel, [c[0], c[1], c[2], bg[3]]);
+            store_rgba16f(&out, texel, [c[0], c[1], c[2], 1.0 - open * (1.0 - bg[3])]);
         }
     }
 }

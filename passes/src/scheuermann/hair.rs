@@ -258,7 +258,7 @@ pub(super) fn stage_state(stage: Stage, p: &HairParams, q: &Quantities) -> Raste
         depth_compare,
         depth_write,
     };
-    let over = Blend::PremultipliedOverKeepAlpha;
+    let over = Blend::PremultipliedOver;
     let (cull, d) = match stage {
         Stage::PrimeDepth => (
             Cull::None,

@@ -249,14 +249,12 @@ impl<'a> Shared<'a> {
             );
             let src = match state.blend {
                 Blend::Replace => lit.truncate().extend(1.0),
-                Blend::PremultipliedOverKeepAlpha => (lit.truncate() * lit.w).extend(lit.w),
+                Blend::PremultipliedOver => (lit.truncate() * lit.w).extend(lit.w),
             };
             let dst = Vec4::from(load_rgba16f(&self.output, i));
             let out = match state.blend {
                 Blend::Replace => src,
-                Blend::PremultipliedOverKeepAlpha => {
-                    (src.truncate() + (1.0 - src.w) * dst.truncate()).extend(dst.w)
-                }
+                Blend::PremultipliedOver => src + (1.0 - src.w) * dst,
             };
             store_rgba16f(&self.output, i, out.to_array());
         }

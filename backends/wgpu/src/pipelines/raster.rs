@@ -215,15 +215,15 @@ fn compare(c: Compare) -> wgpu::CompareFunction {
 fn blend(b: Blend) -> Option<wgpu::BlendState> {
     match b {
         Blend::Replace => None,
-        Blend::PremultipliedOverKeepAlpha => Some(wgpu::BlendState {
+        Blend::PremultipliedOver => Some(wgpu::BlendState {
             color: wgpu::BlendComponent {
                 src_factor: wgpu::BlendFactor::One,
                 dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
                 operation: wgpu::BlendOperation::Add,
             },
             alpha: wgpu::BlendComponent {
-                src_factor: wgpu::BlendFactor::Zero,
-                dst_factor: wgpu::BlendFactor::One,
+                src_factor: wgpu::BlendFactor::One,
+                dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
                 operation: wgpu::BlendOperation::Add,
             },
         }),

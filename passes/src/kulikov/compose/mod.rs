@@ -421,6 +421,7 @@ impl CpuKernel for ComposeKernel {
                 for k in 0..3 {
                     color[k] = hair[k] + (1.0 - alpha) * color[k];
                 }
+                color[3] = alpha + (1.0 - alpha) * color[3];
                 touched = true;
                 if alpha >= self.0.depth_threshold
                     && let Some((_, w)) = layers.first()
