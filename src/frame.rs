@@ -72,11 +72,19 @@ pub fn complete_upload(plan: &Plan, scene: &Scene, up: &mut Upload) -> Result<Op
 
 /// Scheuermann's hair patches: built from the grooms (and the patch count
 /// set) only for a graph that imports `patches.vertices`, since no other
-/// pipeline draws them. Does nothing when the upload already holds them.
+/// pipeline draws them; likewise his shading inputs on the strands for a
+/// graph that imports `scheuermann.strand_shading` (his ground truth). Does
+/// nothing when the upload already holds them.
 fn build_patches(plan: &Plan, scene: &Scene, up: &mut Upload) {
-    use strandgraph_passes::scheuermann::upload::{VERTICES, pack};
+    use strandgraph_passes::scheuermann::upload::{
+        STRAND_SHADING, VERTICES, pack, pack_strand_shading,
+    };
     if plan.graph.resource_id(VERTICES).is_some() && !up.resources.contains_key(VERTICES) {
         pack(scene, up);
+    }
+    let wants = plan.graph.resource_id(STRAND_SHADING).is_some();
+    if wants && !up.resources.contains_key(STRAND_SHADING) {
+        pack_strand_shading(scene, up);
     }
 }
 

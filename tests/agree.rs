@@ -98,7 +98,12 @@ const LIPP_REFERENCE: Case = Case {
     size: (320, 180),
     ..REFERENCE
 };
-const ALL: [&Case; 10] = [
+/// Scheuermann's reference: the same lists, his shading per vertex.
+const SCHEUERMANN_REFERENCE: Case = Case {
+    graph: "scenes/graphs/scheuermann_reference.ron",
+    ..REFERENCE
+};
+const ALL: [&Case; 11] = [
     &SHOWCASE,
     &VISIBILITY,
     &LIPP,
@@ -109,6 +114,7 @@ const ALL: [&Case; 10] = [
     &HW_MESH,
     &REFERENCE,
     &LIPP_REFERENCE,
+    &SCHEUERMANN_REFERENCE,
 ];
 
 fn prepared(case: &Case) -> Prepared {
@@ -225,6 +231,11 @@ fn reference_passes_agree() {
 #[test]
 fn lipp_reference_passes_agree() {
     run(&LIPP_REFERENCE);
+}
+
+#[test]
+fn scheuermann_reference_passes_agree() {
+    run(&SCHEUERMANN_REFERENCE);
 }
 
 #[test]

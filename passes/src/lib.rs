@@ -82,6 +82,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &scheuermann::hair::OPAQUE,
     &scheuermann::hair::BACK_FACES,
     &scheuermann::hair::FRONT_FACES,
+    &scheuermann::reference_shade::REFERENCE_SHADE,
     // Hardware-rasterized strands: Lipp's Table 1 baseline.
     &hw_strands::assemble::ASSEMBLE,
     &hw_strands::raster::RASTER,

@@ -175,7 +175,7 @@ fn pack_grooms(scene: &Scene, triangle_first: &[u32]) -> PackedGrooms {
 
 /// The pipelines index segments as strand × (points − 1): grooms whose
 /// strands vary in length are resampled to the longest strand's count.
-fn uniform_groom(g: &SceneGroom) -> Cow<'_, Groom> {
+pub(crate) fn uniform_groom(g: &SceneGroom) -> Cow<'_, Groom> {
     if g.groom.uniform_points_per_strand().is_some() {
         return Cow::Borrowed(&g.groom);
     }

@@ -23,6 +23,7 @@ pub fn reference_graph(pipeline: &str) -> Option<&'static str> {
         "Kulikov" => Some("scenes/graphs/kulikov_reference.ron"),
         // The hardware-raster baselines shade with lipp.shade.
         "Lipp" | "HW strands" | "HW mesh" => Some("scenes/graphs/lipp_reference.ron"),
+        "Scheuermann" => Some("scenes/graphs/scheuermann_reference.ron"),
         _ => None,
     }
 }

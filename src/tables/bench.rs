@@ -150,9 +150,8 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
                 &rows,
                 &views,
                 |c| {
-                    let text = |key: &str| {
-                        crate::compare::flip_text(c[key].as_f64().unwrap_or(f64::NAN))
-                    };
+                    let text =
+                        |key: &str| crate::compare::flip_text(c[key].as_f64().unwrap_or(f64::NAN));
                     let coverage = c["coverage_error"]
                         .is_number()
                         .then(|| format!(" / {}", text("coverage_error")))

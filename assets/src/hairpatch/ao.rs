@@ -30,7 +30,7 @@ const EXTINCTION: f32 = 0.6;
 /// Fibonacci spiral on the unit disc lifted onto the hemisphere, which spreads them
 /// evenly in cosine-weighted measure, so an equal-weight mean approximates the cosine-
 /// weighted occlusion integral.
-fn directions() -> [Vec3; 8] {
+pub(super) fn directions() -> [Vec3; 8] {
     const GOLDEN_ANGLE: f32 = 2.399_963;
     std::array::from_fn(|k| {
         let r = ((k as f32 + 0.5) / 8.0).sqrt();
@@ -43,22 +43,35 @@ fn directions() -> [Vec3; 8] {
 pub(super) fn bake(patches: &mut [Patch], grid: &DensityGrid) {
     let dirs = directions();
     let marcher = grid.marcher();
-    // Beyond this depth a direction's transmittance is below 1e-4.
-    let limit = 9.3 / EXTINCTION;
     patches.par_iter_mut().for_each(|p| {
         for v in &mut p.vertices {
-            let b = v.tangent.cross(v.normal);
-            let from = grid.to_grid(v.position);
-            let sum: f32 = dirs
-                .iter()
-                .map(|d| {
-                    let dir = b * d.x + v.tangent * d.y + v.normal * d.z;
-                    (-EXTINCTION * marcher.optical_depth(from, dir, limit)).exp()
-                })
-                .sum();
-            v.ao = (sum / dirs.len() as f32).clamp(0.0, 1.0);
+            v.ao = occlusion(grid, &marcher, &dirs, v.position, v.tangent, v.normal);
         }
     });
+}
+
+/// The AO of one point with unit `tangent` and `normal`: the mean
+/// transmittance along `dirs` over the hemisphere about `normal`.
+pub(super) fn occlusion(
+    grid: &DensityGrid,
+    marcher: &crate::density::Marcher<'_>,
+    dirs: &[Vec3; 8],
+    position: Vec3,
+    tangent: Vec3,
+    normal: Vec3,
+) -> f32 {
+    // Beyond this depth a direction's transmittance is below 1e-4.
+    let limit = 9.3 / EXTINCTION;
+    let b = tangent.cross(normal);
+    let from = grid.to_grid(position);
+    let sum: f32 = dirs
+        .iter()
+        .map(|d| {
+            let dir = b * d.x + tangent * d.y + normal * d.z;
+            (-EXTINCTION * marcher.optical_depth(from, dir, limit)).exp()
+        })
+        .sum();
+    (sum / dirs.len() as f32).clamp(0.0, 1.0)
 }
 
 /// Strand length (in cell lengths) per cell, splatted at half-cell steps along every

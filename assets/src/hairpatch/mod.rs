@@ -11,6 +11,7 @@
 mod ao;
 mod centre;
 mod outward;
+mod strand_shading;
 mod strip;
 pub mod texture;
 
@@ -21,6 +22,7 @@ use serde::{Deserialize, Serialize};
 use crate::groom::Groom;
 use crate::hairmesh::fit::kmeans;
 
+pub use strand_shading::{StrandShading, strand_shading};
 pub use texture::HairTexture;
 
 /// Quads along every patch, root to tip (so 2 * (PATCH_SEGMENTS + 1) vertices per patch).
@@ -222,14 +224,14 @@ fn clumps(strands: &Strands, params: &PatchParams) -> Vec<Vec<u32>> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::procedural::surface::{Shape, Surface};
     use crate::procedural::{GroomParams, HeadParams, Style};
 
     /// Strands planted on the upper half of a sphere of radius 0.1 about the origin,
     /// combed down over it and hanging below, in `shells` radial layers 6 mm apart.
-    fn sphere_groom(shells: usize) -> Groom {
+    pub(super) fn sphere_groom(shells: usize) -> Groom {
         let mut strands = Vec::new();
         for shell in 0..shells {
             for a in 0..48 {

@@ -110,6 +110,22 @@ impl HairTexture {
     }
 }
 
+impl HairTexture {
+    /// The level-0 columns that lie on one of the texture's strands (not in
+    /// a gap or on a variant's border), left to right.
+    pub fn strand_columns(seed: u64) -> Vec<u32> {
+        (0..Self::VARIANTS)
+            .flat_map(|variant| {
+                strand_columns(seed, variant)
+                    .into_iter()
+                    .enumerate()
+                    .filter(|(_, c)| matches!(c, Some((_, true))))
+                    .map(move |(x, _)| variant * Self::COLUMNS + x as u32)
+            })
+            .collect()
+    }
+}
+
 /// The box average of two texels, rounding to nearest (halves up).
 fn average(a: [u8; 4], b: [u8; 4]) -> [u8; 4] {
     [0, 1, 2, 3].map(|c| (a[c] as u16 + b[c] as u16).div_ceil(2) as u8)

@@ -228,7 +228,7 @@ stage_kind!(
 );
 
 /// The WGSL parameter block of `stage`.
-fn gpu_block(stage: Stage, p: &HairParams, q: &Quantities) -> HairGpu {
+pub(super) fn gpu_block(stage: Stage, p: &HairParams, q: &Quantities) -> HairGpu {
     HairGpu {
         stage: stage as u32,
         primed: flag(p.primed),

@@ -18,6 +18,7 @@ pub mod hair;
 #[cfg(test)]
 mod hair_tests;
 mod kernel;
+pub mod reference_shade;
 pub mod shading;
 pub mod texture;
 pub mod upload;

@@ -13,13 +13,58 @@ use super::texture;
 use crate::upload::Upload;
 use glam::{Mat3, Vec3};
 use strandgraph_assets::Scene;
-use strandgraph_assets::hairpatch::{HairPatches, HairTexture, PatchVertex};
+use strandgraph_assets::hairpatch::{HairPatches, HairTexture, PatchVertex, strand_shading};
 use strandgraph_assets::octahedral::pack_unit_vector;
 
 /// Resource names.
 pub const VERTICES: &str = "patches.vertices";
 pub const MODELS: &str = "patches.models";
 pub const TEXTURE: &str = "patches.texture";
+/// Per groom vertex, Scheuermann's shading inputs on the strands
+/// themselves, for his ground truth (scenes/graphs/scheuermann_reference.ron).
+pub const STRAND_SHADING: &str = "scheuermann.strand_shading";
+
+/// Words per vertex of [`STRAND_SHADING`]: octahedral world normal, AO,
+/// texture u, texture v (0 at the root, 1 at the tip).
+pub const STRAND_SHADING_WORDS: usize = 4;
+
+/// Adds [`STRAND_SHADING`] for every vertex of `groom.vertices` (in its
+/// order: grooms in scene order, each as `upload` resamples it) and, if
+/// missing, the hair texture.
+pub fn pack_strand_shading(scene: &Scene, up: &mut Upload) {
+    let mut words: Vec<u32> = Vec::new();
+    for g in &scene.grooms {
+        let started = std::time::Instant::now();
+        let groom = crate::upload::uniform_groom(g);
+        let place = Placement::new(g.world);
+        let shading = strand_shading(&groom, g.patches.seed);
+        tracing::info!(
+            groom = %g.name,
+            points = shading.len(),
+            ms = started.elapsed().as_secs_f64() * 1e3,
+            "strand shading inputs built"
+        );
+        for s in 0..groom.strand_count() {
+            let range = groom.strand_range(s);
+            let last = range.len().saturating_sub(1).max(1) as f32;
+            for (i, p) in range.enumerate() {
+                let x = &shading[p];
+                let n = pack_unit_vector((place.directions * x.normal).normalize_or(Vec3::Y));
+                words.extend([
+                    n,
+                    x.ao.to_bits(),
+                    x.u.to_bits(),
+                    (i as f32 / last).to_bits(),
+                ]);
+            }
+        }
+    }
+    up.set(STRAND_SHADING, words);
+    if !up.resources.contains_key(TEXTURE) {
+        let seed = scene.grooms.first().map_or(1, |g| g.patches.seed);
+        up.set(TEXTURE, texture::words(&HairTexture::generate(seed)));
+    }
+}
 
 /// Builds the patches of every groom and adds them, the hair texture and
 /// the patch count to `up`.
