@@ -8,7 +8,8 @@ in its own call (benches/device.sh).
 
 With `--add PIPELINE`, the first file is an already merged result and the
 cells of PIPELINE's rows (say, "HW mesh") from the later runs of the same
-device are added to it, replacing any it had; the notes say which runs.
+device are added to it, replacing those it had on the backends the later
+runs measured; the notes say which runs.
 
     python3 benches/merge_runs.py --add "HW mesh" benches/results/h100.json ash/bench.json wgpu/bench.json
 """
@@ -37,9 +38,11 @@ else:
     added = [c for r in runs[1:] for c in r["cells"] if c["pipeline"] == add]
     if not added:
         sys.exit(f"no `{add}` cells in the added runs")
+    measured = {c["backend"] for c in added}
+    replaced = lambda c: c["pipeline"] == add and c["backend"] in measured
     # In place of the cells they replace, so the tables keep their row order.
-    at = next((i for i, c in enumerate(out["cells"]) if c["pipeline"] == add), len(out["cells"]))
-    kept = [c for c in out["cells"] if c["pipeline"] != add]
+    at = next((i for i, c in enumerate(out["cells"]) if replaced(c)), len(out["cells"]))
+    kept = [c for c in out["cells"] if not replaced(c)]
     out["cells"] = kept[:at] + added + kept[at:]
     out["elapsed_s"] = out["elapsed_s"] + sum(r["elapsed_s"] for r in runs[1:])
     out["notes"] = out["notes"] + [f"`{add}` rows added from later runs on the same device (benches/merge_runs.py --add): {backends}"]
