@@ -152,10 +152,11 @@ pub fn flip_table(json: &Value) -> Result<String, String> {
                 |c| {
                     let text =
                         |key: &str| crate::compare::flip_text(c[key].as_f64().unwrap_or(f64::NAN));
-                    let coverage = c["coverage_error"]
-                        .is_number()
-                        .then(|| format!(" / {}", text("coverage_error")))
-                        .unwrap_or_default();
+                    let coverage = if c["coverage_error"].is_number() {
+                        format!(" / {}", text("coverage_error"))
+                    } else {
+                        String::new()
+                    };
                     format!(
                         "{}{coverage} ({:.2})",
                         text("flip"),
