@@ -10,6 +10,7 @@ mod graph_cmd;
 mod info;
 mod render_cmd;
 mod report_cmd;
+mod shell_cmd;
 mod tables_cmd;
 
 use clap::{Parser, Subcommand};
@@ -40,6 +41,10 @@ enum Command {
     Report(report_cmd::Args),
     /// Regenerate (or --check) README's tables from the measurements under benches/results/.
     Tables(tables_cmd::Args),
+    /// Print the shell completion script for bash, zsh, fish, elvish or PowerShell.
+    Completions(shell_cmd::CompletionsArgs),
+    /// Write the manual pages (roff), one per subcommand.
+    Man(shell_cmd::ManArgs),
 }
 
 fn main() -> ExitCode {
@@ -60,6 +65,8 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare_cmd::run(args),
         Command::Report(args) => report_cmd::run(args),
         Command::Tables(args) => tables_cmd::run(args),
+        Command::Completions(args) => shell_cmd::completions::<Cli>(args),
+        Command::Man(args) => shell_cmd::man::<Cli>(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -197,7 +197,7 @@ fn check_cropped(run: &Path) {
     assert!(out.status.success(), "{}", words(&out));
     let json = read_json(&small.join("bench.json"));
     let dom = check_page(&small.join("index.html"), &json);
-    let note = "1:1 crop 64x48 at (48, 21) of the 160x90 frame; FLIP and coverage error are over the whole frame";
+    let note = "1:1 crop 64x48 at (48, 21) of the 160x90 frame; FLIP is over the whole frame, coverage error over its pixels with hair";
     assert!(dom.contains(note), "no crop note in the page");
     let named = pictures(&json);
     for rel in &named {
