@@ -21,6 +21,7 @@ add = None
 if args[:1] == ["--add"]:
     add, args = args[1], args[2:]
 runs = [json.load(open(p)) for p in args]
+partial = [p for p, r in zip(args, runs) if r.get("partial")]
 for key in ("frames", "warmup", "size", "cpu_subgroup_width"):
     if any(r[key] != runs[0][key] for r in runs):
         sys.exit(f"runs differ in {key}: {[r[key] for r in runs]}")
@@ -46,5 +47,8 @@ else:
     out["cells"] = kept[:at] + added + kept[at:]
     out["elapsed_s"] = out["elapsed_s"] + sum(r["elapsed_s"] for r in runs[1:])
     out["notes"] = out["notes"] + [f"`{add}` rows added from later runs on the same device (benches/merge_runs.py --add): {backends}"]
+if partial:
+    out["notes"].append(f"partial runs (stopped before their last row; their finished rows are kept): {', '.join(partial)}")
+out["partial"] = False
 json.dump(out, sys.stdout, indent=2, sort_keys=True)
 print()

@@ -378,9 +378,15 @@ pub fn run(mut args: Args) -> Result<()> {
                     Err(e) => return Err(e),
                 }
             }
+            if let Some(dir) = &args.out {
+                report.elapsed_s = t0.elapsed().as_secs_f64();
+                report.partial = true;
+                report.write(dir)?;
+            }
         }
     }
     progress.finish();
+    report.partial = false;
     for line in references.notes.drain(..) {
         report.note(line);
     }

@@ -292,6 +292,8 @@ fn report_renders_and_loads_in_chromium() {
         String::from_utf8_lossy(&out.stderr)
     );
     let json = read_json(&dir.join("bench.json"));
+    // Rewritten after every row while it ran; complete now.
+    assert_eq!(json["partial"], false);
     for cell in json["cells"].as_array().unwrap() {
         let pic = cell["picture"].as_str().expect("every cell has a picture");
         assert!(dir.join(pic).is_file(), "{pic}");

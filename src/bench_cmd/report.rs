@@ -156,6 +156,10 @@ pub struct Report {
     cells: Vec<(Backend, Variant, usize, Cell)>,
     notes: Vec<String>,
     pub elapsed_s: f64,
+    /// While the bench runs, `--out` is rewritten after every row with
+    /// what is measured so far ("partial": true in the JSON), so a run cut
+    /// short (a device's time limit) keeps its finished rows.
+    pub partial: bool,
 }
 
 /// A row's `pipeline: variant` label.
@@ -207,6 +211,7 @@ impl Report {
             cells: Vec::new(),
             notes: Vec::new(),
             elapsed_s: 0.0,
+            partial: false,
         }
     }
     /// A line printed under the table (and kept in the JSON).
@@ -571,6 +576,7 @@ impl Report {
             "cells": cells,
             "notes": self.notes,
             "elapsed_s": self.elapsed_s,
+            "partial": self.partial,
         })
     }
 

@@ -22,6 +22,9 @@ pub struct Bench {
     pub crops: Vec<CropNote>,
     /// Written by `report --jpeg`: the pictures' JPEG quality.
     pub jpeg_quality: Option<u8>,
+    /// A bench cut short: the rows it finished.
+    #[serde(default)]
+    pub partial: bool,
 }
 
 /// A view whose pictures are the `width`x`height` rectangle at (`x`, `y`)

@@ -91,6 +91,9 @@ fn header(b: &Bench, secs: &[Section<'_>], source: &str) -> String {
             " · pictures as JPEG of quality {q} (FLIP is of the lossless frames)"
         );
     }
+    if b.partial {
+        took.push_str(" · <strong>partial run</strong>: the bench stopped before its last row");
+    }
     let _ = write!(
         o,
         "<p class=\"meta\">{} · {} timed frame{} after {} warm-up{took} · from <a href=\"{src}\">{src}</a></p>",
