@@ -216,3 +216,30 @@ fn showcase_composed_matches_cpu_on_ash() {
         .unwrap_or_else(|e| panic!("second frame: {e}"));
     assert_eq!(read_ash(&session, name), a, "the second frame differs");
 }
+
+/// A frame that does not finish within the session's timeout ends with an
+/// error naming the pass it is stuck at, rather than waiting forever: with
+/// no time at all, lavapipe has barely started the showcase.
+#[test]
+fn a_frame_past_its_timeout_names_the_unfinished_pass() {
+    let graph = root().join("scenes/graphs/kulikov.ron");
+    let p = prepare(
+        &root().join("scenes/showcase.ron"),
+        Some(&graph),
+        Some((640, 360)),
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let backend = strandgraph_ash::AshBackend {
+        timeout: std::time::Duration::ZERO,
+        ..Default::default()
+    };
+    let err = match backend.execute(&p.plan, &p.instance, &p.upload) {
+        Ok(_) => panic!("the showcase finished within no time at all"),
+        Err(e) => e.to_string(),
+    };
+    eprintln!("{err}");
+    assert!(
+        err.contains("no completion within 0 ms") && err.contains("unfinished: pass `"),
+        "{err}"
+    );
+}

@@ -177,10 +177,40 @@ impl Session {
         match unsafe { self.gpu.device.wait_semaphores(&info, timeout) } {
             Ok(()) => Ok(()),
             Err(vk::Result::TIMEOUT) => Err(AshError::Timeout {
-                what: format!("waiting for {what}"),
+                what: format!("waiting for {what}{}", self.unfinished(f)),
                 millis: self.timeout.as_millis(),
             }),
             Err(e) => Err(AshError::vk(format!("waiting for {what}"), e)),
+        }
+    }
+
+    /// The passes frame `f` is stuck at: per lane, the first pass whose
+    /// batch has not signalled its timeline value (a hung shader is in it,
+    /// or in a pass submitted in the same batch after it).
+    fn unfinished(&self, f: u64) -> String {
+        let g = &self.plan.graph;
+        let mut stuck = Vec::new();
+        for lane in &self.lanes.lanes {
+            // SAFETY: a live timeline semaphore.
+            let value = unsafe {
+                self.gpu
+                    .device
+                    .get_semaphore_counter_value(lane.semaphore.raw())
+            };
+            let done = value.map_or(0, |v| v.saturating_sub(f * self.stride)) as usize;
+            if let Some(&p) = lane.passes.get(done) {
+                stuck.push(format!(
+                    "pass `{}` (queue {}, {done} of {} passes done)",
+                    g.passes[p].name,
+                    lane.queue,
+                    lane.passes.len()
+                ));
+            }
+        }
+        if stuck.is_empty() {
+            String::new()
+        } else {
+            format!(" (unfinished: {})", stuck.join(", "))
         }
     }
 

@@ -67,6 +67,12 @@ pub enum WgpuError {
     Pass { pass: String, message: String },
     #[error("wgpu validation: {0}")]
     Validation(String),
+    /// One submission holds every pass, so wgpu cannot say which one hung
+    /// (the ash backend names it).
+    #[error(
+        "wgpu: the GPU did not finish the frame and its readback within {millis} ms (a shader that does not end, or a lost device; run on ash to see the pass)"
+    )]
+    Timeout { millis: u128 },
     #[error("no resource `{0}`")]
     NoResource(String),
 }

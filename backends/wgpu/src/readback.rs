@@ -2,6 +2,10 @@
 
 use super::*;
 
+/// How long a readback waits for the GPU (the frame before it included):
+/// a shader that never ends becomes an error, not a hang (ash's default).
+pub(crate) const GPU_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(60);
+
 /// Copies `bytes` of `buffer` into a mappable buffer and reads it.
 pub(crate) fn read_buffer(
     device: &wgpu::Device,
@@ -33,9 +37,19 @@ pub(crate) fn map_and_read(
             *mapped.lock().unwrap_or_else(|e| e.into_inner()) = Some(r);
         });
     }
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| WgpuError::Validation(format!("poll: {e}")))?;
+    let wait = wgpu::PollType::Wait {
+        submission_index: None,
+        timeout: Some(GPU_TIMEOUT),
+    };
+    match device.poll(wait) {
+        Ok(_) => {}
+        Err(wgpu::PollError::Timeout) => {
+            return Err(WgpuError::Timeout {
+                millis: GPU_TIMEOUT.as_millis(),
+            });
+        }
+        Err(e) => return Err(WgpuError::Validation(format!("poll: {e}"))),
+    }
     match mapped.lock().unwrap_or_else(|e| e.into_inner()).take() {
         Some(Ok(())) => {}
         Some(Err(e)) => return Err(WgpuError::Validation(format!("map: {e}"))),
