@@ -238,7 +238,11 @@ fn write_outputs(
         } else {
             main.to_path_buf()
         };
-        let saved = match (exr, to_linear(&p.plan, r, &words, q.width, q.height)) {
+        // The float image only for EXR: at 16384x16384 it is 4 GiB.
+        let linear = exr
+            .then(|| to_linear(&p.plan, r, &words, q.width, q.height))
+            .flatten();
+        let saved = match (exr, linear) {
             (true, Some(img)) => img.save(&path),
             _ => match to_picture(&p.plan, r, &words, q.width, q.height, extras.display) {
                 Some(img) if !exr => img.save(&path),

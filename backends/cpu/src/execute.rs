@@ -32,6 +32,14 @@ pub enum CpuError {
     },
     #[error("pass `{pass}`: kernel panicked: {message}")]
     KernelPanic { pass: String, message: String },
+    #[error(
+        "the plan needs {needed} of memory ({largest} the largest) and {available} is available: render smaller (--size) or on a GPU backend"
+    )]
+    OutOfMemory {
+        needed: String,
+        largest: String,
+        available: String,
+    },
 }
 
 /// How the simulator runs.
@@ -48,6 +56,9 @@ pub struct CpuBackend {
     /// ([`Session::captured`]): the inputs the per-pass agreement harness
     /// replays on the GPU backends.
     pub capture: bool,
+    /// Refuse a plan needing more memory than this many bytes; `None`: what
+    /// the host has available (`/proc/meminfo`), unchecked where unknown.
+    pub memory_limit: Option<u64>,
 }
 
 impl Default for CpuBackend {
@@ -58,6 +69,7 @@ impl Default for CpuBackend {
             alias: true,
             sync_timeout: Duration::from_secs(120),
             capture: false,
+            memory_limit: None,
         }
     }
 }
@@ -167,7 +179,7 @@ impl CpuBackend {
         Ok(Session {
             backend: self.clone(),
             prepared: self.prepare(defs, plan)?,
-            memory: Memory::new(plan, instance, self.alias),
+            memory: Memory::new(plan, instance, self.alias, self.memory_limit)?,
             plan: plan.clone(),
             instance: instance.clone(),
             timings: Vec::new(),

@@ -39,8 +39,15 @@ fn words_of(bytes: u64) -> usize {
 
 impl Memory {
     /// Lays out memory for `instance`. With `alias` false every transient
-    /// gets its own range, the reference the aliased layout is diffed against.
-    pub fn new(plan: &Plan, instance: &Instance, alias: bool) -> Memory {
+    /// gets its own range, the reference the aliased layout is diffed
+    /// against. More than `limit` bytes (default: what the host has
+    /// available) is an error.
+    pub fn new(
+        plan: &Plan,
+        instance: &Instance,
+        alias: bool,
+        limit: Option<u64>,
+    ) -> Result<Memory, CpuError> {
         let g = &plan.graph;
         let mut homes = vec![Home::Unused; g.resources.len()];
         // Heaps sit back to back in one arena: buffers, then images.
@@ -70,6 +77,7 @@ impl Memory {
             }
         }
         let arena_bytes = cursor;
+        check_budget(plan, instance, arena_bytes, limit.or_else(available_bytes))?;
         let arena = (0..words_of(arena_bytes))
             .map(|_| AtomicU32::new(0))
             .collect();
@@ -83,13 +91,13 @@ impl Memory {
             homes[r] = Home::Owned(owned.len());
             owned.push((0..len).map(|_| AtomicU32::new(0)).collect());
         }
-        Memory {
+        Ok(Memory {
             arena,
             owned,
             homes,
             out_of_bounds: AtomicU64::new(0),
             arena_bytes,
-        }
+        })
     }
 
     /// Writes a frame's inputs into the imported and history resources they
@@ -140,4 +148,56 @@ impl Memory {
                 .collect(),
         )
     }
+}
+
+/// The memory the host can still give, from `/proc/meminfo` (`None`
+/// elsewhere, where nothing is checked).
+fn available_bytes() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Refuses a plan whose memory (the transient arena plus every imported
+/// and history resource) exceeds `available`, naming the largest resource:
+/// sizes follow the output's resolution and the scene, both user input, so
+/// an allocation the host cannot hold must be an error, not an abort.
+fn check_budget(
+    plan: &Plan,
+    instance: &Instance,
+    arena_bytes: u64,
+    available: Option<u64>,
+) -> Result<(), CpuError> {
+    let Some(available) = available else {
+        return Ok(());
+    };
+    let g = &plan.graph;
+    let owned = (0..g.resources.len()).filter(|&r| {
+        g.resources[r].version_of.is_none()
+            && g.resources[r].decl.lifetime() != LifetimeClass::Transient
+    });
+    let needed = arena_bytes + owned.clone().map(|r| instance.sizes[r].bytes).sum::<u64>();
+    if needed <= available {
+        return Ok(());
+    }
+    let largest = (0..g.resources.len())
+        .filter(|&r| g.resources[r].version_of.is_none())
+        .max_by_key(|&r| instance.sizes[r].bytes)
+        .map_or(String::from("-"), |r| {
+            format!(
+                "`{}` at {}",
+                g.resources[r].name,
+                gib(instance.sizes[r].bytes)
+            )
+        });
+    Err(CpuError::OutOfMemory {
+        needed: gib(needed),
+        largest,
+        available: gib(available),
+    })
+}
+
+fn gib(bytes: u64) -> String {
+    format!("{:.2} GiB", bytes as f64 / (1u64 << 30) as f64)
 }

@@ -353,3 +353,30 @@ fn imported_inputs_are_uploaded_and_checked() {
         .expect("too many words");
     assert!(matches!(err, CpuError::Input { .. }), "{err}");
 }
+
+#[test]
+fn a_plan_larger_than_the_memory_limit_is_refused_by_name() {
+    let plan = compile_str("cross.ron", CROSS_QUEUE, &kinds(), 1).unwrap();
+    let inst = plan.instantiate(&quantities()).unwrap();
+    let backend = CpuBackend {
+        memory_limit: Some(1024),
+        ..CpuBackend::default()
+    };
+    let err = backend
+        .execute_with(&TestDefs, &plan, &inst, &Inputs::default())
+        .err()
+        .expect("over the limit");
+    assert!(matches!(err, CpuError::OutOfMemory { .. }), "{err}");
+    let text = err.to_string();
+    assert!(text.contains("the largest") && text.contains('`'), "{text}");
+    // At the plan's own size it runs.
+    let roomy = CpuBackend {
+        memory_limit: Some(1 << 30),
+        ..CpuBackend::default()
+    };
+    assert!(
+        roomy
+            .execute_with(&TestDefs, &plan, &inst, &Inputs::default())
+            .is_ok()
+    );
+}
