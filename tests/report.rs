@@ -40,22 +40,28 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// Runs `cmd` to its end or kills it after `limit` (a hung browser must
-/// fail the test, not stall it).
+/// fail the test, not stall it). Its output is drained while it runs: a
+/// DOM over the pipe's 64 KiB would otherwise block the browser forever.
 fn run_for(mut cmd: Command, limit: Duration) -> Output {
-    let mut child = cmd
+    let child = cmd
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .expect("spawn");
-    let t0 = Instant::now();
-    while child.try_wait().expect("wait").is_none() {
-        if t0.elapsed() > limit {
-            let _ = child.kill();
+    let pid = child.id();
+    let (done, result) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = done.send(child.wait_with_output().expect("output"));
+    });
+    match result.recv_timeout(limit) {
+        Ok(out) => out,
+        Err(_) => {
+            let _ = Command::new("kill")
+                .args(["-KILL", &pid.to_string()])
+                .status();
             panic!("{cmd:?} ran past {limit:?}");
         }
-        std::thread::sleep(Duration::from_millis(100));
     }
-    child.wait_with_output().expect("output")
 }
 
 /// The page's DOM after load, and Chromium's log.

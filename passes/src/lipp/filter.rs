@@ -84,7 +84,7 @@ pub struct FilterParams {
     /// Convert the hit ratio to the strands' own width (ours; see above).
     pub true_width: bool,
     /// Pixels; `lipp.raster`'s `centre_diameter`, the line width the hit
-    /// ratio measures (tests/shipped_graphs.rs checks the graphs agree).
+    /// ratio measures (a test in passes/src/lib.rs checks the graphs agree).
     pub centre_diameter: f32,
     /// The groom being filtered (set by the graph's per-model repeat).
     pub model_index: u32,
