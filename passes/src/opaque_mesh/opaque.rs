@@ -317,7 +317,8 @@ mod tests {
         let lit = unpack(&out, 16 * 32 + 16);
         let expected = p.albedo[0] * (3.0 / std::f32::consts::PI + p.ambient);
         assert!((lit[0] - expected).abs() < 1e-2, "{lit:?} vs {expected}");
-        assert_eq!(lit[3], 1.0);
+        // No hair yet: `output`'s alpha is the hair's coverage.
+        assert_eq!(lit[3], 0.0);
         let corner = unpack(&out, 0);
         assert!((corner[2] - p.background[2]).abs() < 1e-3, "{corner:?}");
     }
@@ -344,7 +345,7 @@ mod tests {
     fn procedural_head_covers_a_plausible_blob() {
         let (depth, out, oob) = render(&head(), 128, 128);
         assert_eq!(oob, 0);
-        let bg = pack([0.02, 0.02, 0.025, 1.0]);
+        let bg = pack([0.02, 0.02, 0.025, 0.0]);
         let covered = (0..depth.len())
             .filter(|&i| [out[2 * i], out[2 * i + 1]] != bg)
             .count();
@@ -355,7 +356,7 @@ mod tests {
         assert_eq!(covered, deep);
         // The face is lit: the centre is brighter than the ambient floor.
         let c = unpack(&out, 64 * 128 + 64);
-        assert!(c[0] > 0.2 && c[3] == 1.0, "{c:?}");
+        assert!(c[0] > 0.2 && c[3] == 0.0, "{c:?}");
     }
 
     #[test]
