@@ -12,7 +12,7 @@
 #import strandgraph::half::pack_radiance
 
 @group(0) @binding(4) var<storage, read> groom_vertices: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> strand_shading: array<vec4<u32>>;
+@group(0) @binding(5) var<storage, read> scheuermann_strand_shading: array<vec4<u32>>;
 @group(0) @binding(7) var<storage, read_write> vertex_lighting: array<vec2<u32>>;
 
 fn world_of(m: u32, v: u32) -> vec3<f32> {
@@ -22,7 +22,7 @@ fn world_of(m: u32, v: u32) -> vec3<f32> {
 @compute @workgroup_size(256)
 fn reference_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = gid.x;
-    if v >= min(arrayLength(&groom_vertices), arrayLength(&strand_shading)) {
+    if v >= min(arrayLength(&groom_vertices), arrayLength(&scheuermann_strand_shading)) {
         return;
     }
     // reference_shade::model_of: the last model starting at or before v.
@@ -37,7 +37,7 @@ fn reference_shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     let world = world_of(m, v);
     let before = world_of(m, v - min(i, 1u));
     let after = world_of(m, v + select(1u, 0u, i + 1u >= n));
-    let s = strand_shading[v];
+    let s = scheuermann_strand_shading[v];
     let tex = sample_level(0u, bitcast<vec2<f32>>(s.zw));
     let lit = hair_lighting_at(world, after - before, unpack_unit_vector(s.x), bitcast<f32>(s.y), tex, m);
     vertex_lighting[v] = pack_radiance(lit.rgb);
