@@ -121,10 +121,11 @@ pub fn standard_samples(n: u32) -> Vec<[i64; 2]> {
 impl Setup {
     /// Sets up the triangle with clip-space corners `clip`, or `None` when it
     /// is culled: a back face, degenerate after snapping, off screen, or with
-    /// a corner at or behind the near plane (w ≤ `near`). Dropping near-plane
-    /// crossers instead of clipping them is deliberate: heads never cross the
-    /// near plane in our scenes, and the WGSL vertex shaders drop them the same
-    /// way so every backend agrees.
+    /// a corner behind the near plane (w < `near`; a strand quad's corner cut
+    /// at the plane has w = `near` exactly, see `common::clip`). Dropping
+    /// near-plane crossers instead of clipping them is deliberate: heads never
+    /// cross the near plane in our scenes, and the WGSL vertex shaders drop
+    /// them the same way so every backend agrees.
     pub fn from_clip(clip: [Vec4; 3], near: f32, width: u32, height: u32) -> Option<Self> {
         Self::from_clip_culled(clip, near, width, height, Cull::Back)
     }
@@ -182,7 +183,7 @@ impl Setup {
         let mut z = [0.0f32; 3];
         let mut inv_w = [0.0f32; 3];
         for (k, c) in clip.iter().enumerate() {
-            if c.w.is_nan() || c.w <= near {
+            if !(c.w >= near && c.w > 0.0) {
                 return None;
             }
             let iw = 1.0 / c.w;

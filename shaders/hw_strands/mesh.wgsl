@@ -25,7 +25,7 @@ enable wgpu_mesh_shader;
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{LOD_WORDS, RASTER_GROUP, MAX_CONTROL_POINTS}
 #import strandgraph::hw_strands_segment::segment_bits
-#import strandgraph::hw_strands_quad::{QuadVertex, corner_position, write_sample}
+#import strandgraph::hw_strands_quad::{QuadVertex, quad_corner_clipped, write_sample}
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, ControlPoint, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
 
 struct MeshParams {
@@ -121,7 +121,8 @@ fn ms_main(
         let bits = segment_bits(a, strip_tangent(strip, m), b, strip_tangent(strip, m + 1u), st.uv);
         let v = 4u * (g - lo);
         for (var corner = 0u; corner < 4u; corner++) {
-            mesh_out.vertices[v + corner] = QuadVertex(corner_position(ca, cb, corner, params.width_px, size, frame.near), f32(corner & 1u), bits.x, bits.y);
+            let c = quad_corner_clipped(ca, cb, corner, params.width_px, size, frame.near);
+            mesh_out.vertices[v + corner] = QuadVertex(c.position, c.t, bits.x, bits.y);
         }
         // hw_strands::CORNERS as indices: (a-, b-, a+) and (a+, b-, b+).
         let p = 2u * (g - lo);

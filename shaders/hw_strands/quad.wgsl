@@ -6,12 +6,13 @@
 //   #define SCENE_DEPTH_BINDING 4
 //   #define HAIR_DEPTH_BINDING 5
 //   #define GBUFFER_BINDING 6
-//   #import strandgraph::hw_strands_quad::{corner_position, write_sample, ...}
+//   #import strandgraph::hw_strands_quad::{quad_corner_clipped, write_sample, ...}
 // Each pass numbers its bindings in the order of its definition's bindings()
 // (passes/tests/wgsl_bindings.rs checks it); the defines say where these sit.
 #define_import_path strandgraph::hw_strands_quad
 
 #import strandgraph::lipp::{quantize, depth_bits}
+#import strandgraph::clip::near_clip
 
 @group(0) @binding(#{SCENE_DEPTH_BINDING}) var scene_depth: texture_2d<f32>;
 @group(0) @binding(#{HAIR_DEPTH_BINDING}) var<storage, read> hair_depth: array<u32>;
@@ -29,7 +30,8 @@ const CORNERS: array<u32, 6> = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
 // view (80.9 against 63.9 ms), where mesh shaders have no record to load.
 struct QuadVertex {
     @builtin(position) position: vec4<f32>,
-    // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t.
+    // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t
+    // (a cut end's parameter where the near plane cuts the segment).
     @location(0) @interpolate(linear, sample) t: f32,
     @location(1) @interpolate(flat) bits_a: u32,
     @location(2) @interpolate(flat) bits_b: u32,
@@ -56,15 +58,23 @@ fn quad_corner(a: vec4<f32>, b: vec4<f32>, corner: u32, half: f32, size: vec2<f3
     return vec4<f32>(c.xy + ndc * c.w, c.z, c.w);
 }
 
-// Where corner `corner` of the quad of segment (a, b), `width_px` wide,
-// goes. lipp.raster drops a segment with an end at or behind the near
-// plane: such a quad's corners all lie outside the clip volume at one
-// point, so nothing is drawn.
-fn corner_position(a: vec4<f32>, b: vec4<f32>, corner: u32, width_px: f32, size: vec2<f32>, near: f32) -> vec4<f32> {
-    if a.w > near && b.w > near {
-        return quad_corner(a, b, corner, 0.5 * width_px, size);
+// A quad corner: its clip position and its parameter t along the segment.
+struct Corner {
+    position: vec4<f32>,
+    t: f32,
+}
+
+// View::triangles: corner `corner` of the `width_px` wide quad of the part
+// of segment (a, b) in front of the near plane (near_clip), as lipp.raster
+// draws that part. With no such part every corner is the same point outside
+// the clip volume, so nothing is drawn.
+fn quad_corner_clipped(a: vec4<f32>, b: vec4<f32>, corner: u32, width_px: f32, size: vec2<f32>, near: f32) -> Corner {
+    let part = near_clip(a, b, near);
+    let t = select(part.ta, part.tb, (corner & 1u) != 0u);
+    if part.valid {
+        return Corner(quad_corner(part.a, part.b, corner, 0.5 * width_px, size), t);
     }
-    return vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    return Corner(vec4<f32>(2.0, 2.0, 2.0, 1.0), t);
 }
 
 // Segment::payload's 6-bit interpolation, operation for operation.

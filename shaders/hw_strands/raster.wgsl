@@ -16,7 +16,7 @@
 #define HAIR_DEPTH_BINDING 5
 #define GBUFFER_BINDING 6
 #import strandgraph::layout::FrameData
-#import strandgraph::hw_strands_quad::{corner_position, write_sample, CORNERS}
+#import strandgraph::hw_strands_quad::{quad_corner_clipped, write_sample, CORNERS}
 
 struct RasterParams {
     // Quad width in pixels (lipp.raster's centre_diameter).
@@ -41,7 +41,8 @@ const VERTICES_PER_SEGMENT: u32 = 6u;
 
 struct Varyings {
     @builtin(position) position: vec4<f32>,
-    // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t.
+    // 0 at end a, 1 at end b, linear in screen space like lipp.raster's t
+    // (a cut end's parameter where the near plane cuts the segment).
     @location(0) @interpolate(linear, sample) t: f32,
     // The fragment shader loads the segment's payload bits (quad.wgsl's
     // QuadVertex says why).
@@ -71,7 +72,9 @@ fn vs_main(@builtin(vertex_index) vertex: u32) -> Varyings {
     }
     let base = segment * SEGMENT_WORDS;
     let size = vec2<f32>(f32(params.width), f32(params.height));
-    out.position = corner_position(clip_at(base), clip_at(base + 4u), corner, params.width_px, size, frame.near);
+    let c = quad_corner_clipped(clip_at(base), clip_at(base + 4u), corner, params.width_px, size, frame.near);
+    out.position = c.position;
+    out.t = c.t;
     return out;
 }
 

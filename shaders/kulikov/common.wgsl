@@ -13,7 +13,7 @@
 // (naga_oil: identifiers of a composable module must not end in a digit.)
 
 #import strandgraph::layout::{ModelData, ModelLod, ModelTiles}
-#import strandgraph::clip::clip_to_screen
+#import strandgraph::clip::{clip_to_screen, near_clip, clip_at}
 
 // Atlas tile edge in texels (kulikov::TILE) and texels per tile.
 const TILE: u32 = 64u;
@@ -256,17 +256,26 @@ fn trapezoid_new(a_in: vec2<f32>, b_in: vec2<f32>, half_a: f32, half_b: f32, wa:
     return t;
 }
 
-// compose::segment_trapezoid (and RasterKernel's setup): the segment from
-// clip position c0 to c1 as a trapezoid in its model's raster grid, in the
-// CPU's operation order, so raster, composition and motion see one shape.
-fn model_trapezoid(t: ModelTiles, lod: ModelLod, c0: vec4<f32>, c1: vec4<f32>, thick_a: f32, thick_b: f32, screen: vec2<f32>, pixels_per_unit: f32) -> Trapezoid {
+// compose::segment_trapezoid (and RasterKernel's setup): the part of the
+// segment from clip position c0 to c1 in front of the near plane (near_clip)
+// as a trapezoid in its model's raster grid, in the CPU's operation order,
+// so raster, composition and motion see one shape.
+fn model_trapezoid(t: ModelTiles, lod: ModelLod, c0_in: vec4<f32>, c1_in: vec4<f32>, thick_a: f32, thick_b: f32, screen: vec2<f32>, pixels_per_unit: f32, near: f32) -> Trapezoid {
+    let clipped = near_clip(c0_in, c1_in, near);
+    if !clipped.valid {
+        var none: Trapezoid;
+        none.valid = false;
+        return none;
+    }
+    let c0 = clipped.a;
+    let c1 = clipped.b;
     let d = f32(t.downscale);
     let origin = vec2<f32>(f32(t.origin_x * TILE), f32(t.origin_y * TILE));
     let sa = clip_to_screen(c0, screen.x, screen.y);
     let sb = clip_to_screen(c1, screen.x, screen.y);
     // Strand width in raster pixels: thickness x LOD compensation x projection.
-    let ha = 0.5 * thick_a * lod.thickness_scale * pixels_per_unit / c0.w / d;
-    let hb = 0.5 * thick_b * lod.thickness_scale * pixels_per_unit / c1.w / d;
+    let ha = 0.5 * clip_at(thick_a, thick_b, clipped.ta) * lod.thickness_scale * pixels_per_unit / c0.w / d;
+    let hb = 0.5 * clip_at(thick_a, thick_b, clipped.tb) * lod.thickness_scale * pixels_per_unit / c1.w / d;
     return trapezoid_new(sa.xy / d - origin, sb.xy / d - origin, ha, hb, c0.w, c1.w);
 }
 

@@ -16,6 +16,7 @@
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, ModelTiles, MODEL_FACIAL_HAIR}
 #import strandgraph::half::unpack_radiance
 #import strandgraph::kulikov::{load_lod, load_tiles, tile_texel, total_coverage, drawn_in_model, model_trapezoid, quad_pixel_coverage, trapezoid_depth_at, segment_in_model, EMPTY, LAYERS, TILE, SEGMENT_MASK, COVERAGE_SCALE}
+#import strandgraph::clip::{near_clip, clip_at3}
 
 struct ComposeParams {
     poisson_samples: u32,
@@ -193,8 +194,10 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
         if !seg.valid {
             continue;
         }
-        let trap = model_trapezoid(t, lod, clip_positions[seg.va], clip_positions[seg.vb],
-            groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit);
+        let c0 = clip_positions[seg.va];
+        let c1 = clip_positions[seg.vb];
+        let trap = model_trapezoid(t, lod, c0, c1, groom_vertices[seg.va].w, groom_vertices[seg.vb].w,
+            frame.screen.xy, frame.pixels_per_unit, frame.near);
         if !trap.valid {
             continue;
         }
@@ -213,7 +216,11 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
             out.front_w = trapezoid_depth_at(trap.a, trap.b, trap.wa, trap.wb, u, v);
         }
         cov[n] = clamp(coverage, 0.0, 1.0);
-        lit[n] = mix(lighting(seg.va), lighting(seg.vb), tt);
+        // The vertex lighting at the ends of the part in front of the near plane.
+        let part = near_clip(c0, c1, frame.near);
+        let la = lighting(seg.va);
+        let lb = lighting(seg.vb);
+        lit[n] = mix(clip_at3(la, lb, part.ta), clip_at3(la, lb, part.tb), tt);
         n += 1u;
     }
     // Kulikov: C_front by alpha blending; missing lighting as the weighted

@@ -12,7 +12,7 @@
 #define LOD_MODELS_BINDING 3
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::layout::ModelData
-#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::clip::{transform, clip_to_screen, near_clip}
 #import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
 #import strandgraph::subgroup::elected
 
@@ -60,12 +60,15 @@ struct Verdict {
 }
 
 // CullKernel::test.
-fn test(seg: DrawnSegment, c0: vec4<f32>, c1: vec4<f32>) -> Verdict {
+fn test(seg: DrawnSegment, c0_in: vec4<f32>, c1_in: vec4<f32>) -> Verdict {
     var out = Verdict(false, vec4<u32>(0u), 0u);
-    // Segments reaching behind the near plane are not drawn.
-    if c0.w <= frame.near || c1.w <= frame.near {
+    // Only the part in front of the near plane is drawn.
+    let part = near_clip(c0_in, c1_in, frame.near);
+    if !part.valid {
         return out;
     }
+    let c0 = part.a;
+    let c1 = part.b;
     if params.frustum != 0u {
         let right = c0.x > c0.w && c1.x > c1.w;
         let left = -c0.x > c0.w && -c1.x > c1.w;

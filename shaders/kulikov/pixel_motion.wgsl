@@ -63,7 +63,8 @@ fn front_layer(m: u32, x: u32, y: u32, z: f32) -> Front {
     }
     let d = t.downscale;
     let trap = model_trapezoid(t, lod, clip_positions[seg.va], clip_positions[seg.vb],
-        groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit);
+        groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit,
+        frame.near);
     if !trap.valid {
         return out;
     }

@@ -122,13 +122,12 @@ fn project(index: u32) -> Segment {
     }
     let lod = load_lod(lod_models[seg.model]);
     let tiles = load_tiles(atlas_tiles[seg.model]);
-    let c0 = clip_positions[seg.va];
-    let c1 = clip_positions[seg.vb];
-    if c0.w <= frame.near || c1.w <= frame.near || tiles.valid == 0u {
+    if tiles.valid == 0u {
         return out;
     }
-    let trap = model_trapezoid(tiles, lod, c0, c1, groom_vertices[seg.va].w, groom_vertices[seg.vb].w,
-        frame.screen.xy, frame.pixels_per_unit);
+    let trap = model_trapezoid(tiles, lod, clip_positions[seg.va], clip_positions[seg.vb],
+        groom_vertices[seg.va].w, groom_vertices[seg.vb].w, frame.screen.xy, frame.pixels_per_unit,
+        frame.near);
     if !trap.valid {
         return out;
     }

@@ -7,7 +7,7 @@
 #define MODELS_BINDING 2
 #define LOD_MODELS_BINDING 3
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
-#import strandgraph::clip::clip_to_screen
+#import strandgraph::clip::{clip_to_screen, near_clip}
 #import strandgraph::kulikov::screen_bin
 #import strandgraph::scan::{scan_run, scan_lanes, scan_total, SCAN_LANES}
 
@@ -81,8 +81,10 @@ fn scatter(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
         }
         let w = frame.screen.x;
         let h = frame.screen.y;
-        let s0 = clip_to_screen(clip_positions[seg.va], w, h);
-        let s1 = clip_to_screen(clip_positions[seg.vb], w, h);
+        // The bin the cull counted: that of the part in front of the near plane.
+        let part = near_clip(clip_positions[seg.va], clip_positions[seg.vb], frame.near);
+        let s0 = clip_to_screen(part.a, w, h);
+        let s1 = clip_to_screen(part.b, w, h);
         slot = atomicAdd(&sort_offsets[screen_bin(w, h, s0, s1)], 1u);
     } else {
         slot = atomicAdd(&sort_offsets[params.bins], 1u);

@@ -14,7 +14,7 @@
 #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
-#import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::clip::{transform, clip_to_screen, near_clip, clip_at, clip_at3}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
@@ -53,16 +53,13 @@ struct End {
     tangent: vec3<f32>,
     w: f32,
     ao: f32,
-    ok: bool,
 }
 
-fn project(cp: ControlPoint, tangent: vec3<f32>) -> End {
-    let c = transform(frame.view_proj, vec4<f32>(cp.pos, 1.0));
-    if c.w <= frame.near {
-        return End(0.0, 0.0, 0.0, tangent, cp.w, cp.ao, false);
-    }
+// Target::project: one end of the part of segment (a, b) in front of the
+// near plane, at its clip position c and parameter t along (a, b).
+fn project_end(c: vec4<f32>, t: f32, a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>) -> End {
     let s = clip_to_screen(c, frame.screen.x, frame.screen.y);
-    return End(snap(s.x), snap(s.y), s.z, tangent, cp.w, cp.ao, true);
+    return End(snap(s.x), snap(s.y), s.z, clip_at3(ta, tb, t), clip_at(a.w, b.w, t), clip_at(a.ao, b.ao, t));
 }
 
 // payload::pack's tangent bits: octahedral x (high word) and y (low word,
@@ -229,9 +226,11 @@ fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
 }
 
 fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, bits: vec2<u32>, per_sample: bool) {
-    let pa = project(a, ta);
-    let pb = project(b, tb);
-    if pa.ok && pb.ok {
+    let part = near_clip(transform(frame.view_proj, vec4<f32>(a.pos, 1.0)),
+        transform(frame.view_proj, vec4<f32>(b.pos, 1.0)), frame.near);
+    if part.valid {
+        let pa = project_end(part.a, part.ta, a, ta, b, tb);
+        let pb = project_end(part.b, part.tb, a, ta, b, tb);
         if params.msaa > 1u {
             draw_segment_msaa(pa, pb, bits, per_sample);
         } else {

@@ -5,7 +5,7 @@
 //   #import strandgraph::reference::{Ribbon, ribbon_covers, ...}
 #define_import_path strandgraph::reference
 
-#import strandgraph::clip::clip_to_screen
+#import strandgraph::clip::{clip_to_screen, near_clip, clip_at}
 
 // reference::TILE: the lists' screen tile edge.
 const REFERENCE_TILE: u32 = 8u;
@@ -31,27 +31,35 @@ struct Ribbon {
     join_b: bool,
     va: u32,
     vb: u32,
+    // The parameters of a and b along the segment (Ribbon::range).
+    range: vec2<f32>,
 }
 
-// Ribbon::new for the segment from clip position c0 to c1 with world
-// thicknesses t0, t1 and end vertices va, vb; not valid when an end lies at
-// or behind the near plane.
-fn ribbon_of(c0: vec4<f32>, c1: vec4<f32>, t0: f32, t1: f32, join_a: bool, join_b: bool, va: u32, vb: u32, near: f32, screen: vec2<f32>, pixels_per_unit: f32) -> Ribbon {
+// Ribbon::new: the part in front of the near plane (near_clip) of the
+// segment from clip position c0 to c1 with world thicknesses t0, t1 and end
+// vertices va, vb; a cut end has no join.
+fn ribbon_of(c0_in: vec4<f32>, c1_in: vec4<f32>, t0_in: f32, t1_in: f32, join_a: bool, join_b: bool, va: u32, vb: u32, near: f32, screen: vec2<f32>, pixels_per_unit: f32) -> Ribbon {
     var r: Ribbon;
-    r.valid = c0.w >= near && c1.w >= near;
+    let part = near_clip(c0_in, c1_in, near);
+    r.valid = part.valid;
     if !r.valid {
         return r;
     }
+    let c0 = part.a;
+    let c1 = part.b;
+    let t0 = clip_at(t0_in, t1_in, part.ta);
+    let t1 = clip_at(t0_in, t1_in, part.tb);
     r.a = clip_to_screen(c0, screen.x, screen.y).xy;
     r.b = clip_to_screen(c1, screen.x, screen.y).xy;
     r.ha = 0.5 * t0 * pixels_per_unit / c0.w;
     r.hb = 0.5 * t1 * pixels_per_unit / c1.w;
     r.wa = c0.w;
     r.wb = c1.w;
-    r.join_a = join_a;
-    r.join_b = join_b;
+    r.join_a = join_a && part.ta == 0.0;
+    r.join_b = join_b && part.tb == 1.0;
     r.va = va;
     r.vb = vb;
+    r.range = vec2<f32>(part.ta, part.tb);
     return r;
 }
 
@@ -60,11 +68,15 @@ fn ribbon_pack(r: Ribbon) -> array<vec4<u32>, 3> {
     if !r.valid {
         return array<vec4<u32>, 3>(vec4<u32>(0u), vec4<u32>(0u), vec4<u32>(0u));
     }
-    let flags = 1u | (u32(r.join_a) << 1u) | (u32(r.join_b) << 2u);
+    // The near plane cuts at most one end.
+    let cut_a = r.range.x != 0.0;
+    let cut_b = r.range.y != 1.0;
+    let flags = 1u | (u32(r.join_a) << 1u) | (u32(r.join_b) << 2u) | (u32(cut_a) << 3u) | (u32(cut_b) << 4u);
+    let cut = select(select(0.0, r.range.y, cut_b), r.range.x, cut_a);
     return array<vec4<u32>, 3>(
         bitcast<vec4<u32>>(vec4<f32>(r.a, r.b)),
         bitcast<vec4<u32>>(vec4<f32>(r.ha, r.hb, r.wa, r.wb)),
-        vec4<u32>(r.va, r.vb, flags, 0u),
+        vec4<u32>(r.va, r.vb, flags, bitcast<u32>(cut)),
     );
 }
 
@@ -72,7 +84,9 @@ fn ribbon_pack(r: Ribbon) -> array<vec4<u32>, 3> {
 fn ribbon_unpack(w0: vec4<u32>, w1: vec4<u32>, w2: vec4<u32>) -> Ribbon {
     let p = bitcast<vec4<f32>>(w0);
     let h = bitcast<vec4<f32>>(w1);
-    return Ribbon((w2.z & 1u) != 0u, p.xy, p.zw, h.x, h.y, h.z, h.w, (w2.z & 2u) != 0u, (w2.z & 4u) != 0u, w2.x, w2.y);
+    let cut = bitcast<f32>(w2.w);
+    let range = vec2<f32>(select(0.0, cut, (w2.z & 8u) != 0u), select(1.0, cut, (w2.z & 16u) != 0u));
+    return Ribbon((w2.z & 1u) != 0u, p.xy, p.zw, h.x, h.y, h.z, h.w, (w2.z & 2u) != 0u, (w2.z & 4u) != 0u, w2.x, w2.y, range);
 }
 
 // Ribbon::axis.
@@ -122,11 +136,12 @@ fn ribbon_depth_at(r: Ribbon, t: f32) -> f32 {
     return 1.0 / ((1.0 - t) / r.wa + t / r.wb);
 }
 
-// Ribbon::world_t: the perspective-correct parameter along the segment.
+// Ribbon::world_t: the perspective-correct parameter along the segment
+// (through range where the near plane cut an end).
 fn ribbon_world_t(r: Ribbon, t: f32) -> f32 {
     let ia = (1.0 - t) / r.wa;
     let ib = t / r.wb;
-    return ib / (ia + ib);
+    return clip_at(r.range.x, r.range.y, ib / (ia + ib));
 }
 
 // bin::reached_tiles: the tile rectangle of the ribbon's bounds, as

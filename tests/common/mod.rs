@@ -86,8 +86,28 @@ pub fn check_flip(
     test: &[u32],
     max_mean: f32,
 ) {
+    check_flip_of(
+        p,
+        "output.final",
+        test_name,
+        label,
+        reference,
+        test,
+        max_mean,
+    );
+}
+
+/// [`check_flip`] of image resource `name`.
+pub fn check_flip_of(
+    p: &Prepared,
+    name: &str,
+    test_name: &str,
+    label: &str,
+    reference: &[u32],
+    test: &[u32],
+    max_mean: f32,
+) {
     let label = &format!("{}.{label}", p.plan.graph.name);
-    let name = "output.final";
     let (w, h) = (p.upload.quantities.width, p.upload.quantities.height);
     let r = p.plan.graph.resource_id(name).unwrap();
     let a = to_picture(&p.plan, r, reference, w, h, Display::CLIP).unwrap();

@@ -1,3 +1,4 @@
 //! Passes every pipeline uses.
 
 pub mod clear;
+pub mod clip;

@@ -25,6 +25,7 @@
 //! [`crate::hardware_raster`] at the standard sample locations.
 
 use super::{CORNERS, SEGMENT_WORDS, Segment, VERTICES_PER_SEGMENT, quad_corner};
+use crate::common::clip::near_clip;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::hardware_raster::{SampledFragment, Setup, standard_samples};
@@ -258,40 +259,38 @@ struct View {
 }
 
 impl View {
-    /// Segment `s`'s two triangles (the vertex shader, then setup).
+    /// Segment `s`'s two triangles (the vertex shader, then setup): the quad
+    /// of its part in front of the near plane, as `lipp.raster` draws it.
     fn triangles(&self, s: &Segment) -> impl Iterator<Item = Triangle> + '_ {
-        let visible = s.a.w > self.near && s.b.w > self.near;
+        let part = near_clip(s.a.to_array(), s.b.to_array(), self.near);
         let size = Vec2::new(self.width as f32, self.height as f32);
         let s = *s;
-        CORNERS
-            .chunks(3)
-            .filter(move |_| visible)
-            .filter_map(move |tri| {
-                let clip: [Vec4; 3] =
-                    [0, 1, 2].map(|k| quad_corner(s.a, s.b, tri[k], self.half, size));
-                let setup = Setup::from_clip_multisampled(
-                    clip,
-                    self.near,
-                    self.width,
-                    self.height,
-                    Cull::None,
-                )?;
-                Some(Triangle {
-                    setup,
-                    t: [0, 1, 2].map(|k| (tri[k] & 1) as f32),
-                    segment: s,
-                })
+        CORNERS.chunks(3).filter_map(move |tri| {
+            let part = part?;
+            let (a, b) = (Vec4::from_array(part.a), Vec4::from_array(part.b));
+            let clip: [Vec4; 3] = [0, 1, 2].map(|k| quad_corner(a, b, tri[k], self.half, size));
+            let setup = Setup::from_clip_multisampled(
+                clip,
+                self.near,
+                self.width,
+                self.height,
+                Cull::None,
+            )?;
+            Some(Triangle {
+                setup,
+                t: [0, 1, 2].map(|k| if tri[k] & 1 != 0 { part.tb } else { part.ta }),
+                segment: s,
             })
+        })
     }
 
-    /// The rows segment `s`'s quad may reach: its ends' rows, `half` a pixel
-    /// and one row of margin either side.
+    /// The rows segment `s`'s quad may reach: its clipped ends' rows, `half`
+    /// a pixel and one row of margin either side.
     fn rows(&self, s: &Segment) -> Option<(u32, u32)> {
-        if s.a.w <= self.near || s.b.w <= self.near {
-            return None;
-        }
-        let y = |c: Vec4| (0.5 - c.y / c.w * 0.5) * self.height as f32;
-        let (lo, hi) = (y(s.a).min(y(s.b)), y(s.a).max(y(s.b)));
+        let part = near_clip(s.a.to_array(), s.b.to_array(), self.near)?;
+        let y = |c: [f32; 4]| (0.5 - c[1] / c[3] * 0.5) * self.height as f32;
+        let (ya, yb) = (y(part.a), y(part.b));
+        let (lo, hi) = (ya.min(yb), ya.max(yb));
         let margin = self.half + 1.0;
         if !(hi + margin >= 0.0 && lo - margin < self.height as f32) {
             return None;

@@ -8,6 +8,7 @@
 //! bins are filled here too ("Populate sorting bins in visibility culling pass").
 
 use super::{ModelLod, Scene, TILE, clip_to_screen, transform};
+use crate::common::clip::near_clip;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
@@ -150,11 +151,10 @@ impl CullKernel {
         c1: [f32; 4],
     ) -> Option<([u32; 4], u32)> {
         let f = &scene.frame;
-        // Segments reaching behind the near plane would need clipping; hair that
-        // close to the camera is not drawn.
-        if c0[3] <= f.near || c1[3] <= f.near {
-            return None;
-        }
+        // Only the part in front of the near plane is drawn (the raster's
+        // segment_trapezoid clips the same way).
+        let part = near_clip(c0, c1, f.near)?;
+        let (c0, c1) = (part.a, part.b);
         if self.0.frustum {
             let out = |axis: usize, sign: f32| sign * c0[axis] > c0[3] && sign * c1[axis] > c1[3];
             if out(0, 1.0)

@@ -139,7 +139,8 @@ impl CpuKernel for PixelMotionKernel {
                     let Some(seg) = drawn_segment(&scene, &lods, id) else {
                         continue;
                     };
-                    let Some(trap) = segment_trapezoid(&scene, ctx, t, &lods[mi], seg.v0, seg.v1)
+                    let Some((trap, _)) =
+                        segment_trapezoid(&scene, ctx, t, &lods[mi], seg.v0, seg.v1)
                     else {
                         continue;
                     };

@@ -9,6 +9,7 @@
 
 use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
 use super::{Scene, clip_to_screen};
+use crate::common::clip::near_clip;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
@@ -145,8 +146,16 @@ impl CpuKernel for ScatterKernel {
                 let Some(seg) = drawn_segment(&scene, &lods, id) else {
                     continue;
                 };
-                let s0 = clip_to_screen(clip.load_vec4(seg.v0 as usize), w, h);
-                let s1 = clip_to_screen(clip.load_vec4(seg.v1 as usize), w, h);
+                // The bin the cull counted: that of the part in front of the near plane.
+                let (c0, c1) = (
+                    clip.load_vec4(seg.v0 as usize),
+                    clip.load_vec4(seg.v1 as usize),
+                );
+                let Some(part) = near_clip(c0, c1, scene.frame.near) else {
+                    continue;
+                };
+                let s0 = clip_to_screen(part.a, w, h);
+                let s1 = clip_to_screen(part.b, w, h);
                 offsets.fetch_add(screen_bin(w, h, s0, s1) as usize, 1)
             } else {
                 offsets.fetch_add(counter, 1)

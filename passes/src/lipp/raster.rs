@@ -43,6 +43,7 @@ use super::payload::{Sample, pack};
 use super::strand::{ControlPoint, strand_uv};
 use super::walk::Dda;
 use super::{RASTER_GROUP, frame, mix, normalize, transform};
+use crate::common::clip::{at, near_clip};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
@@ -212,20 +213,31 @@ fn snap(v: f32) -> f32 {
 }
 
 impl Target<'_> {
-    fn project(&self, cp: &ControlPoint, tangent: [f32; 3]) -> Option<End> {
-        let c = transform(&self.f.view_proj, [cp.pos[0], cp.pos[1], cp.pos[2], 1.0]);
-        if c[3] <= self.f.near {
-            return None;
-        }
-        let s = crate::kulikov::clip_to_screen(c, self.f.screen[0], self.f.screen[1]);
-        Some(End {
-            x: snap(s[0]),
-            y: snap(s[1]),
-            z: s[2],
-            tangent,
-            w: cp.w,
-            ao: cp.ao,
-        })
+    /// Segment (a, b)'s ends on screen: the part in front of the near plane,
+    /// its attributes interpolated to a cut end.
+    fn project(
+        &self,
+        a: &ControlPoint,
+        ta: [f32; 3],
+        b: &ControlPoint,
+        tb: [f32; 3],
+    ) -> Option<(End, End)> {
+        let clip = |cp: &ControlPoint| {
+            transform(&self.f.view_proj, [cp.pos[0], cp.pos[1], cp.pos[2], 1.0])
+        };
+        let part = near_clip(clip(a), clip(b), self.f.near)?;
+        let end = |c: [f32; 4], t: f32| {
+            let s = crate::kulikov::clip_to_screen(c, self.f.screen[0], self.f.screen[1]);
+            End {
+                x: snap(s[0]),
+                y: snap(s[1]),
+                z: s[2],
+                tangent: [0, 1, 2].map(|k| at(ta[k], tb[k], t)),
+                w: at(a.w, b.w, t),
+                ao: at(a.ao, b.ao, t),
+            }
+        };
+        Some((end(part.a, part.ta), end(part.b, part.tb)))
     }
 
     /// Writes the sample at parameter `t` of segment (a, b) into pixel (x, y)
@@ -374,7 +386,7 @@ impl CpuKernel for RasterKernel {
             target.uv = strand_uv(k);
             let layers = &strands.layers;
             let (active, lanes) = assemble(layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
-                if let (Some(pa), Some(pb)) = (target.project(a, ta), target.project(b, tb)) {
+                if let Some((pa, pb)) = target.project(a, ta, b, tb) {
                     target.segment(&pa, &pb);
                 }
             });

@@ -253,6 +253,7 @@ mod tests {
             wb: w,
             join_a: false,
             join_b: false,
+            range: [0.0, 1.0],
         };
         Candidate {
             id,

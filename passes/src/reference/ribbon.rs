@@ -9,6 +9,7 @@
 //! at the root and the tip the end is cut flat (no cap beyond the strand).
 //! The same arithmetic, in the same order, is `shaders/reference/ribbon.wgsl`.
 
+use crate::common::clip::{at, near_clip};
 use crate::kernel::Words;
 use crate::kulikov::clip_to_screen;
 use crate::layout::FrameData;
@@ -27,13 +28,17 @@ pub struct Ribbon {
     /// Whether the strand continues beyond `a` / `b` (a round join there).
     pub join_a: bool,
     pub join_b: bool,
+    /// The parameters of `a` and `b` along the segment: `[0, 1]` unless
+    /// the near plane cuts one end (`common::clip`).
+    pub range: [f32; 2],
 }
 
 /// Pixels per sample grid cell are never finer than this: 16 × 16.
 pub const MAX_SAMPLES_PER_AXIS: u32 = 16;
 
 /// Words of a segment's record in `reference_ribbons`: the ribbon, its end
-/// vertices and flags (bit 0 drawn, bit 1 joined at `a`, bit 2 at `b`).
+/// vertices, flags (bit 0 drawn, bit 1 joined at `a`, bit 2 at `b`, bit 3
+/// `a` cut by the near plane, bit 4 `b` cut) and the cut end's parameter.
 pub const RECORD_WORDS: usize = 12;
 
 /// A drawn segment's ribbon and end vertices, as `reference.count` stores
@@ -64,11 +69,23 @@ impl Record {
         }
         w.store(b + 8, vertices[0]);
         w.store(b + 9, vertices[1]);
+        // The near plane cuts at most one end.
+        let (cut_a, cut_b) = (r.range[0] != 0.0, r.range[1] != 1.0);
         w.store(
             b + 10,
-            1 | u32::from(r.join_a) << 1 | u32::from(r.join_b) << 2,
+            1 | u32::from(r.join_a) << 1
+                | u32::from(r.join_b) << 2
+                | u32::from(cut_a) << 3
+                | u32::from(cut_b) << 4,
         );
-        w.store(b + 11, 0);
+        let cut = if cut_a {
+            r.range[0]
+        } else if cut_b {
+            r.range[1]
+        } else {
+            0.0
+        };
+        w.store_f32(b + 11, cut);
     }
 
     /// The record of segment `id`, `None` when it is not drawn.
@@ -89,6 +106,10 @@ impl Record {
                 wb: f(7),
                 join_a: flags & 2 != 0,
                 join_b: flags & 4 != 0,
+                range: [
+                    if flags & 8 != 0 { f(11) } else { 0.0 },
+                    if flags & 16 != 0 { f(11) } else { 1.0 },
+                ],
             },
             vertices: [w.load(b + 8), w.load(b + 9)],
         })
@@ -96,10 +117,10 @@ impl Record {
 }
 
 impl Ribbon {
-    /// The segment from clip position `c0` to `c1` with world thicknesses
-    /// `t0`, `t1`. `None` when an end lies at or behind the near plane (the
-    /// skinning pass leaves skipped vertices at w = 0): the reference draws
-    /// no hair that crosses the camera.
+    /// The part in front of the near plane ([`near_clip`]) of the segment
+    /// from clip position `c0` to `c1` with world thicknesses `t0`, `t1`;
+    /// `None` when no part is (the skinning pass leaves skipped vertices at
+    /// w = 0). A cut end is flat: no join beyond the plane.
     pub fn new(
         frame: &FrameData,
         c0: [f32; 4],
@@ -109,9 +130,9 @@ impl Ribbon {
         join_a: bool,
         join_b: bool,
     ) -> Option<Self> {
-        if !(c0[3] >= frame.near && c1[3] >= frame.near) {
-            return None;
-        }
+        let part = near_clip(c0, c1, frame.near)?;
+        let (c0, c1) = (part.a, part.b);
+        let [t0, t1] = part.ends(t0, t1);
         let (sa, sb) = (
             clip_to_screen(c0, frame.screen[0], frame.screen[1]),
             clip_to_screen(c1, frame.screen[0], frame.screen[1]),
@@ -123,8 +144,9 @@ impl Ribbon {
             hb: 0.5 * t1 * frame.pixels_per_unit / c1[3],
             wa: c0[3],
             wb: c1[3],
-            join_a,
-            join_b,
+            join_a: join_a && part.ta == 0.0,
+            join_b: join_b && part.tb == 1.0,
+            range: [part.ta, part.tb],
         })
     }
 
@@ -189,10 +211,11 @@ impl Ribbon {
     }
 
     /// The perspective-correct parameter along the world segment at
-    /// screen-space parameter `t`, for interpolating vertex attributes.
+    /// screen-space parameter `t`, for interpolating vertex attributes
+    /// (through `range` when the near plane cut an end).
     pub fn world_t(&self, t: f32) -> f32 {
         let (ia, ib) = ((1.0 - t) / self.wa, t / self.wb);
-        ib / (ia + ib)
+        at(self.range[0], self.range[1], ib / (ia + ib))
     }
 }
 
@@ -234,6 +257,7 @@ mod tests {
             hb: h,
             wa: 1.0,
             wb: 1.0,
+            range: [0.0, 1.0],
             join_a: false,
             join_b: false,
         }
@@ -289,5 +313,47 @@ mod tests {
         assert!((r.world_t(0.5) - 0.25).abs() < 1e-6);
         assert!((r.depth_at(0.5) - 1.5).abs() < 1e-6);
         assert_eq!(r.depth_at(0.0), 1.0);
+    }
+
+    #[test]
+    fn the_near_plane_cuts_a_crossing_segment_flat() {
+        use bytemuck::Zeroable;
+        let mut f = FrameData::zeroed();
+        f.screen = [100.0, 100.0, 0.01, 0.01];
+        f.near = 0.5;
+        f.pixels_per_unit = 100.0;
+        // From w = 2.5 in front to w = -1.5 behind: the plane cuts at t = 1/2.
+        let (front, behind) = ([0.0, 0.0, 1.0, 2.5], [1.0, 0.0, -1.0, -1.5]);
+        let r = Ribbon::new(&f, front, behind, 0.01, 0.03, true, true).unwrap();
+        assert_eq!((r.range, r.wa, r.wb), ([0.0, 0.5], 2.5, 0.5));
+        assert!(r.join_a && !r.join_b, "the cut end has no join");
+        // Thickness 0.02 at the cut, 0.5 px per 0.01 at w = 0.5.
+        assert!((r.hb - 0.5 * 0.02 * 100.0 / 0.5).abs() < 1e-6, "{}", r.hb);
+        // Attributes run over the part in front: its cut end is halfway.
+        assert_eq!(r.world_t(1.0), 0.5);
+        let back = Ribbon::new(&f, behind, front, 0.03, 0.01, true, true).unwrap();
+        assert_eq!(back.range, [0.5, 1.0]);
+        assert!(!back.join_a && back.join_b);
+        // Records keep the cut: the store and load round-trip it.
+        use std::sync::atomic::{AtomicU32, AtomicU64};
+        let (words, oob) = (
+            (0..RECORD_WORDS)
+                .map(|_| AtomicU32::new(0))
+                .collect::<Vec<_>>(),
+            AtomicU64::new(0),
+        );
+        let w = Words::new(&words, &oob);
+        for ribbon in [r, back] {
+            let rec = Record {
+                ribbon,
+                vertices: [3, 4],
+            };
+            Record::store(Some(&rec), &w, 0);
+            assert_eq!(Record::load(&w, 0), Some(rec));
+        }
+        assert_eq!(
+            Ribbon::new(&f, behind, [0.0, 0.0, 0.0, 0.2], 0.01, 0.01, true, true),
+            None
+        );
     }
 }

@@ -342,7 +342,8 @@ impl ComposeKernel {
             let Some(seg) = drawn_segment(scene, lods, id) else {
                 continue;
             };
-            let Some(trap) = segment_trapezoid(scene, ctx, &md.tiles, &md.lod, seg.v0, seg.v1)
+            let Some((trap, part)) =
+                segment_trapezoid(scene, ctx, &md.tiles, &md.lod, seg.v0, seg.v1)
             else {
                 continue;
             };
@@ -359,7 +360,11 @@ impl ComposeKernel {
                 load_rgba16f(&light, seg.v0 as usize),
                 load_rgba16f(&light, seg.v1 as usize),
             );
-            let lighting = [0, 1, 2].map(|k| l0[k] + t * (l1[k] - l0[k]));
+            // The vertex lighting at the ends of the part in front of the near plane.
+            let lighting = [0, 1, 2].map(|k| {
+                let [a, b] = part.ends(l0[k], l1[k]);
+                a + t * (b - a)
+            });
             out.push((Layer { coverage, lighting }, trap.depth_at(u, v)));
         }
         out

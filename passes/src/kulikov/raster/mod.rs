@@ -29,6 +29,7 @@ use super::cull::{DrawnSegment, drawn_segment};
 use super::payload::{COVERAGE_SCALE, EMPTY, linear_depth, pack, quantize_depth};
 use super::tile_alloc::ModelTiles;
 use super::{ModelLod, Scene, TILE, TILE_TEXELS};
+use crate::common::clip::{NearClipped, near_clip};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
@@ -168,9 +169,11 @@ struct Targets<'a> {
     height: u32,
 }
 
-/// Segment `v0`–`v1`'s trapezoid in its model's raster grid: the shape the
+/// The part of segment `v0`–`v1` in front of the near plane
+/// ([`near_clip`]) as a trapezoid in its model's raster grid: the shape the
 /// raster measures, and that composition and `kulikov.pixel_motion`
-/// evaluate again per pixel.
+/// evaluate again per pixel. Also returns the clipped part, whose ends
+/// composition interpolates the vertex lighting between.
 pub(crate) fn segment_trapezoid(
     scene: &Scene,
     ctx: &Ctx<'_>,
@@ -178,10 +181,14 @@ pub(crate) fn segment_trapezoid(
     lod: &ModelLod,
     v0: u32,
     v1: u32,
-) -> Option<Trapezoid> {
+) -> Option<(Trapezoid, NearClipped)> {
     let (clip, verts) = (ctx.words("clip_positions"), ctx.words("groom.vertices"));
     let f = &scene.frame;
-    let (c0, c1) = (clip.load_vec4(v0 as usize), clip.load_vec4(v1 as usize));
+    let part = near_clip(
+        clip.load_vec4(v0 as usize),
+        clip.load_vec4(v1 as usize),
+        f.near,
+    )?;
     let d = tiles.downscale as f32;
     let (ox, oy) = (
         (tiles.origin_x * TILE) as f32,
@@ -192,17 +199,19 @@ pub(crate) fn segment_trapezoid(
         [s[0] / d - ox, s[1] / d - oy]
     };
     // Strand width in raster pixels: world thickness × LOD compensation × projection.
-    let half = |v: u32, w: f32| {
-        0.5 * verts.load_f32(4 * v as usize + 3) * lod.thickness_scale * f.pixels_per_unit / w / d
-    };
-    Trapezoid::new(
-        to_raster(c0),
-        to_raster(c1),
-        half(v0, c0[3]),
-        half(v1, c1[3]),
-        c0[3],
-        c1[3],
-    )
+    let thick = |v: u32| verts.load_f32(4 * v as usize + 3);
+    let [ta, tb] = part.ends(thick(v0), thick(v1));
+    let half = |t: f32, w: f32| 0.5 * t * lod.thickness_scale * f.pixels_per_unit / w / d;
+    let (a, b) = (part.a, part.b);
+    let trap = Trapezoid::new(
+        to_raster(a),
+        to_raster(b),
+        half(ta, a[3]),
+        half(tb, b[3]),
+        a[3],
+        b[3],
+    )?;
+    Some((trap, part))
 }
 
 impl RasterKernel {
@@ -214,16 +223,10 @@ impl RasterKernel {
         lod: ModelLod,
         tiles: ModelTiles,
     ) -> Option<Lane> {
-        let clip = ctx.words("clip_positions");
-        let near = scene.frame.near;
-        let (c0, c1) = (
-            clip.load_vec4(seg.v0 as usize),
-            clip.load_vec4(seg.v1 as usize),
-        );
-        if c0[3] <= near || c1[3] <= near || tiles.valid == 0 {
+        if tiles.valid == 0 {
             return None;
         }
-        let trap = segment_trapezoid(scene, ctx, &tiles, &lod, seg.v0, seg.v1)?;
+        let (trap, _) = segment_trapezoid(scene, ctx, &tiles, &lod, seg.v0, seg.v1)?;
         let mid = [0.5 * (trap.a[0] + trap.b[0]), 0.5 * (trap.a[1] + trap.b[1])];
         let morton = order::morton(mid[0].max(0.0) as u32, mid[1].max(0.0) as u32);
         Some(Lane {

@@ -21,7 +21,30 @@ struct Seg {
 }
 
 fn harness(segs: &[Seg], order: &[u32]) -> Harness {
-    let n = segs.len() as u32;
+    let mut clip = Vec::new();
+    let mut thickness = Vec::new();
+    for s in segs {
+        for (p, w) in [(s.a, s.wa), (s.b, s.wb)] {
+            clip.push(clip_at(p, w));
+            thickness.push(s.width * w);
+        }
+    }
+    harness_clip(&clip, &thickness, order)
+}
+
+/// Screen (x right, y down) back to clip space at depth `w`.
+fn clip_at(p: [f32; 2], w: f32) -> [f32; 4] {
+    let ndc = [
+        p[0] / SIZE as f32 * 2.0 - 1.0,
+        1.0 - p[1] / SIZE as f32 * 2.0,
+    ];
+    [ndc[0] * w, ndc[1] * w, 0.5 * w, w]
+}
+
+/// Segments given by their ends' clip positions and world thicknesses
+/// (`pixels_per_unit` is 1).
+fn harness_clip(clip: &[[f32; 4]], thickness: &[f32], order: &[u32]) -> Harness {
+    let n = (clip.len() / 2) as u32;
     let mut frame = FrameData::zeroed();
     frame.screen = [
         SIZE as f32,
@@ -37,19 +60,11 @@ fn harness(segs: &[Seg], order: &[u32]) -> Harness {
     let mut model = ModelData::zeroed();
     model.strand_count = n;
     model.points_per_strand = 2;
-    let mut clip = Vec::new();
-    let mut verts = Vec::new();
-    for s in segs {
-        for (p, w) in [(s.a, s.wa), (s.b, s.wb)] {
-            // Screen (x right, y down) back to clip space at depth w.
-            let ndc = [
-                p[0] / SIZE as f32 * 2.0 - 1.0,
-                1.0 - p[1] / SIZE as f32 * 2.0,
-            ];
-            clip.extend([ndc[0] * w, ndc[1] * w, 0.5 * w, w].map(f32::to_bits));
-            verts.extend([0.0, 0.0, 0.0, s.width * w].map(f32::to_bits));
-        }
-    }
+    let clip: Vec<u32> = clip.iter().flatten().map(|v| v.to_bits()).collect();
+    let verts: Vec<u32> = thickness
+        .iter()
+        .flat_map(|&t| [0.0, 0.0, 0.0, t].map(f32::to_bits))
+        .collect();
     let lod = ModelLod {
         strands: n,
         vertex_step: 1,
@@ -405,4 +420,31 @@ fn request_stacks_raise_lane_utilisation() {
             "flattened {flat}: {s:?} vs {n:?}"
         );
     }
+}
+
+/// A segment from in front of the camera to behind it draws its part in
+/// front of the near plane (`common::clip`), exactly as that part given as
+/// the segment; one wholly behind draws nothing.
+#[test]
+fn a_segment_crossing_the_near_plane_draws_its_part_in_front() {
+    let near = 0.01; // the harness's frame.near
+    let front = clip_at([12.0, 40.0], 2.0);
+    let behind = [0.9, 0.3, -0.5, -1.0];
+    let run_clip = |clip: &[[f32; 4]], thickness: &[f32]| {
+        let h = harness_clip(clip, thickness, &[0]);
+        h.run(&RasterKernel(defaults()), 1, GROUP);
+        assert_eq!(h.out_of_bounds(), 0);
+        (h.read("vis_atlas"), h.read("coverage_atlas"))
+    };
+    let (vis, cov) = run_clip(&[front, behind], &[2.0, 2.0]);
+    let part = crate::common::clip::near_clip(front, behind, near).unwrap();
+    assert_eq!(part.b[3], near);
+    let (vis_part, cov_part) = run_clip(&[part.a, part.b], &part.ends(2.0, 2.0));
+    assert_eq!((&vis, &cov), (&vis_part, &cov_part));
+    let covered = (0..(SIZE * SIZE) as usize)
+        .filter(|&i| vis[i] != EMPTY)
+        .count();
+    assert!(covered > 40, "{covered} pixels");
+    let (vis, _) = run_clip(&[[0.1, 0.1, -0.1, 0.005], behind], &[2.0, 2.0]);
+    assert!(vis.iter().all(|&p| p == EMPTY));
 }
