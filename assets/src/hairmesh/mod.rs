@@ -66,7 +66,37 @@ fn default_seed() -> u64 {
     1
 }
 
+/// The most bundles a hair mesh may ask for (Lipp's 127k-strand groom has 1,024).
+pub const MAX_BUNDLES: u32 = 65_536;
+/// The most layers a bundle may ask for.
+pub const MAX_LAYERS: u32 = 64;
+
 impl HairMeshParams {
+    /// What is wrong with the parameters, if anything; the message names the
+    /// field. Bounds what building the mesh allocates (bundles × layers quads).
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_BUNDLES).contains(&self.bundles) {
+            return Err(format!(
+                "bundles = {} must be in 1..={MAX_BUNDLES}",
+                self.bundles
+            ));
+        }
+        if !(2..=MAX_LAYERS).contains(&self.layers) {
+            return Err(format!(
+                "layers = {} must be in 2..={MAX_LAYERS}",
+                self.layers
+            ));
+        }
+        let s = &self.style;
+        if ![s.curl_radius, s.curl_turns, s.twist, s.noise]
+            .iter()
+            .all(|v| v.is_finite())
+        {
+            return Err("style: every number must be finite".into());
+        }
+        Ok(())
+    }
+
     /// What a groom that declares no hair mesh is fitted with: a bundle per
     /// 128 strands (Lipp's 127k-strand groom has 1,024), 16 to 1,024 of
     /// them, and 8 layers.

@@ -133,6 +133,13 @@ impl GroomParams {
         if !(2..=1024).contains(&self.points) {
             return Err(format!("points = {} must be in 2..=1024", self.points));
         }
+        let total = u64::from(self.strands) * u64::from(self.points);
+        if total > crate::loaders::MAX_POINTS {
+            return Err(format!(
+                "strands × points = {total} is more than the {} points any groom may have",
+                crate::loaders::MAX_POINTS
+            ));
+        }
         let r = self.resolve();
         let checks = [
             ("length", r.length > 0.0 && r.length < 10.0),
@@ -165,6 +172,8 @@ impl GroomParams {
                 (1..=100_000).contains(&r.strands_per_guide),
             ),
             ("volume", (0.0..=0.2).contains(&r.volume)),
+            ("parting", self.parting.is_none_or(f32::is_finite)),
+            ("cut_height", r.cut_height.is_none_or(f32::is_finite)),
         ];
         match checks.iter().find(|(_, ok)| !ok) {
             // NaN fails every range check too.

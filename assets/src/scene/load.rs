@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+use super::check;
 use super::{GroomDesc, GroomSource, LodSettings, Material, MeshSource, SceneDesc};
 use crate::error::AssetError;
 use crate::groom::Groom;
@@ -85,17 +86,6 @@ pub struct SceneCounts {
     pub height: u32,
 }
 
-/// 1-based (line, column) of the first occurrence of `needle` in `text`, else (1, 1).
-fn locate(text: &str, needle: &str) -> (usize, usize) {
-    let Some(at) = text.find(needle) else {
-        return (1, 1);
-    };
-    let before = &text[..at];
-    let line = before.matches('\n').count() + 1;
-    let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    (line, col)
-}
-
 impl Scene {
     /// Parses a scene file without loading what it names.
     pub fn parse(path: &Path, text: &str) -> Result<SceneDesc, AssetError> {
@@ -111,16 +101,36 @@ impl Scene {
         })
     }
 
-    /// Parses the scene and builds or loads all of its meshes and grooms.
+    /// Parses a scene file and checks everything that needs neither the
+    /// files it names nor a generator (ranges, finite numbers, mesh names,
+    /// the counts that size what loading allocates; `check.rs`). Every
+    /// error has the line and column of its culprit. [`Scene::load`] runs
+    /// this before it loads anything.
+    pub fn check(path: &Path, text: &str) -> Result<SceneDesc, AssetError> {
+        let desc = Self::parse(path, text)?;
+        check::check(&desc).map_err(|p| {
+            let (line, col) = check::locate(text, &p.needle, p.nth);
+            AssetError::Scene {
+                path: path.to_path_buf(),
+                line,
+                col,
+                message: p.message,
+            }
+        })?;
+        Ok(desc)
+    }
+
+    /// Parses and checks the scene ([`Scene::check`]), then builds or loads
+    /// all of its meshes and grooms.
     pub fn load(path: &Path) -> Result<Scene, AssetError> {
         let text = std::fs::read_to_string(path).map_err(|source| AssetError::Io {
             path: path.to_path_buf(),
             source,
         })?;
-        let desc = Self::parse(path, &text)?;
+        let desc = Self::check(path, &text)?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let err = |needle: &str, message: String| {
-            let (line, col) = locate(&text, needle);
+            let (line, col) = check::locate(&text, needle, 0);
             AssetError::Scene {
                 path: path.to_path_buf(),
                 line,
@@ -128,21 +138,6 @@ impl Scene {
                 message,
             }
         };
-        let (w, h) = desc.resolution;
-        if w == 0 || h == 0 || w > 16384 || h > 16384 {
-            return Err(err(
-                "resolution",
-                format!("resolution {w}x{h} is out of range"),
-            ));
-        }
-        for (i, m) in desc.meshes.iter().enumerate() {
-            if desc.meshes[..i].iter().any(|o| o.name == m.name) {
-                return Err(err(
-                    &format!("\"{}\"", m.name),
-                    format!("mesh name {:?} is used twice", m.name),
-                ));
-            }
-        }
 
         // Meshes (in parallel).
         let meshes: Vec<SceneMesh> = desc
@@ -158,12 +153,6 @@ impl Scene {
                         (mesh, None)
                     }
                 };
-                if !m.transform.is_finite() {
-                    return Err(err(
-                        &format!("\"{}\"", m.name),
-                        format!("mesh {:?}: bad transform", m.name),
-                    ));
-                }
                 mesh.transform = m.transform;
                 Ok(SceneMesh {
                     name: m.name.clone(),
@@ -253,28 +242,17 @@ fn load_groom(
             None => Surface::from_mesh(m.mesh.clone()),
         })
     };
-    g.material
-        .validate()
-        .map_err(|m| err(&name, format!("groom {:?}: material: {m}", g.name)))?;
+    // Scene::check has checked the names, ranges and sizes.
     let patches = g.patches.unwrap_or_default();
-    patches
-        .validate()
-        .map_err(|m| err(&name, format!("groom {:?}: patches: {m}", g.name)))?;
     let mut skinning = None;
     let mut hair_mesh = None;
     let mut groom = match &g.source {
         GroomSource::Procedural(params) => {
-            params
-                .validate()
-                .map_err(|m| err(&name, format!("groom {:?}: {m}", g.name)))?;
             let generated = params.generate(&surface()?);
             skinning = Some(generated.skinning);
             generated.groom
         }
         GroomSource::HairMesh(params) => {
-            params
-                .validate()
-                .map_err(|m| err(&name, format!("groom {:?}: {m}", g.name)))?;
             let hm = g.hair_mesh.ok_or_else(|| {
                 err(&name, format!("groom {:?}: a HairMesh source needs `hair_mesh: (bundles: .., layers: ..)`", g.name))
             })?;
@@ -305,9 +283,6 @@ fn load_groom(
                 g.name
             ),
         ));
-    }
-    if !g.transform.is_finite() {
-        return Err(err(&name, format!("groom {:?}: bad transform", g.name)));
     }
     if let (Some(p), None) = (parent, &skinning) {
         skinning = Some(skinning::bake(&meshes[p].mesh, &groom.roots()));
@@ -523,6 +498,159 @@ mod tests {
                 .unwrap()
                 .environment_map
                 .is_none()
+        );
+    }
+
+    /// `Scene::check` on MINI with `from` replaced by `to`: the error's line
+    /// and message.
+    fn check_err(from: &str, to: &str) -> (usize, String) {
+        assert!(MINI.contains(from), "{from}");
+        let text = MINI.replacen(from, to, 1);
+        match Scene::check(Path::new("s.ron"), &text) {
+            Err(AssetError::Scene { line, message, .. }) => (line, message),
+            Err(e) => panic!("{e}"),
+            Ok(_) => panic!("{to} passed the check"),
+        }
+    }
+
+    #[test]
+    fn check_needs_no_files_and_passes_every_shipped_scene() {
+        let desc = Scene::check(Path::new("s.ron"), MINI).unwrap();
+        assert_eq!(desc.grooms.len(), 2);
+        let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+        let mut checked = 0;
+        for dir in [scenes.clone(), scenes.join("distances")] {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let p = entry.unwrap().path();
+                if p.extension().is_some_and(|e| e == "ron") {
+                    let text = std::fs::read_to_string(&p).unwrap();
+                    Scene::check(&p, &text).unwrap_or_else(|e| panic!("{e}"));
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 9, "{checked}");
+    }
+
+    /// What `Scene::load` would have allocated or computed from before it
+    /// refused them (a body of 4e9 rings overflowed `resolution * 3` and
+    /// asked for 1e19 vertices; 20M strands of 1,024 points, 245 GB; an
+    /// unbounded hair mesh), and numbers that are not numbers: each is an
+    /// error at its line.
+    #[test]
+    fn check_refuses_what_loading_could_not_build() {
+        let cases = [
+            (
+                "Head(resolution: 48)",
+                "Body(resolution: 4000000000)",
+                10,
+                "mesh \"head\": resolution = 4000000000 must be at most 1024",
+            ),
+            (
+                "Head(resolution: 48)",
+                "Body(half_extents: (0.2, 0.0, 0.5))",
+                10,
+                "half_extents",
+            ),
+            (
+                "strands: 500, points: 8",
+                "strands: 20000000, points: 1024",
+                13,
+                "groom \"hair\": strands × points = 20480000000 is more than",
+            ),
+            (
+                "hair_mesh: (bundles: 20,",
+                "hair_mesh: (bundles: 0,",
+                15,
+                "groom \"beard\": hair_mesh: bundles = 0 must be in 1..=65536",
+            ),
+            (
+                "layers: 4)",
+                "layers: 100000)",
+                15,
+                "hair_mesh: layers = 100000 must be in 2..=64",
+            ),
+            (
+                "layers: 4)",
+                "layers: 4, style: (noise: NaN))",
+                15,
+                "hair_mesh: style",
+            ),
+            (
+                "points: 8)",
+                "points: 8, parting: inf)",
+                13,
+                "parting is out of range",
+            ),
+            (
+                "roughness: 0.25)),",
+                "roughness: 0.25), lod: (min_fraction: 2.0)),",
+                13,
+                "lod: min_fraction = 2 must be in 0..=1",
+            ),
+            (
+                "roughness: 0.25)),",
+                "roughness: 0.25), fedora: (box_min: (0, 0, 0), box_max: (1, 1, 1), \
+                 sphere_center: (0, NaN, 0), sphere_radius: 1)),",
+                13,
+                "fedora",
+            ),
+            (
+                "fov_deg: 35.0",
+                "fov_deg: 180.0",
+                3,
+                "camera: fov_deg = 180",
+            ),
+            ("distance: 0.8", "distance: 0.0", 3, "camera: distance = 0"),
+            (
+                "yaw_deg: 30.0",
+                "yaw_deg: -inf",
+                3,
+                "camera: target, yaw_deg",
+            ),
+            ("intensity: 10.0", "intensity: NaN", 4, "light 1: color"),
+            (
+                "direction: (0.0, -1.0, -1.0)",
+                "direction: (0.0, 0.0, 0.0)",
+                4,
+                "light 0: direction",
+            ),
+            ("intensity: 0.3", "intensity: -0.3", 8, "environment: color"),
+            (
+                "resolution: (640, 360)",
+                "resolution: (640, 0)",
+                2,
+                "resolution 640x0 is out of range",
+            ),
+        ];
+        for (from, to, line, message) in cases {
+            let (l, m) = check_err(from, to);
+            assert!(l == line && m.contains(message), "{to}: {l}: {m}");
+        }
+        // A file groom's units and thickness.
+        let file = "Procedural(style: Wavy, strands: 500, points: 8)";
+        for to in [
+            "File(path: \"g.hair\", units: Scale(0.0))",
+            "File(path: \"g.hair\", thickness: -1e-4)",
+        ] {
+            let (l, m) = check_err(file, to);
+            assert!(
+                l == 13 && m.starts_with("groom \"hair\": "),
+                "{to}: {l}: {m}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_duplicate_mesh_name_points_at_the_second() {
+        let (line, message) = check_err(
+            "        (name: \"head\", source: Head(resolution: 48)),\n",
+            "        (name: \"head\", source: Head(resolution: 48)),\n        \
+             (name: \"head\", source: Body(resolution: 64)),\n",
+        );
+        assert_eq!(
+            (line, message.as_str()),
+            (11, "mesh name \"head\" is used twice")
         );
     }
 }

@@ -5,6 +5,7 @@
 //! so a procedural source reads `Procedural(style: Long, strands: 40000)` and optional
 //! values need no `Some(..)`.
 
+mod check;
 mod load;
 
 use serde::{Deserialize, Serialize};
@@ -15,6 +16,7 @@ use crate::loaders::Units;
 use crate::procedural::{BodyParams, GroomParams, HeadParams};
 use crate::transform::Transform;
 
+pub use check::{MAX_BODY_RESOLUTION, MAX_RESOLUTION};
 pub use load::{Scene, SceneCounts, SceneGroom, SceneMesh};
 
 /// The scene file's contents, before anything is loaded or generated.
