@@ -182,9 +182,9 @@ pub fn parse(data: &[u8]) -> Result<EnvMap, FormatError> {
     limits.max_image_width = Some(MAX_WIDTH);
     limits.max_image_height = Some(MAX_HEIGHT);
     limits.max_alloc = Some(MAX_ALLOC);
-    let cursor = std::io::Cursor::new(data);
     let image = match kind {
         Kind::Exr => {
+            let cursor = std::io::Cursor::new(data);
             let mut d =
                 image::codecs::openexr::OpenExrDecoder::new(cursor).map_err(decode_error)?;
             let (w, h) = d.dimensions();
@@ -193,6 +193,18 @@ pub fn parse(data: &[u8]) -> Result<EnvMap, FormatError> {
             DynamicImage::from_decoder(d)
         }
         Kind::Hdr => {
+            // The decoder knows only the "#?RADIANCE" signature: an "#?RGBE"
+            // file (the other one Radiance tools write) is read with it in
+            // its place.
+            let renamed: Vec<u8>;
+            let bytes = match data.strip_prefix(b"#?RGBE") {
+                Some(rest) => {
+                    renamed = [b"#?RADIANCE".as_slice(), rest].concat();
+                    &renamed[..]
+                }
+                None => data,
+            };
+            let cursor = std::io::Cursor::new(bytes);
             let mut d = image::codecs::hdr::HdrDecoder::new(cursor).map_err(decode_error)?;
             let (w, h) = d.dimensions();
             check_dimensions(w, h)?;
@@ -421,6 +433,25 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    /// Found by the envmap_hdr fuzz target's seeds: `detect` accepted the
+    /// "#?RGBE" signature, but the decoder reads only "#?RADIANCE", so such
+    /// a file was "cannot decode: Radiance HDR signature not found".
+    #[test]
+    fn the_rgbe_signature_decodes_as_radiance() {
+        let radiance = hdr_bytes(8, 4, |x, y| [x as f32, 0.5, y as f32]);
+        let rgbe = [b"#?RGBE".as_slice(), &radiance[b"#?RADIANCE".len()..]].concat();
+        assert_eq!(parse(&rgbe).unwrap(), parse(&radiance).unwrap());
+        // An uncompressed 4 x 2 file with a comment and an exposure line.
+        let mut flat =
+            b"#?RGBE\n# hand-written\nEXPOSURE=1.0\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+        for _ in 0..8 {
+            flat.extend([128, 64, 32, 129]);
+        }
+        let m = parse(&flat).unwrap();
+        assert_eq!((m.width, m.height), (4, 2));
+        assert_eq!(m.texel(3, 1), [1.0, 0.5, 0.25]);
     }
 
     #[test]
