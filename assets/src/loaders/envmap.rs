@@ -167,6 +167,63 @@ fn check_dimensions(width: u32, height: u32) -> Result<(), FormatError> {
     Ok(())
 }
 
+/// The byte offset of the `nth` (0-based) header attribute `name` of an
+/// OpenEXR file (name, NUL, type name, NUL), else the whole file.
+fn exr_attribute(data: &[u8], name: &str, type_name: &str, nth: usize) -> Location {
+    let needle = [name.as_bytes(), b"\0", type_name.as_bytes(), b"\0"].concat();
+    data.windows(needle.len())
+        .enumerate()
+        .filter(|(_, w)| *w == needle.as_slice())
+        .nth(nth)
+        .map_or(Location::File, |(i, _)| Location::Byte(i))
+}
+
+/// Checks every part of an OpenEXR file before the decoder sizes buffers by
+/// it. `image` reports (and we check) the display window, but decodes the
+/// data window with every channel: a 563-byte file whose data window was
+/// 788,529,160 pixels wide made the B44 decompressor ask for 18.9 GB. Each
+/// part's data window must fit [`MAX_WIDTH`] x [`MAX_HEIGHT`], and its
+/// pixels times its channels' bytes must fit the decoder's allocation limit.
+fn check_exr_parts(data: &[u8]) -> Result<(), FormatError> {
+    let meta = exr::meta::MetaData::read_from_buffered(data, false).map_err(|e| {
+        FormatError::new(
+            Location::File,
+            FormatErrorKind::Syntax(format!("cannot decode: {e}")),
+        )
+    })?;
+    for (i, part) in meta.headers.iter().enumerate() {
+        let (w, h) = (part.layer_size.x() as u64, part.layer_size.y() as u64);
+        let window = || exr_attribute(data, "dataWindow", "box2i", i);
+        for (field, value, max) in [
+            ("dataWindow width", w, MAX_WIDTH),
+            ("dataWindow height", h, MAX_HEIGHT),
+        ] {
+            if value > u64::from(max) {
+                return Err(FormatError::new(
+                    window(),
+                    FormatErrorKind::AbsurdCount {
+                        field,
+                        value,
+                        max: max.into(),
+                    },
+                ));
+            }
+        }
+        let bytes = w * h * part.channels.bytes_per_pixel as u64;
+        if bytes > MAX_ALLOC {
+            return Err(FormatError::new(
+                exr_attribute(data, "channels", "chlist", i),
+                FormatErrorKind::AbsurdCount {
+                    field: "decoded bytes (dataWindow pixels x channel bytes)",
+                    value: bytes,
+                    max: MAX_ALLOC,
+                },
+            ));
+        }
+    }
+    Ok(())
+}
+
 fn decode_error(e: image::ImageError) -> FormatError {
     FormatError::new(
         Location::File,
@@ -184,6 +241,7 @@ pub fn parse(data: &[u8]) -> Result<EnvMap, FormatError> {
     limits.max_alloc = Some(MAX_ALLOC);
     let image = match kind {
         Kind::Exr => {
+            check_exr_parts(data)?;
             let cursor = std::io::Cursor::new(data);
             let mut d =
                 image::codecs::openexr::OpenExrDecoder::new(cursor).map_err(decode_error)?;
@@ -452,6 +510,41 @@ mod tests {
         let m = parse(&flat).unwrap();
         assert_eq!((m.width, m.height), (4, 2));
         assert_eq!(m.texel(3, 1), [1.0, 0.5, 0.25]);
+    }
+
+    /// Found by the envmap_exr fuzz target (an out-of-memory crash): the
+    /// data window, which the decoder sizes its buffers by, was not checked,
+    /// only the display window `image` reports.
+    #[test]
+    fn an_exr_data_window_past_the_bounds_is_refused_where_it_is() {
+        let mut bytes = exr_bytes(8, 4, |_, _| [1.0; 3]);
+        let Location::Byte(at) = exr_attribute(&bytes, "dataWindow", "box2i", 0) else {
+            panic!("no dataWindow attribute")
+        };
+        // name, type, 4-byte size, then xMin yMin xMax yMax.
+        let x_max = at + "dataWindow\0box2i\0".len() + 4 + 8;
+        bytes[x_max..x_max + 4].copy_from_slice(&788_529_159i32.to_le_bytes());
+        let e = format_error(&bytes);
+        assert_eq!(
+            e,
+            FormatError::new(
+                Location::Byte(at),
+                FormatErrorKind::AbsurdCount {
+                    field: "dataWindow width",
+                    value: 788_529_160,
+                    max: MAX_WIDTH.into()
+                }
+            )
+        );
+        // A data window inside the bounds passes the check and reaches the
+        // decoder, which finds the file's blocks too short for it.
+        bytes[x_max..x_max + 4].copy_from_slice(&15i32.to_le_bytes());
+        let e = parse(&bytes);
+        assert!(
+            e.as_ref()
+                .is_err_and(|e| e.to_string().contains("cannot decode")),
+            "{e:?}"
+        );
     }
 
     #[test]
