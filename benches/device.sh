@@ -19,13 +19,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# Once per machine: the Vulkan loader and GL libraries for the device.
+# Once per machine: the Vulkan loader, the validation layer (benches/validate.sh)
+# and GL libraries for the device.
 if ! ls .gl/*.deb >/dev/null 2>&1; then
   grep -qx '/.gl/' .git/info/exclude 2>/dev/null || printf '/.gl/\n' >> .git/info/exclude
   mkdir -p .gl /tmp/amd64/partial
   o='-oAPT::Architecture=amd64 -oAPT::Architectures=amd64 -oDir::State::Lists=/tmp/amd64'
   apt-get $o update -qq
-  (cd .gl && apt-get $o download libvulkan1 libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
+  (cd .gl && apt-get $o download libvulkan1 vulkan-validationlayers libegl1 libglvnd0 libopengl0 libgl1 libglx0 libgles2)
 fi
 grep -qx '/.devbin/' .git/info/exclude 2>/dev/null || printf '/.devbin/\n' >> .git/info/exclude
 
