@@ -5,8 +5,7 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::Path;
 use strandgraph_assets::Scene;
 use strandgraph_bake::BakeOutcome;
-use strandgraph_graph::unroll::MODEL_INDEX;
-use strandgraph_graph::{Instance, PassRegistry, Plan, Usage, compile_file};
+use strandgraph_graph::{Instance, Plan, compile_file};
 use strandgraph_passes::Registry;
 use strandgraph_passes::kulikov::shade::{SHADE, SelfShadow};
 use strandgraph_passes::upload::{SHADOW_SH, Upload, bake_shadow_sh, upload};
@@ -136,114 +135,9 @@ pub fn parse_size(s: &str) -> Result<(u32, u32)> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// Applies `PASS.PARAM=VALUE` (VALUE in RON: `false`, `64`, `"Baked"`) to a
-/// compiled plan: how ablations run without editing the graph file.
+/// Applies `PASS.PARAM=VALUE` (VALUE in RON: `false`, `64`, `"Baked"`) or
+/// `IMAGE.samples=N` to a compiled plan: how ablations run without editing
+/// the graph file ([`strandgraph_passes::params::override_param`]).
 pub fn override_param(plan: &mut Plan, spec: &str) -> Result<()> {
-    let bad = || {
-        miette::miette!(
-            "--param {spec}: expected PASS.PARAM=VALUE, e.g. raster.loop_flattening=false"
-        )
-    };
-    let (target, value) = spec.split_once('=').ok_or_else(bad)?;
-    if let Some(image) = target.trim().strip_suffix(".samples")
-        && plan.graph.resource_id(image).is_some()
-    {
-        return override_samples(plan, spec, image, value);
-    }
-    let (pass, param) = target.split_once('.').ok_or_else(bad)?;
-    let value: ron::Value = ron::from_str(value.trim())
-        .map_err(|e| miette::miette!("--param {spec}: value is not RON: {e}"))?;
-    // `raster.x=…` sets every per-model copy (`raster[0]`, `raster[1]`, …).
-    let pass = pass.trim();
-    let targets: Vec<usize> = (0..plan.graph.passes.len())
-        .filter(|&p| {
-            let name = &plan.graph.passes[p].name;
-            name == pass || strandgraph_graph::base_name(name) == pass
-        })
-        .collect();
-    if targets.is_empty() {
-        return Err(miette::miette!(
-            "--param {spec}: graph `{}` has no pass `{pass}`",
-            plan.graph.name
-        ));
-    }
-    for p in targets {
-        let pass = &mut plan.graph.passes[p];
-        let mut params = match &pass.params {
-            ron::Value::Map(m) => m.clone(),
-            _ => ron::Map::new(),
-        };
-        params.insert(ron::Value::String(param.trim().to_string()), value.clone());
-        check_override(&pass.name, &pass.kind, &params, param.trim())
-            .map_err(|e| miette::miette!("--param {spec}: {e}"))?;
-        pass.params = ron::Value::Map(params);
-    }
-    Ok(())
-}
-
-/// `IMAGE.samples=N`: an attachment's sample count (how a bench row runs
-/// one graph at MSAA 1, 4 and 8), checked as the graph compiler checks it.
-fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Result<()> {
-    use strandgraph_graph::schema::ResourceDecl;
-    let n: u32 = value
-        .trim()
-        .parse()
-        .map_err(|_| miette::miette!("--param {spec}: samples must be 1, 2, 4 or 8"))?;
-    let g = &mut plan.graph;
-    let r = g.physical(g.resource_id(image).expect("checked by the caller"));
-    // The image and its versions (`a -> a.final`) share one declaration.
-    for v in 0..g.resources.len() {
-        if v != r && g.resources[v].version_of != Some(r) {
-            continue;
-        }
-        let ResourceDecl::Image { samples, .. } = &mut g.resources[v].decl else {
-            return Err(miette::miette!(
-                "--param {spec}: `{image}` is a buffer, not an image"
-            ));
-        };
-        *samples = n;
-    }
-    if let Some(why) = strandgraph_graph::resolve::samples_problem(&g.resources[r].decl) {
-        return Err(miette::miette!("--param {spec}: image `{image}` {why}"));
-    }
-    let attachment_only = g
-        .passes
-        .iter()
-        .flat_map(|p| &p.accesses)
-        .all(|a| g.physical(a.resource) != r || matches!(a.usage, Usage::Color | Usage::Depth));
-    if n > 1 && !attachment_only {
-        return Err(miette::miette!(
-            "--param {spec}: a pass uses `{image}` as more than an attachment, so it cannot be multisampled"
-        ));
-    }
-    Ok(())
-}
-
-/// Checks a pass's parameters after an override as the graph compiler
-/// checks the file's (unknown key with the closest valid one, type, range).
-/// `model_index`, which unrolling adds to per-model passes, is the block's
-/// to set, not the command line's.
-fn check_override(
-    pass: &str,
-    kind: &str,
-    params: &ron::Map,
-    param: &str,
-) -> std::result::Result<(), String> {
-    if param == MODEL_INDEX {
-        return Err(format!(
-            "pass `{pass}`: `{param}` is set by the per-model block"
-        ));
-    }
-    let mut written = params.clone();
-    written.remove(&ron::Value::String(MODEL_INDEX.into()));
-    Registry
-        .check_params(kind, &ron::Value::Map(written))
-        .map_err(|p| {
-            let key = if p.key.is_empty() {
-                "params".into()
-            } else {
-                format!("parameter `{}`", p.key)
-            };
-            format!("pass `{pass}` ({kind}): {key}: {}", p.message)
-        })
+    strandgraph_passes::params::override_param(plan, spec).map_err(|e| miette::miette!("{e}"))
 }

@@ -5,9 +5,13 @@
 //! (naming the closest valid key) instead of a silently ignored switch, and
 //! [`PassParams::validate`] checks ranges. Every error names the offending
 //! key, so the graph compiler can point at it (`PassRegistry::check_params`).
+//!
+//! [`override_param`] applies the command line's `--param PASS.PARAM=VALUE`
+//! to a compiled plan, checked the same way (the fuzz target `param`).
 
 use serde::de::DeserializeOwned;
 use strandgraph_graph::unroll::MODEL_INDEX;
+use strandgraph_graph::{PassRegistry, Plan, Usage};
 
 /// A parameter value that is unknown, mistyped or out of range.
 #[derive(Debug, Clone, PartialEq)]
@@ -231,6 +235,114 @@ macro_rules! string_enum {
             }
         }
     };
+}
+
+/// Applies `PASS.PARAM=VALUE` (VALUE in RON: `false`, `64`, `"Baked"`) to a
+/// compiled plan: how ablations run without editing the graph file
+/// (`--param`). `raster.x=…` sets every per-model copy (`raster[0]`,
+/// `raster[1]`, …), `raster[1].x=…` one; `IMAGE.samples=N` sets an
+/// attachment's sample count. Checked as the graph compiler checks the
+/// file's parameters (unknown key with the closest valid one, type, range);
+/// the error starts `--param SPEC:`.
+pub fn override_param(plan: &mut Plan, spec: &str) -> Result<(), String> {
+    let bad =
+        || format!("--param {spec}: expected PASS.PARAM=VALUE, e.g. raster.loop_flattening=false");
+    let (target, value) = spec.split_once('=').ok_or_else(bad)?;
+    if let Some(image) = target.trim().strip_suffix(".samples")
+        && plan.graph.resource_id(image).is_some()
+    {
+        return override_samples(plan, spec, image, value);
+    }
+    let (pass, param) = target.split_once('.').ok_or_else(bad)?;
+    let value: ron::Value = ron::from_str(value.trim())
+        .map_err(|e| format!("--param {spec}: value is not RON: {e}"))?;
+    let pass = pass.trim();
+    let targets: Vec<usize> = (0..plan.graph.passes.len())
+        .filter(|&p| {
+            let name = &plan.graph.passes[p].name;
+            name == pass || strandgraph_graph::base_name(name) == pass
+        })
+        .collect();
+    if targets.is_empty() {
+        return Err(format!(
+            "--param {spec}: graph `{}` has no pass `{pass}`",
+            plan.graph.name
+        ));
+    }
+    for p in targets {
+        let pass = &mut plan.graph.passes[p];
+        let mut params = match &pass.params {
+            ron::Value::Map(m) => m.clone(),
+            _ => ron::Map::new(),
+        };
+        params.insert(ron::Value::String(param.trim().to_string()), value.clone());
+        check_override(&pass.name, &pass.kind, &params, param.trim())
+            .map_err(|e| format!("--param {spec}: {e}"))?;
+        pass.params = ron::Value::Map(params);
+    }
+    Ok(())
+}
+
+/// `IMAGE.samples=N`: an attachment's sample count (how a bench row runs
+/// one graph at MSAA 1, 4 and 8), checked as the graph compiler checks it.
+fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Result<(), String> {
+    use strandgraph_graph::schema::ResourceDecl;
+    let n: u32 = value
+        .trim()
+        .parse()
+        .map_err(|_| format!("--param {spec}: samples must be 1, 2, 4 or 8"))?;
+    let g = &mut plan.graph;
+    let r = g.physical(g.resource_id(image).expect("checked by the caller"));
+    // The image and its versions (`a -> a.final`) share one declaration.
+    for v in 0..g.resources.len() {
+        if v != r && g.resources[v].version_of != Some(r) {
+            continue;
+        }
+        let ResourceDecl::Image { samples, .. } = &mut g.resources[v].decl else {
+            return Err(format!(
+                "--param {spec}: `{image}` is a buffer, not an image"
+            ));
+        };
+        *samples = n;
+    }
+    if let Some(why) = strandgraph_graph::resolve::samples_problem(&g.resources[r].decl) {
+        return Err(format!("--param {spec}: image `{image}` {why}"));
+    }
+    let attachment_only = g
+        .passes
+        .iter()
+        .flat_map(|p| &p.accesses)
+        .all(|a| g.physical(a.resource) != r || matches!(a.usage, Usage::Color | Usage::Depth));
+    if n > 1 && !attachment_only {
+        return Err(format!(
+            "--param {spec}: a pass uses `{image}` as more than an attachment, so it cannot be multisampled"
+        ));
+    }
+    Ok(())
+}
+
+/// Checks a pass's parameters after an override as the graph compiler
+/// checks the file's (unknown key with the closest valid one, type, range).
+/// `model_index`, which unrolling adds to per-model passes, is the block's
+/// to set, not the command line's.
+fn check_override(pass: &str, kind: &str, params: &ron::Map, param: &str) -> Result<(), String> {
+    if param == MODEL_INDEX {
+        return Err(format!(
+            "pass `{pass}`: `{param}` is set by the per-model block"
+        ));
+    }
+    let mut written = params.clone();
+    written.remove(&ron::Value::String(MODEL_INDEX.into()));
+    crate::Registry
+        .check_params(kind, &ron::Value::Map(written))
+        .map_err(|p| {
+            let key = if p.key.is_empty() {
+                "params".into()
+            } else {
+                format!("parameter `{}`", p.key)
+            };
+            format!("pass `{pass}` ({kind}): {key}: {}", p.message)
+        })
 }
 
 #[cfg(test)]
