@@ -1,0 +1,116 @@
+//! Fuzz `--param` (`strandgraph_passes::params::override_param`): the
+//! `PASS.PARAM=VALUE` / `IMAGE.samples=N` syntax and its application to a
+//! compiled shipped graph's typed parameters, checked by the real pass
+//! registry. The first byte picks the graph (every `scenes/graphs/*.ron`,
+//! with one or two hair models); the rest is up to 8 overrides, one a line,
+//! applied in turn.
+//!
+//! An override that fails names itself (`--param SPEC: ...`) and leaves the
+//! plan as it was. One that succeeds leaves every pass's parameters readable
+//! by its kind (entry point, CPU kernel, GPU block, raster state), the plan
+//! still instantiates, and applying it again changes nothing.
+#![no_main]
+
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use strandgraph_graph::{Plan, Quantities, compile_str};
+use strandgraph_passes::Registry;
+use strandgraph_passes::params::override_param;
+
+macro_rules! graphs {
+    ($($name:literal),+ $(,)?) => {
+        [$(($name, include_str!(concat!("../../scenes/graphs/", $name)))),+]
+    };
+}
+
+const GRAPHS: [(&str, &str); 11] = graphs![
+    "hw_mesh.ron",
+    "hw_strands.ron",
+    "kulikov.ron",
+    "kulikov_reference.ron",
+    "kulikov_visibility.ron",
+    "lipp.ron",
+    "lipp_msaa.ron",
+    "lipp_reference.ron",
+    "roofline.ron",
+    "scheuermann.ron",
+    "scheuermann_reference.ron",
+];
+
+/// Each graph compiled for one and for two hair models (index 2g + m - 1).
+fn plans() -> &'static [Plan] {
+    static PLANS: OnceLock<Vec<Plan>> = OnceLock::new();
+    PLANS.get_or_init(|| {
+        GRAPHS
+            .iter()
+            .flat_map(|(name, text)| {
+                (1..=2).map(move |models| {
+                    compile_str(name, text, &Registry, models)
+                        .unwrap_or_else(|e| panic!("{name}: {e:?}"))
+                })
+            })
+            .collect()
+    })
+}
+
+fn quantities(models: u64) -> Quantities {
+    Quantities {
+        strands: 64,
+        vertices: 512,
+        segments: 448,
+        bundles: 8,
+        mesh_strands: 64,
+        models,
+        patches: 8,
+        triangles: 32,
+        lights: 2,
+        width: 64,
+        height: 36,
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&pick, text)) = data.split_first() else {
+        return;
+    };
+    let Ok(text) = std::str::from_utf8(text) else {
+        return;
+    };
+    let plans = plans();
+    let index = pick as usize % plans.len();
+    let q = quantities(1 + (index % 2) as u64);
+    let mut plan = plans[index].clone();
+    for spec in text.split('\n').take(8) {
+        let before = format!("{:?}", plan.graph);
+        match override_param(&mut plan, spec) {
+            Err(e) => {
+                assert!(e.starts_with(&format!("--param {spec}: ")), "{e}");
+                assert_eq!(
+                    format!("{:?}", plan.graph),
+                    before,
+                    "a failed override changed the plan: {e}"
+                );
+            }
+            Ok(()) => {
+                for pass in &plan.graph.passes {
+                    let def = Registry.get(&pass.kind).expect("a compiled kind");
+                    let name = &pass.name;
+                    if let Err(e) = def.entry(&pass.params) {
+                        panic!("after `{spec}`, pass `{name}`'s parameters do not read: {e:?}");
+                    }
+                    if let Err(e) = def.cpu_kernel(&pass.params) {
+                        panic!("after `{spec}`, pass `{name}` has no CPU kernel: {e:?}");
+                    }
+                    let _ = def.gpu_params(&pass.params, &q);
+                    let _ = def.raster(&pass.params, &q);
+                }
+                let _ = plan.instantiate(&q);
+                let after = format!("{:?}", plan.graph);
+                let mut again = plan.clone();
+                assert_eq!(override_param(&mut again, spec), Ok(()));
+                assert_eq!(format!("{:?}", again.graph), after, "`{spec}` twice");
+            }
+        }
+    }
+});
