@@ -5,8 +5,8 @@
 // not snapped) with +1 in each 8x8 tile it may reach, as reference.count
 // does for a groom. Port of passes/src/lipp/reference/strands.rs.
 
-#define REFERENCE_COUNTS_BINDING 8
-#define REFERENCE_RIBBONS_BINDING 9
+#define REFERENCE_COUNTS_BINDING 7
+#define REFERENCE_RIBBONS_BINDING 8
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{quantize, LOD_WORDS, BUNDLE_WORDS, MAX_CONTROL_POINTS}
@@ -31,9 +31,8 @@ struct StrandsParams {
 // Bindings 2-5 (raster_args, bundle_lod, hairmesh.bundles, hairmesh.layers)
 // are declared in assembly.wgsl.
 @group(0) @binding(6) var<storage, read> models: array<ModelData>;
-@group(0) @binding(7) var<storage, read> groom_vertices: array<vec4<f32>>;
-// Bindings 8 (reference_counts) and 9 (reference_ribbons) are bins.wgsl's.
-@group(0) @binding(10) var<storage, read_write> reference_points: array<vec4<u32>>;
+// Bindings 7 (reference_counts) and 8 (reference_ribbons) are bins.wgsl's.
+@group(0) @binding(9) var<storage, read_write> reference_points: array<vec4<u32>>;
 
 // strands::{MODEL_SHIFT, VALID}: the point record's model index above
 // (u, v), and the bit that marks a written point (the buffer is cleared).
@@ -41,7 +40,7 @@ const MODEL_SHIFT: u32 = 12u;
 const VALID: u32 = 0x80000000u;
 
 // strands::Meta: the strand's model, its (u, v) in 1/63 steps, and its
-// thickness (the groom's, at the model's first vertex).
+// thickness (the model's).
 struct Meta {
     packed: u32,
     thickness: f32,
@@ -49,13 +48,8 @@ struct Meta {
 
 fn strand_meta(st: Strand) -> Meta {
     let model = min(hairmesh_bundles[st.bundle_index * BUNDLE_WORDS + 3u], arrayLength(&models) - 1u);
-    let first = models[model].vertex_first;
-    var thickness = 0.0;
-    if first < arrayLength(&groom_vertices) {
-        thickness = groom_vertices[first].w;
-    }
     let packed = quantize(st.uv.x, 63.0) | (quantize(st.uv.y, 63.0) << 6u) | (model << MODEL_SHIFT) | VALID;
-    return Meta(packed, thickness);
+    return Meta(packed, models[model].thickness);
 }
 
 // strands::store_point: 8 words (position, AO, tangent, packed).

@@ -116,7 +116,8 @@ pub struct AshBackend {
     pub alias: bool,
     /// Use a compute-only queue family for AsyncCompute passes when there is one.
     pub async_compute: bool,
-    /// The longest any fence or semaphore wait may take before the run fails.
+    /// The longest any fence or semaphore wait may take before the run fails
+    /// (ten times this on a CPU implementation such as lavapipe).
     pub timeout: Duration,
     /// Pick the first device whose name contains this (else the first discrete GPU).
     pub device_name: Option<String>,

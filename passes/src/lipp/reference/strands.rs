@@ -5,8 +5,8 @@
 //! curve the pipeline draws, at the LOD pass's control points.
 //!
 //! Each segment becomes a ribbon of the groom's thickness (hair meshes
-//! carry none; the groom generated from the same mesh has one, read at the
-//! model's first vertex), unsnapped, joined to its neighbours but at root
+//! carry none; the groom generated from the same mesh has one, the
+//! model's `thickness`), unsnapped, joined to its neighbours but at root
 //! and tip, counted in every tile it may reach.
 
 use super::{PointRecord, SLOTS};
@@ -68,7 +68,6 @@ pub static STRANDS: PassKind<StrandsParams, StrandsGpu> = PassKind {
         Binding::read("hairmesh.bundles"),
         Binding::read("hairmesh.layers"),
         Binding::read("models"),
-        Binding::read("groom.vertices"),
         Binding::atomic("reference_counts"),
         Binding::write("reference_ribbons"),
         Binding::write("reference_points"),
@@ -149,17 +148,10 @@ impl Writer<'_> {
     }
 }
 
-/// The groom's thickness for `model`: its first vertex's (0 without one).
+/// The strand thickness of `model` (`ModelData::thickness`, the groom's).
 fn thickness(ctx: &Ctx<'_>, model: u32) -> f32 {
-    let models = ctx.words("models");
-    let m: ModelData = read(&models, model as usize);
-    let verts = ctx.words("groom.vertices");
-    let w = 4 * m.vertex_first as usize + 3;
-    if w < verts.len() {
-        verts.load_f32(w)
-    } else {
-        0.0
-    }
+    let m: ModelData = read(&ctx.words("models"), model as usize);
+    m.thickness
 }
 
 struct StrandsKernel(StrandsParams);
@@ -233,8 +225,11 @@ mod tests {
         let (w, hgt) = (h.quantities.width, h.quantities.height);
         let slots = (groups * SLOTS) as usize;
         let thickness = 2e-3;
-        h.buffer("models", words_of(&[ModelData::zeroed()]))
-            .buffer("groom.vertices", vec![0, 0, 0, f32::to_bits(thickness)])
+        let model = ModelData {
+            thickness,
+            ..ModelData::zeroed()
+        };
+        h.buffer("models", words_of(&[model]))
             .buffer(
                 "reference_counts",
                 vec![0; (tiles(w, hgt).0 * tiles(w, hgt).1) as usize],
