@@ -349,38 +349,3 @@ fn compose_workgroup_cull_changes_no_pixel() {
     assert!(culled.0 == all.0, "composed colour differs");
     assert!(culled.1 == all.1, "hair depth differs");
 }
-
-/// `cull.kept_only` (ours) changes which invocation tests which segment,
-/// not the result: the crowd (LOD dropping most strands) culls to the same
-/// visibility bits, screen bounds and sort bins either way.
-#[test]
-fn cull_over_kept_segments_changes_no_result() {
-    let frame = |kept: &str| {
-        let params = [format!("cull.kept_only={kept}")];
-        let p = strandgraph::frame::prepare_with(
-            &root().join("scenes/crowd.ron"),
-            Some(&root().join("scenes/graphs/kulikov_visibility.ron")),
-            Some((320, 180)),
-            &params,
-        )
-        .unwrap_or_else(|e| panic!("{e:?}"));
-        let f = run(&p, &CpuBackend::default());
-        let words = |name: &str| f.read(&p.plan, name).unwrap();
-        let lods = words("lod_models");
-        // The LOD must drop segments for the switch to matter.
-        let kept: u32 = lods.chunks(8).map(|l| l[0] * l[3]).sum();
-        assert!(
-            u64::from(kept) < p.upload.quantities.segments / 2,
-            "{kept} kept"
-        );
-        ["segment_visibility", "screen_bounds", "sort_bins"].map(words)
-    };
-    let (kept, all) = (frame("true"), frame("false"));
-    assert!(kept[0].iter().any(|&w| w != 0), "nothing visible");
-    for (name, (a, b)) in ["segment_visibility", "screen_bounds", "sort_bins"]
-        .iter()
-        .zip(kept.iter().zip(&all))
-    {
-        assert!(a == b, "{name} differs");
-    }
-}

@@ -13,7 +13,7 @@
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::layout::ModelData
 #import strandgraph::clip::{transform, clip_to_screen, near_clip}
-#import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR, drawn_in_model, load_lod}
+#import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
 #import strandgraph::subgroup::elected
 
 struct CullParams {
@@ -23,7 +23,6 @@ struct CullParams {
     wave_aggregated_atomics: u32,
     // Scene quantity: segments in the full numbering.
     segments: u32,
-    kept_only: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: CullParams;
@@ -118,51 +117,22 @@ fn test(seg: DrawnSegment, c0_in: vec4<f32>, c1_in: vec4<f32>) -> Verdict {
     return out;
 }
 
-// A segment to test and its id in the full numbering (cull::culled_segment).
-struct Culled {
-    seg: DrawnSegment,
-    id: u32,
-}
-
-// cull::culled_segment: invocation g tests the g-th segment the LOD keeps
-// (kept_only), numbered by ModelLod::segment_prefix, else segment id g.
-fn culled_segment(g: u32) -> Culled {
-    var out = Culled(DrawnSegment(false, 0u, 0u, 0u, 0u), g);
-    if params.kept_only == 0u {
-        if g < params.segments {
-            out.seg = drawn_segment(g);
-        }
-        return out;
-    }
-    for (var m = 0u; m < frame.model_count; m++) {
-        let first = lod_models[m].segment_prefix;
-        let per = lod_models[m].segments_per_strand;
-        if g >= first && g - first < lod_models[m].strands * per {
-            let j = g - first;
-            let md = models[m];
-            out.id = md.segment_first + (j / per) * (md.points_per_strand - 1u) + j % per;
-            out.seg = drawn_in_model(md, load_lod(lod_models[m]), m, out.id);
-            return out;
-        }
-    }
-    return out;
-}
-
 @compute @workgroup_size(256)
 fn cull(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) index: u32,
     @builtin(subgroup_invocation_id) lane: u32,
 ) {
-    let culled = culled_segment(wg.x * GROUP + index);
-    let seg = culled.seg;
-    let id = culled.id;
+    let id = wg.x * GROUP + index;
     var v = Verdict(false, vec4<u32>(0u), 0u);
     var model = 0u;
     // No early return: every lane reaches the subgroup operations below.
-    if seg.valid {
-        v = test(seg, clip_positions[seg.va], clip_positions[seg.vb]);
-        model = seg.model;
+    if id < params.segments {
+        let seg = drawn_segment(id);
+        if seg.valid {
+            v = test(seg, clip_positions[seg.va], clip_positions[seg.vb]);
+            model = seg.model;
+        }
     }
     let word = id / 32u;
     let bit = 1u << (id % 32u);

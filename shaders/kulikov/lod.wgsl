@@ -120,7 +120,6 @@ fn lod() {
         }
     }
     var prefix = 0u;
-    var segments = 0u;
     for (var mi = 0u; mi < count; mi++) {
         let strands = lod_models[mi].strands;
         if params.thickness_compensation != 0u && strands > 0u {
@@ -130,8 +129,6 @@ fn lod() {
         }
         lod_models[mi].strand_prefix = prefix;
         prefix += strands;
-        lod_models[mi].segment_prefix = segments;
-        segments += strands * lod_models[mi].segments_per_strand;
     }
     skin_args[0] = (prefix + SKIN_GROUP - 1u) / SKIN_GROUP;
     skin_args[1] = 1u;

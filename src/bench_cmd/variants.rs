@@ -106,16 +106,6 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
-    // Ours: the cull's invocations walk the segments the LOD keeps, so
-    // those past the kept count exit at once (passes/src/kulikov/cull.rs).
-    Variant {
-        pipeline: "Kulikov",
-        name: "cull over every segment",
-        graph: KULIKOV,
-        overrides: &["cull.kept_only=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min32",
-    },
     // Quality ablations of the talk's composition (their FLIP against the
     // reference is the point; the raster still writes three layers):
     // one atlas layer instead of three, the random-lines limit 1 - e^-x

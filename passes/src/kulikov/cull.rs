@@ -27,12 +27,6 @@ pub struct CullParams {
     pub fedora: bool,
     /// One atomic per subgroup and target instead of one per lane.
     pub wave_aggregated_atomics: bool,
-    /// Ours: invocation g tests the g-th segment the LOD keeps (numbered by
-    /// `ModelLod::segment_prefix`), so invocations past the kept count exit
-    /// at once; off, invocation g tests segment id g and looks its model
-    /// and LOD up. Either way every segment of the full numbering has an
-    /// invocation, and the results are the same.
-    pub kept_only: bool,
 }
 
 impl Default for CullParams {
@@ -42,7 +36,6 @@ impl Default for CullParams {
             occlusion: true,
             fedora: true,
             wave_aggregated_atomics: true,
-            kept_only: true,
         }
     }
 }
@@ -50,7 +43,7 @@ impl Default for CullParams {
 impl PassParams for CullParams {}
 
 crate::gpu_block! {
-    /// `CullParams`: the switches, then the segment count.
+    /// `CullParams`: the four switches, then the segment count.
     pub struct CullGpu {
         frustum: u32,
         occlusion: u32,
@@ -58,7 +51,6 @@ crate::gpu_block! {
         wave_aggregated_atomics: u32,
         /// Scene quantity: segments in the full numbering.
         segments: u32,
-        kept_only: u32,
     }
 }
 
@@ -89,7 +81,6 @@ pub static CULL: PassKind<CullParams, CullGpu> = PassKind {
         fedora: flag(p.fedora),
         wave_aggregated_atomics: flag(p.wave_aggregated_atomics),
         segments: count(q.segments),
-        kept_only: flag(p.kept_only),
     },
     raster: None,
 };
@@ -123,27 +114,6 @@ pub fn drawn_segment(scene: &Scene, lods: &[ModelLod], id: u32) -> Option<DrawnS
         v0: base + a,
         v1: base + b,
     })
-}
-
-/// The segment invocation `g` of the cull tests, with its id in the full
-/// numbering: the g-th segment the LOD keeps (`kept_only`), else id `g`.
-fn culled_segment(
-    scene: &Scene,
-    lods: &[ModelLod],
-    kept_only: bool,
-    g: u32,
-) -> Option<(u32, DrawnSegment)> {
-    if !kept_only {
-        return drawn_segment(scene, lods, g).map(|s| (g, s));
-    }
-    let (m, l) = lods.iter().enumerate().find(|(_, l)| {
-        g >= l.segment_prefix && g - l.segment_prefix < l.strands * l.segments_per_strand
-    })?;
-    let md = &scene.models[m];
-    let j = g - l.segment_prefix;
-    let (strand, k) = (j / l.segments_per_strand, j % l.segments_per_strand);
-    let id = md.segment_first + strand * (md.points_per_strand - 1) + k;
-    drawn_segment(scene, lods, id).map(|s| (id, s))
 }
 
 /// The sort bucket of a segment: the 64×64 screen tile of its midpoint.
@@ -258,9 +228,9 @@ impl CpuKernel for CullKernel {
         for sub in 0..GROUP.div_ceil(width) {
             let lanes = (sub * width..((sub + 1) * width).min(GROUP)).map(|l| group * GROUP + l);
             let visible: Vec<Visible> = lanes
-                .filter(|&g| u64::from(g) < total)
-                .filter_map(|g| {
-                    let (id, seg) = culled_segment(&scene, &lods, self.0.kept_only, g)?;
+                .filter(|&id| u64::from(id) < total)
+                .filter_map(|id| {
+                    let seg = drawn_segment(&scene, &lods, id)?;
                     let (c0, c1) = (
                         clip.load_vec4(seg.v0 as usize),
                         clip.load_vec4(seg.v1 as usize),

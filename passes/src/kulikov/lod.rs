@@ -217,7 +217,6 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
                 strand_prefix: 0,
                 depth_near: near,
                 depth_far: far,
-                segment_prefix: 0,
             }
         })
         .collect();
@@ -231,7 +230,7 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
             l.strands = (f64::from(l.strands) * factor).floor() as u32;
         }
     }
-    let (mut prefix, mut segments) = (0, 0);
+    let mut prefix = 0;
     for (l, m) in lods.iter_mut().zip(&scene.models) {
         if p.thickness_compensation && l.strands > 0 {
             // Coverage is additive in this pipeline: keep strands × thickness constant.
@@ -241,8 +240,6 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
         }
         l.strand_prefix = prefix;
         prefix += l.strands;
-        l.segment_prefix = segments;
-        segments += l.strands * l.segments_per_strand;
     }
     lods
 }

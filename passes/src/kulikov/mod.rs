@@ -41,8 +41,6 @@ pub struct ModelLod {
     /// Linear view depth range of the model's bounds, for payload depth.
     pub depth_near: f32,
     pub depth_far: f32,
-    /// Drawn segments of all earlier models (the cull's `kept_only` numbering).
-    pub segment_prefix: u32,
 }
 
 impl ModelLod {
@@ -58,7 +56,6 @@ impl ModelLod {
             strand_prefix: w.load(b + 4),
             depth_near: w.load_f32(b + 5),
             depth_far: w.load_f32(b + 6),
-            segment_prefix: w.load(b + 7),
         }
     }
 
@@ -71,7 +68,7 @@ impl ModelLod {
         w.store(b + 4, self.strand_prefix);
         w.store_f32(b + 5, self.depth_near);
         w.store_f32(b + 6, self.depth_far);
-        w.store(b + 7, self.segment_prefix);
+        w.store(b + 7, 0);
     }
 
     /// The two vertex indices (within the strand) of drawn segment `k`.
