@@ -269,8 +269,11 @@ pub fn override_param(plan: &mut Plan, spec: &str) -> Result<(), String> {
             plan.graph.name
         ));
     }
+    // Every copy's new parameters are checked before any is written, so a
+    // failed override leaves the plan as it was.
+    let mut written = Vec::with_capacity(targets.len());
     for p in targets {
-        let pass = &mut plan.graph.passes[p];
+        let pass = &plan.graph.passes[p];
         let mut params = match &pass.params {
             ron::Value::Map(m) => m.clone(),
             _ => ron::Map::new(),
@@ -278,7 +281,10 @@ pub fn override_param(plan: &mut Plan, spec: &str) -> Result<(), String> {
         params.insert(ron::Value::String(param.trim().to_string()), value.clone());
         check_override(&pass.name, &pass.kind, &params, param.trim())
             .map_err(|e| format!("--param {spec}: {e}"))?;
-        pass.params = ron::Value::Map(params);
+        written.push((p, params));
+    }
+    for (p, params) in written {
+        plan.graph.passes[p].params = ron::Value::Map(params);
     }
     Ok(())
 }
@@ -294,18 +300,18 @@ fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Re
     let g = &mut plan.graph;
     let r = g.physical(g.resource_id(image).expect("checked by the caller"));
     // The image and its versions (`a -> a.final`) share one declaration.
-    for v in 0..g.resources.len() {
-        if v != r && g.resources[v].version_of != Some(r) {
-            continue;
-        }
-        let ResourceDecl::Image { samples, .. } = &mut g.resources[v].decl else {
-            return Err(format!(
-                "--param {spec}: `{image}` is a buffer, not an image"
-            ));
-        };
-        *samples = n;
-    }
-    if let Some(why) = strandgraph_graph::resolve::samples_problem(&g.resources[r].decl) {
+    let versions: Vec<usize> = (0..g.resources.len())
+        .filter(|&v| v == r || g.resources[v].version_of == Some(r))
+        .collect();
+    let buffer = || format!("--param {spec}: `{image}` is a buffer, not an image");
+    // The new declaration is checked before it is written anywhere, so a
+    // failed override leaves the plan as it was.
+    let mut decl = g.resources[r].decl.clone();
+    let ResourceDecl::Image { samples, .. } = &mut decl else {
+        return Err(buffer());
+    };
+    *samples = n;
+    if let Some(why) = strandgraph_graph::resolve::samples_problem(&decl) {
         return Err(format!("--param {spec}: image `{image}` {why}"));
     }
     let attachment_only = g
@@ -317,6 +323,17 @@ fn override_samples(plan: &mut Plan, spec: &str, image: &str, value: &str) -> Re
         return Err(format!(
             "--param {spec}: a pass uses `{image}` as more than an attachment, so it cannot be multisampled"
         ));
+    }
+    if versions
+        .iter()
+        .any(|&v| !matches!(g.resources[v].decl, ResourceDecl::Image { .. }))
+    {
+        return Err(buffer());
+    }
+    for v in versions {
+        if let ResourceDecl::Image { samples, .. } = &mut g.resources[v].decl {
+            *samples = n;
+        }
     }
     Ok(())
 }
@@ -413,6 +430,40 @@ mod tests {
         assert!(e.message.contains("\"Fast\", \"Exact\""), "{}", e.message);
         let e = check::<Example>(&v("[1, 2]")).unwrap_err();
         assert_eq!(e.key, "");
+    }
+
+    /// Found by the `param` fuzz target: `strand_depth.samples=3` was refused
+    /// after the sample count had been written, leaving the plan with a
+    /// 3-sample image; a per-model override could likewise set some copies
+    /// before another's check failed. A failed override now changes nothing.
+    #[test]
+    fn a_failed_override_leaves_the_plan_as_it_was() {
+        let text = include_str!("../../scenes/graphs/hw_mesh.ron");
+        let mut plan =
+            strandgraph_graph::compile_str("hw_mesh.ron", text, &crate::Registry, 2).unwrap();
+        let snapshot = |plan: &Plan| {
+            let g = &plan.graph;
+            let params: Vec<_> = g.passes.iter().map(|p| p.params.clone()).collect();
+            (params, format!("{:?}", g.resources))
+        };
+        let before = snapshot(&plan);
+        for spec in [
+            "strand_depth.samples=3",
+            "strand_depth.samples=x",
+            "filter.msaa=3",
+            "filter.model_index=1",
+            "filter[1].nope=1",
+            "nope.x=1",
+            "filter.msaa",
+            "filter.msaa=(",
+        ] {
+            let e = override_param(&mut plan, spec).unwrap_err();
+            assert!(e.starts_with(&format!("--param {spec}: ")), "{e}");
+            assert!(snapshot(&plan) == before, "{spec} changed the plan: {e}");
+        }
+        override_param(&mut plan, "strand_depth.samples=8").unwrap();
+        override_param(&mut plan, "filter.msaa=8").unwrap();
+        assert!(snapshot(&plan) != before);
     }
 
     #[test]

@@ -10,6 +10,7 @@
 #import strandgraph::clip::{clip_to_screen, near_clip}
 #import strandgraph::kulikov::screen_bin
 #import strandgraph::scan::{scan_run, scan_lanes, scan_total, SCAN_LANES}
+#import strandgraph::subgroup::elected
 
 struct SortParams {
     // kulikov.sort `enabled` (scatter only).
@@ -18,6 +19,8 @@ struct SortParams {
     // (64x64 screen tiles); the word after the bins is the arrival counter.
     segments: u32,
     bins: u32,
+    // kulikov.sort `wave_aggregated_atomics` (scatter only).
+    aggregate: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: SortParams;
@@ -66,28 +69,63 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
 @group(0) @binding(7) var<storage, read_write> sorted_segments: array<u32>;
 
 const GROUP: u32 = 256u;
+const NONE: u32 = 0xFFFFFFFFu;
+
+// ScatterKernel::bucket: the bucket segment `id` goes to, NONE when it is
+// not drawn.
+fn bucket(id: u32) -> u32 {
+    if id >= params.segments || (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
+        return NONE;
+    }
+    if params.enabled == 0u {
+        return params.bins;
+    }
+    let seg = drawn_segment(id);
+    if !seg.valid {
+        return NONE;
+    }
+    let w = frame.screen.x;
+    let h = frame.screen.y;
+    // The bin the cull counted: that of the part in front of the near plane.
+    let part = near_clip(clip_positions[seg.va], clip_positions[seg.vb], frame.near);
+    return screen_bin(w, h, clip_to_screen(part.a, w, h), clip_to_screen(part.b, w, h));
+}
 
 @compute @workgroup_size(256)
-fn scatter(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let id = wg.x * GROUP + lane;
-    if id >= params.segments || (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
+fn scatter(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) index: u32,
+    @builtin(subgroup_invocation_id) lane: u32,
+) {
+    let id = wg.x * GROUP + index;
+    let key = bucket(id);
+    if params.aggregate == 0u {
+        if key != NONE {
+            sorted_segments[atomicAdd(&sort_offsets[key], 1u)] = id;
+        }
         return;
     }
-    var slot = 0u;
-    if params.enabled != 0u {
-        let seg = drawn_segment(id);
-        if !seg.valid {
-            return;
+    // Ours: one atomicAdd per subgroup and bucket, the subgroup's lanes of
+    // that bucket taking consecutive slots in lane order. The loop
+    // condition is subgroup-uniform, so all lanes run the collectives.
+    var pending = key != NONE;
+    loop {
+        let k = subgroupMin(select(NONE, key, pending));
+        if k == NONE {
+            break;
         }
-        let w = frame.screen.x;
-        let h = frame.screen.y;
-        // The bin the cull counted: that of the part in front of the near plane.
-        let part = near_clip(clip_positions[seg.va], clip_positions[seg.vb], frame.near);
-        let s0 = clip_to_screen(part.a, w, h);
-        let s1 = clip_to_screen(part.b, w, h);
-        slot = atomicAdd(&sort_offsets[screen_bin(w, h, s0, s1)], 1u);
-    } else {
-        slot = atomicAdd(&sort_offsets[params.bins], 1u);
+        let mine = pending && key == k;
+        let n = subgroupAdd(select(0u, 1u, mine));
+        let rank = subgroupExclusiveAdd(select(0u, 1u, mine));
+        var base = 0u;
+        if elected(lane) {
+            base = atomicAdd(&sort_offsets[k], n);
+        }
+        // The elected lane is the lowest active one, as subgroupBroadcastFirst reads.
+        base = subgroupBroadcastFirst(base);
+        if mine {
+            sorted_segments[base + rank] = id;
+        }
+        pending = pending && !mine;
     }
-    sorted_segments[slot] = id;
 }

@@ -106,6 +106,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
+    // Ours: the sort's scatter issues one atomicAdd per subgroup and
+    // bucket (passes/src/kulikov/sort.rs).
+    Variant {
+        pipeline: "Kulikov",
+        name: "no sort aggregation",
+        graph: KULIKOV,
+        overrides: &["sort.wave_aggregated_atomics=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
     // Quality ablations of the talk's composition (their FLIP against the
     // reference is the point; the raster still writes three layers):
     // one atlas layer instead of three, the random-lines limit 1 - e^-x

@@ -22,11 +22,17 @@ use strandgraph_graph::schema::Quantity;
 pub struct SortParams {
     /// Off: segments keep arrival order (the talk's "unsorted" baseline).
     pub enabled: bool,
+    /// Ours: one atomicAdd per subgroup and bucket instead of one per
+    /// segment; the subgroup's segments of a bucket take consecutive slots.
+    pub wave_aggregated_atomics: bool,
 }
 
 impl Default for SortParams {
     fn default() -> Self {
-        Self { enabled: true }
+        Self {
+            enabled: true,
+            wave_aggregated_atomics: true,
+        }
     }
 }
 
@@ -41,14 +47,17 @@ crate::gpu_block! {
         segments: u32,
         /// Sort bins (64x64 screen tiles).
         bins: u32,
+        /// kulikov.sort `wave_aggregated_atomics` (scatter only).
+        aggregate: u32,
     }
 }
 
-fn sort_gpu(enabled: bool, q: &Quantities) -> SortGpu {
+fn sort_gpu(p: SortParams, q: &Quantities) -> SortGpu {
     SortGpu {
-        enabled: flag(enabled),
+        enabled: flag(p.enabled),
         segments: count(q.segments),
         bins: count(q.count(Quantity::Tiles(super::TILE))),
+        aggregate: flag(p.wave_aggregated_atomics),
     }
 }
 
@@ -66,8 +75,8 @@ pub static SORT_SCAN: PassKind<NoParams, SortGpu> = PassKind {
     dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("kulikov/sort.wgsl", "scan"),
     kernel: |_| Box::new(ScanKernel),
-    // `enabled` is unused by the scan.
-    gpu: |_, q| sort_gpu(true, q),
+    // The switches are the scatter's.
+    gpu: |_, q| sort_gpu(SortParams::default(), q),
     raster: None,
 };
 
@@ -90,8 +99,8 @@ pub static SORT: PassKind<SortParams, SortGpu> = PassKind {
         per_group: CULL_GROUP,
     },
     shader: Shader::compute("kulikov/sort.wgsl", "scatter"),
-    kernel: |p| Box::new(ScatterKernel { enabled: p.enabled }),
-    gpu: |p, q| sort_gpu(p.enabled, q),
+    kernel: |p| Box::new(ScatterKernel(*p)),
+    gpu: |p, q| sort_gpu(*p, q),
     raster: None,
 };
 
@@ -119,48 +128,77 @@ impl CpuKernel for ScanKernel {
     }
 }
 
-struct ScatterKernel {
-    enabled: bool,
+struct ScatterKernel(SortParams);
+
+impl ScatterKernel {
+    /// The bucket segment `id` goes to (the WGSL's `bucket`), `None` when
+    /// it is not drawn.
+    fn bucket(
+        &self,
+        scene: &Scene,
+        lods: &[super::ModelLod],
+        ctx: &Ctx<'_>,
+        id: u32,
+    ) -> Option<u32> {
+        let bits = ctx.words("segment_visibility");
+        if u64::from(id) >= ctx.quantities.segments
+            || bits.load((id / 32) as usize) & (1 << (id % 32)) == 0
+        {
+            return None;
+        }
+        if !self.0.enabled {
+            return Some(ctx.quantities.count(Quantity::Tiles(super::TILE)) as u32);
+        }
+        let seg = drawn_segment(scene, lods, id)?;
+        let clip = ctx.words("clip_positions");
+        let (c0, c1) = (
+            clip.load_vec4(seg.v0 as usize),
+            clip.load_vec4(seg.v1 as usize),
+        );
+        // The bin the cull counted: that of the part in front of the near plane.
+        let part = near_clip(c0, c1, scene.frame.near)?;
+        let (w, h) = (scene.frame.screen[0], scene.frame.screen[1]);
+        Some(screen_bin(
+            w,
+            h,
+            clip_to_screen(part.a, w, h),
+            clip_to_screen(part.b, w, h),
+        ))
+    }
 }
 
 impl CpuKernel for ScatterKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let scene = Scene::load(ctx);
         let lods = scene.lods(ctx);
-        let (clip, bits, offsets, out) = (
-            ctx.words("clip_positions"),
-            ctx.words("segment_visibility"),
-            ctx.words("sort_offsets"),
-            ctx.words("sorted_segments"),
-        );
-        let counter = ctx.quantities.count(Quantity::Tiles(super::TILE)) as usize;
-        let (w, h) = (scene.frame.screen[0], scene.frame.screen[1]);
-        for lane in 0..CULL_GROUP {
-            let id = group * CULL_GROUP + lane;
-            if u64::from(id) >= ctx.quantities.segments
-                || bits.load((id / 32) as usize) & (1 << (id % 32)) == 0
-            {
-                continue;
+        let (offsets, out) = (ctx.words("sort_offsets"), ctx.words("sorted_segments"));
+        let width = if self.0.wave_aggregated_atomics {
+            ctx.subgroup_width.max(1)
+        } else {
+            1
+        };
+        for sub in 0..CULL_GROUP.div_ceil(width) {
+            let ids =
+                (sub * width..((sub + 1) * width).min(CULL_GROUP)).map(|l| group * CULL_GROUP + l);
+            let keyed: Vec<(u32, u32)> = ids
+                .filter_map(|id| Some((self.bucket(&scene, &lods, ctx, id)?, id)))
+                .collect();
+            // Buckets in ascending order (the subgroupMin loop), one atomic
+            // each; the lanes of a bucket in lane order.
+            let mut buckets: Vec<u32> = keyed.iter().map(|&(k, _)| k).collect();
+            buckets.sort_unstable();
+            buckets.dedup();
+            for k in buckets {
+                let lanes: Vec<u32> = keyed
+                    .iter()
+                    .filter(|&&(b, _)| b == k)
+                    .map(|&(_, id)| id)
+                    .collect();
+                let base = offsets.fetch_add(k as usize, lanes.len() as u32);
+                for (rank, id) in lanes.into_iter().enumerate() {
+                    out.store(base as usize + rank, id);
+                }
             }
-            let slot = if self.enabled {
-                let Some(seg) = drawn_segment(&scene, &lods, id) else {
-                    continue;
-                };
-                // The bin the cull counted: that of the part in front of the near plane.
-                let (c0, c1) = (
-                    clip.load_vec4(seg.v0 as usize),
-                    clip.load_vec4(seg.v1 as usize),
-                );
-                let Some(part) = near_clip(c0, c1, scene.frame.near) else {
-                    continue;
-                };
-                let s0 = clip_to_screen(part.a, w, h);
-                let s1 = clip_to_screen(part.b, w, h);
-                offsets.fetch_add(screen_bin(w, h, s0, s1) as usize, 1)
-            } else {
-                offsets.fetch_add(counter, 1)
-            };
-            out.store(slot as usize, id);
         }
     }
 }
