@@ -231,7 +231,7 @@ fn lod(l: &LodSettings) -> Result<(), String> {
 
 fn fedora(f: &Fedora) -> Result<(), String> {
     let all = [f.box_min, f.box_max, f.sphere_center].concat();
-    if !finite(&all) || !(f.sphere_radius.is_finite() && f.sphere_radius >= 0.0) {
+    if !(finite(&all) && f.sphere_radius.is_finite() && f.sphere_radius >= 0.0) {
         return Err("fedora: every number must be finite (sphere_radius >= 0)".into());
     }
     Ok(())
