@@ -547,6 +547,20 @@ mod tests {
         );
     }
 
+    /// Found by the envmap_exr fuzz target (the fuzzer's input, 563 bytes):
+    /// a B44 block whose deltas take a pixel below zero. exr's unpack14
+    /// computes in u32 and relies on wrap-around, as OpenEXR's C++ does, so
+    /// with overflow checks (dev builds, tests, fuzzing) it panicked with
+    /// "attempt to subtract with overflow" where release decodes garbage.
+    /// The root Cargo.toml keeps exr's arithmetic as in release.
+    #[test]
+    fn a_b44_block_that_wraps_around_does_not_panic() {
+        let bytes = include_bytes!("testdata/b44_wrapping.exr");
+        if let Ok(m) = parse(bytes) {
+            assert_eq!(m.texels.len(), (m.width * m.height) as usize);
+        }
+    }
+
     #[test]
     fn negative_texels_are_clamped() {
         let m = parse(&exr_bytes(4, 2, |_, _| [-1.0, 0.5, 0.0])).unwrap();
