@@ -3,7 +3,8 @@
 # (Graphviz for the DOT export check; Chromium for the HTML report's; a
 # Vulkan driver, lavapipe, and the Vulkan loader for the wgpu differential
 # test when no Vulkan device is installed), then the workspace tests and a
-# quick pass of the criterion benches so they keep building and running.
+# quick pass of the criterion benches so they keep building and running, and
+# a smoke run of every fuzz target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -48,3 +49,6 @@ cargo install --path . --root "$install_root" --locked --target-dir target --qui
 (cd "$empty_dir" && "$install_root/bin/strandgraph" render --demo --size 320x180 -o demo.png && test -s demo.png)
 rm -rf "$install_root" "$empty_dir"
 echo "installed binary: rendered the demo scene from an empty directory"
+# Every fuzz target for 10 s over its committed corpus, under the
+# campaigns' memory and time limits (nightly and cargo-fuzz; fuzz/README.md).
+bash scripts/fuzz_smoke.sh
