@@ -184,6 +184,9 @@ fn exr_attribute(data: &[u8], name: &str, type_name: &str, nth: usize) -> Locati
 /// 788,529,160 pixels wide made the B44 decompressor ask for 18.9 GB. Each
 /// part's data window must fit [`MAX_WIDTH`] x [`MAX_HEIGHT`], and its
 /// pixels times its channels' bytes must fit the decoder's allocation limit.
+/// So must one block (a tile, or the scan lines compressed together), which
+/// the decoder reserves before it reads the block: a 547-byte file with
+/// 4 x 536,870,916-pixel tiles asked for 1.65 GB.
 fn check_exr_parts(data: &[u8]) -> Result<(), FormatError> {
     let meta = exr::meta::MetaData::read_from_buffered(data, false).map_err(|e| {
         FormatError::new(
@@ -209,13 +212,35 @@ fn check_exr_parts(data: &[u8]) -> Result<(), FormatError> {
                 ));
             }
         }
-        let bytes = w * h * part.channels.bytes_per_pixel as u64;
+        let pixel_bytes = part.channels.bytes_per_pixel as u64;
+        let bytes = w * h * pixel_bytes;
         if bytes > MAX_ALLOC {
             return Err(FormatError::new(
                 exr_attribute(data, "channels", "chlist", i),
                 FormatErrorKind::AbsurdCount {
                     field: "decoded bytes (dataWindow pixels x channel bytes)",
                     value: bytes,
+                    max: MAX_ALLOC,
+                },
+            ));
+        }
+        let (block_pixels, at) = match part.blocks {
+            exr::meta::BlockDescription::Tiles(t) => (
+                t.tile_size.x() as u128 * t.tile_size.y() as u128,
+                exr_attribute(data, "tiles", "tiledesc", i),
+            ),
+            exr::meta::BlockDescription::ScanLines => (
+                part.compression.scan_lines_per_block() as u128 * u128::from(w),
+                exr_attribute(data, "compression", "compression", i),
+            ),
+        };
+        let block_bytes = block_pixels * u128::from(pixel_bytes);
+        if block_bytes > u128::from(MAX_ALLOC) {
+            return Err(FormatError::new(
+                at,
+                FormatErrorKind::AbsurdCount {
+                    field: "block bytes (tile or scan-line block pixels x channel bytes)",
+                    value: u64::try_from(block_bytes).unwrap_or(u64::MAX),
                     max: MAX_ALLOC,
                 },
             ));
@@ -559,6 +584,50 @@ mod tests {
         if let Ok(m) = parse(bytes) {
             assert_eq!(m.texels.len(), (m.width * m.height) as usize);
         }
+    }
+
+    /// Found by the envmap_exr fuzz target (an out-of-memory crash; the
+    /// fuzzer's input is testdata/tile_size.exr): a tile's size, which the
+    /// decoder reserves for each block before reading it, was not checked.
+    #[test]
+    fn an_exr_tile_past_the_allocation_limit_is_refused_where_it_is() {
+        let e = format_error(include_bytes!("testdata/tile_size.exr"));
+        assert!(
+            matches!(e.kind, FormatErrorKind::AbsurdCount { field, .. } if field.starts_with("block bytes")),
+            "{e}"
+        );
+        // The same in a file written by exr: 4 x 4 tiles made 65536 x 65536.
+        use exr::prelude::*;
+        let channels = SpecificChannels::rgb(|_: Vec2<usize>| (1.0f32, 1.0f32, 1.0f32));
+        let encoding = Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::Tiles(Vec2(4, 4)),
+            line_order: LineOrder::Increasing,
+        };
+        let mut out = std::io::Cursor::new(Vec::new());
+        Image::from_encoded_channels((8, 4), encoding, channels)
+            .write()
+            .to_buffered(&mut out)
+            .unwrap();
+        let mut bytes = out.into_inner();
+        assert!(parse(&bytes).is_ok());
+        let Location::Byte(at) = exr_attribute(&bytes, "tiles", "tiledesc", 0) else {
+            panic!("no tiles attribute")
+        };
+        let size = at + "tiles\0tiledesc\0".len() + 4;
+        bytes[size..size + 4].copy_from_slice(&65536u32.to_le_bytes());
+        bytes[size + 4..size + 8].copy_from_slice(&65536u32.to_le_bytes());
+        assert_eq!(
+            format_error(&bytes),
+            FormatError::new(
+                Location::Byte(at),
+                FormatErrorKind::AbsurdCount {
+                    field: "block bytes (tile or scan-line block pixels x channel bytes)",
+                    value: 65536 * 65536 * 12,
+                    max: MAX_ALLOC,
+                }
+            )
+        );
     }
 
     #[test]
