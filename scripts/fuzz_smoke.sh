@@ -7,7 +7,8 @@
 # every target has run); libFuzzer's artefact is left in fuzz/artifacts/.
 # New inputs go to a scratch directory: the committed corpora stay as they are.
 #
-# Needs a nightly toolchain and cargo-fuzz; fails (does not skip) without them.
+# Needs a nightly toolchain and cargo-fuzz, and installs them when missing
+# (rustup, cargo install); fails, never skips, when that does not work.
 # FUZZ_TARGET_DIR: the build directory (default fuzz/target).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,13 +16,17 @@ cd "$(dirname "$0")/.."
 seconds="${FUZZ_SMOKE_SECONDS:-10}"
 target_dir="${FUZZ_TARGET_DIR:-fuzz/target}"
 
+# Installs what is missing, as scripts/test.sh does for packages; fails
+# (never skips) when that does not work.
 if ! cargo +nightly --version >/dev/null 2>&1; then
-  echo "fuzz_smoke.sh: no nightly toolchain; install it with: rustup toolchain install nightly" >&2
-  exit 1
+  echo "fuzz_smoke.sh: installing the nightly toolchain"
+  rustup toolchain install nightly --profile minimal ||
+    { echo "fuzz_smoke.sh: no nightly toolchain; install it with: rustup toolchain install nightly" >&2; exit 1; }
 fi
 if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
-  echo "fuzz_smoke.sh: no cargo-fuzz; install it with: cargo install cargo-fuzz" >&2
-  exit 1
+  echo "fuzz_smoke.sh: installing cargo-fuzz"
+  cargo install cargo-fuzz --locked ||
+    { echo "fuzz_smoke.sh: no cargo-fuzz; install it with: cargo install cargo-fuzz" >&2; exit 1; }
 fi
 
 # The longest input each target is fuzzed with (as in the campaigns).
