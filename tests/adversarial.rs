@@ -41,7 +41,13 @@ fn scene(name: &str, grooms: &str, meshes: &str, graph: &str, size: (u32, u32)) 
 fn error_of(path: &Path) -> String {
     match prepare(path, None, None) {
         Ok(_) => panic!("{} prepared without an error", path.display()),
-        Err(e) => format!("{e:?}"),
+        // The chain, not the graphical report: that wraps lines at the
+        // terminal width, which would split the names the tests look for.
+        Err(e) => e
+            .chain()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(": "),
     }
 }
 
