@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test on a fresh Debian machine: installs what the tests need
-# (Graphviz for the DOT export check; Chromium for the HTML report's; a
+# (Graphviz for the DOT export check; Chromium for the HTML report's; Xvfb
+# for the viewer's window; a
 # Vulkan driver, lavapipe, and the Vulkan loader for the wgpu differential
 # test when no Vulkan device is installed), then the workspace tests and a
 # quick pass of the criterion benches so they keep building and running, and
@@ -21,6 +22,12 @@ ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1' || missing+=(libvulkan1)
 # The ash tests run under the Khronos validation layer (synchronization
 # validation on) and fail, not skip, without it.
 ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json >/dev/null 2>&1 || missing+=(vulkan-validationlayers)
+# tests/view.rs opens the viewer's window under Xvfb; winit loads the X
+# libraries at run time.
+command -v xvfb-run >/dev/null 2>&1 || missing+=(xvfb)
+for lib in xauth libx11-xcb1 libxcursor1 libxi6 libxrandr2 libxkbcommon-x11-0; do
+  dpkg -s "$lib" >/dev/null 2>&1 || missing+=("$lib")
+done
 if ((${#missing[@]})); then
   echo "installing: ${missing[*]}"
   sudo_cmd=""

@@ -37,23 +37,51 @@ pub fn prepare_with(
     overrides: &[String],
 ) -> Result<Prepared> {
     let scene = Scene::load(scene_path).map_err(|e| miette::miette!("{e}"))?;
-    let (w, h) = size.unwrap_or(scene.desc.resolution);
+    let size = size.unwrap_or(scene.desc.resolution);
+    let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
+    let Planned {
+        upload,
+        plan,
+        instance,
+    } = plan_for(&scene, &graph_path, size, overrides)?;
+    Ok(Prepared {
+        scene,
+        upload,
+        plan,
+        instance,
+    })
+}
+
+/// A loaded scene's frame for one graph: [`Prepared`] without the scene.
+pub struct Planned {
+    pub upload: Upload,
+    pub plan: Plan,
+    pub instance: Instance,
+}
+
+/// Compiles `graph` for a loaded `scene` at `(w, h)`, applies `overrides`,
+/// packs the scene for it and instantiates the plan: how the viewer opens
+/// one graph after another on the scene it holds.
+pub fn plan_for(
+    scene: &Scene,
+    graph: &Path,
+    (w, h): (u32, u32),
+    overrides: &[String],
+) -> Result<Planned> {
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(miette::miette!(
             "{}: resolution {w}x{h} is outside 1..=16384",
-            scene_path.display()
+            scene.path.display()
         ));
     }
-    let graph_path = graph.map_or_else(|| scene.graph.clone(), Path::to_path_buf);
-    let mut plan = compile_file(&graph_path, &Registry, scene.grooms.len() as u32)?;
+    let mut plan = compile_file(graph, &Registry, scene.grooms.len() as u32)?;
     for spec in overrides {
         override_param(&mut plan, spec)?;
     }
-    let mut upload = upload(&scene, w, h);
-    complete_upload(&plan, &scene, &mut upload)?;
+    let mut upload = upload(scene, w, h);
+    complete_upload(&plan, scene, &mut upload)?;
     let instance = plan.instantiate(&upload.quantities)?;
-    Ok(Prepared {
-        scene,
+    Ok(Planned {
         upload,
         plan,
         instance,

@@ -12,6 +12,7 @@ mod render_cmd;
 mod report_cmd;
 mod shell_cmd;
 mod tables_cmd;
+mod view_cmd;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -39,6 +40,8 @@ enum Command {
     Compare(compare_cmd::Args),
     /// Run the bench with pictures and write an HTML page: pictures beside the reference, FLIP maps, time-versus-FLIP chart, per-pass bars.
     Report(report_cmd::Args),
+    /// Open a window on a scene: any graph live on wgpu, split-screen A/B, parameters as widgets, per-pass GPU times.
+    View(view_cmd::Args),
     /// Regenerate (or --check) README's tables from the measurements under benches/results/.
     Tables(tables_cmd::Args),
     /// Print the shell completion script for bash, zsh, fish, elvish or PowerShell.
@@ -65,6 +68,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => compare_cmd::run(args),
         Command::Report(args) => report_cmd::run(args),
         Command::Tables(args) => tables_cmd::run(args),
+        Command::View(args) => view_cmd::run(args),
         Command::Completions(args) => shell_cmd::completions::<Cli>(args),
         Command::Man(args) => shell_cmd::man::<Cli>(args),
     };

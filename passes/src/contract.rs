@@ -163,6 +163,12 @@ pub trait PassDef: Send + Sync {
         let _ = params;
         Ok(())
     }
+    /// Every parameter the kind takes, at its default, as a map from name
+    /// to value ([`crate::params::defaults`]); `Unit` when it has no typed
+    /// parameters.
+    fn param_defaults(&self) -> ron::Value {
+        ron::Value::Unit
+    }
     /// Reads the graph's parameters and returns the CPU kernel configured by them.
     fn cpu_kernel(&self, params: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError>;
     /// The WGSL parameter block (binding 0) as 32-bit words: the pass's

@@ -117,6 +117,9 @@ impl<P: PassParams, G: GpuBlock> PassDef for PassKind<P, G> {
             .map(drop)
             .map_err(|e| self.error(e))
     }
+    fn param_defaults(&self) -> ron::Value {
+        params::defaults::<P>()
+    }
     fn cpu_kernel(&self, value: &ron::Value) -> Result<Box<dyn CpuKernel>, ParamError> {
         Ok((self.kernel)(&self.params(value)?))
     }

@@ -31,7 +31,9 @@ impl Invalid {
 }
 
 /// A pass kind's parameters.
-pub trait PassParams: DeserializeOwned + Default + Send + Sync + 'static {
+pub trait PassParams:
+    DeserializeOwned + serde::Serialize + Default + Send + Sync + 'static
+{
     /// Whether the kind reads `model_index`, which graph/src/unroll.rs adds
     /// to every pass of a per-model block (declare it as
     /// `#[serde(deserialize_with = "crate::params::some")] model_index: Option<u32>`).
@@ -57,11 +59,25 @@ pub trait PassParams: DeserializeOwned + Default + Send + Sync + 'static {
 }
 
 /// No parameters: only an empty map (or none) is accepted.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct NoParams {}
 
 impl PassParams for NoParams {}
+
+/// A kind's parameters at their defaults, as a map from each name to its
+/// value: every parameter a graph file may set (the viewer's widgets).
+pub fn defaults<P: PassParams>() -> ron::Value {
+    let Ok(text) = ron::to_string(&P::default()) else {
+        return ron::Value::Unit;
+    };
+    match ron::from_str(&text) {
+        Ok(ron::Value::Map(map)) => ron::Value::Map(map),
+        // A struct without fields writes `()`.
+        Ok(ron::Value::Unit) => ron::Value::Map(ron::Map::new()),
+        _ => ron::Value::Unit,
+    }
+}
 
 /// Parses the parameters a graph file (or `--param`) wrote: every key must
 /// be one the kind declares, `model_index` included.
@@ -222,6 +238,12 @@ macro_rules! string_enum {
             pub const NAMES: &'static [&'static str] = &[$(stringify!($variant)),+];
         }
 
+        impl serde::Serialize for $name {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+                s.serialize_str(match self { $(Self::$variant => stringify!($variant)),+ })
+            }
+        }
+
         impl<'de> serde::Deserialize<'de> for $name {
             fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
                 let s = <String as serde::Deserialize>::deserialize(d)?;
@@ -366,11 +388,28 @@ fn check_override(pass: &str, kind: &str, params: &ron::Map, param: &str) -> Res
 mod tests {
     use super::*;
 
+    /// Every kind's defaults are a map a graph file could write back: each
+    /// name is one the kind accepts and each value one it parses to the
+    /// same default (what the viewer's widgets start from).
+    #[test]
+    fn every_kinds_defaults_are_parameters_it_accepts() {
+        for def in crate::PASSES {
+            let defaults = def.param_defaults();
+            let ron::Value::Map(map) = &defaults else {
+                panic!("{}: defaults are not a map: {defaults:?}", def.kind());
+            };
+            let mut written = map.clone();
+            written.remove(&ron::Value::String(MODEL_INDEX.into()));
+            def.check_params(&ron::Value::Map(written))
+                .unwrap_or_else(|e| panic!("{}: {e}", def.kind()));
+        }
+    }
+
     string_enum! {
         enum Mode { Fast, Exact }
     }
 
-    #[derive(Debug, PartialEq, serde::Deserialize)]
+    #[derive(Debug, PartialEq, serde::Deserialize, serde::Serialize)]
     #[serde(deny_unknown_fields, default)]
     struct Example {
         flag: bool,

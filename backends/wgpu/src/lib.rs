@@ -16,6 +16,7 @@
 //! render pass with begin/end `TIMESTAMP_QUERY` writes.
 
 mod depth_upload;
+mod gpu;
 mod interface;
 mod memory;
 mod pipelines;
@@ -25,11 +26,11 @@ mod record;
 mod session;
 mod shaders;
 
+pub use gpu::Gpu;
 use readback::read_buffer;
 pub use session::{Frame, Session};
 
 use naga::{AddressSpace, ImageClass, StorageAccess, TypeInner};
-use shaders::CAPABILITY_FEATURES;
 use std::borrow::Cow;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};

@@ -25,7 +25,7 @@ use strandgraph_graph::schema::Quantity;
 /// Triangles per CPU workgroup.
 const GROUP: u32 = 256;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RasterBenchParams {
     /// Edge of a grid square in pixels (0: one square covering the screen).

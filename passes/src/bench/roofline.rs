@@ -27,7 +27,7 @@ const VALUE_SALT: u32 = 0x9e37_79b9;
 const HIGH_SALT: u32 = 0x85eb_ca6b;
 
 /// The atomic roofline passes' parameters.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RooflineParams {
     /// Atomics per invocation (1..=256).

@@ -16,7 +16,7 @@ const GROUP: u32 = 256;
 /// 2.7 GB on the crowd; `Dispatch::CoverWrites` launches at most 65,535).
 pub const WORDS_PER_LANE: u32 = 16;
 
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ClearParams {
     /// The word every written resource is filled with.

@@ -25,7 +25,7 @@ use crate::lipp::{
 use crate::params::{Invalid, PassParams};
 use glam::Vec4;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct AssembleParams {
     /// Lipp Code 1's subgroup shuffles (as `lipp.raster`'s switch).

@@ -46,7 +46,7 @@ use strandgraph_graph::Quantities;
 /// minimum of 256 for `maxMeshOutputVertices` and `maxMeshOutputPrimitives`.
 pub const MESH_SEGMENTS: u32 = 64;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MeshParams {
     /// Quad width in pixels (as `hw_strands.raster`'s).

@@ -42,7 +42,7 @@ use strandgraph_graph::Quantities;
 /// Bands of rows the CPU kernel rasterizes in parallel.
 pub(super) const BANDS: u32 = 64;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RasterParams {
     /// Quad width in pixels: `lipp.raster`'s `centre_diameter`, the width

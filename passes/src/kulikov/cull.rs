@@ -19,7 +19,7 @@ use strandgraph_graph::schema::Quantity;
 
 pub const GROUP: u32 = 256;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CullParams {
     pub frustum: bool,

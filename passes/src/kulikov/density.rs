@@ -27,7 +27,7 @@ pub const GRID_WORDS: u32 = MAX_RESOLUTION * MAX_RESOLUTION * MAX_RESOLUTION;
 /// Fixed-point unit of the splatted area: 1e-9 m² (0.001 mm²).
 pub const AREA_UNIT: f32 = 1e-9;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DensityParams {
     /// Grid edge (1..=48).

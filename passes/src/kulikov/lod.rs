@@ -22,7 +22,7 @@ use crate::params::{Invalid, PassParams, in_range, non_negative};
 /// Skinning workgroup size; the LOD pass writes the skinning dispatch.
 pub const SKIN_GROUP: u32 = 64;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LodParams {
     pub enabled: bool,

@@ -28,7 +28,7 @@ pub const SHADE_GROUP: u32 = 64;
 /// lanes stride over the rest.
 pub const MAX_SHADE_GROUPS: u32 = 65_535;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ShadeSortParams {
     /// One `atomicAdd` per subgroup; off, one per lane (the ablation).

@@ -17,7 +17,7 @@ use crate::params::{NoParams, PassParams};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SortParams {
     /// Off: segments keep arrival order (the talk's "unsorted" baseline).

@@ -11,7 +11,7 @@ use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::params::{Invalid, PassParams, in_range};
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct TileParams {
     /// Atlas capacity in tiles (Kulikov: 2M pixels, 512 tiles).

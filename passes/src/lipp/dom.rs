@@ -43,7 +43,7 @@ pub const NO_HIT: u32 = u32::MAX;
 /// Lights with a deep opacity map (the rest are unshadowed).
 pub const MAX_DOM_LIGHTS: usize = 4;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct DomParams {
     /// Texels per side of each light's map (16..=4096).

@@ -62,7 +62,7 @@ use strandgraph_graph::schema::Quantity;
 pub const FILTER_GROUP: u32 = 64;
 pub const MAX_RADIUS: u32 = 8;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FilterParams {
     pub enabled: bool,

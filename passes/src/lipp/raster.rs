@@ -53,7 +53,7 @@ use crate::params::{Invalid, PassParams};
 /// Sub-pixel snap grid (as the Kulikov raster's `SNAP`).
 pub const SNAP: f32 = 256.0;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RasterParams {
     pub cooperative_assembly: bool,

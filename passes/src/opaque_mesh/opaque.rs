@@ -54,7 +54,7 @@ pub static OPAQUE: PassKind<OpaqueParams, OpaqueGpu> = PassKind {
 };
 
 /// The pass's parameters, with their defaults.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct OpaqueParams {
     /// Linear RGB where no mesh is drawn.

@@ -46,7 +46,7 @@ pub fn unpack(word: u64) -> Option<(u32, f32)> {
 }
 
 /// The pass's parameters, with their defaults.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct VisibilityParams {
     /// Triangles whose clipped bounding box holds more pixels than this are

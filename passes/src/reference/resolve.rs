@@ -33,7 +33,7 @@ use strandgraph_graph::schema::Quantity;
 const GROUP: u32 = TILE * TILE;
 const MAX_SAMPLES: usize = (MAX_SAMPLES_PER_AXIS * MAX_SAMPLES_PER_AXIS) as usize;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ResolveParams {
     /// `n`: n × n stratified samples per pixel (8: 64, 16: 256).

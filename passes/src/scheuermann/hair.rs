@@ -54,7 +54,7 @@ pub enum Stage {
 }
 
 /// The stages' parameters: the paper's shading constants and two switches.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct HairParams {
     /// False draws nothing: how a bench row drops the prime stage (with

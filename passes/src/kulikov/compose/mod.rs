@@ -88,7 +88,7 @@ crate::string_enum! {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ComposeParams {
     /// Poisson-disk atlas samples per pixel (0..=8).

@@ -42,7 +42,7 @@ pub const GROUP: u32 = 256;
 /// Ordered visibility layers.
 pub const LAYERS: usize = 3;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RasterParams {
     pub loop_flattening: bool,

@@ -60,7 +60,7 @@ impl SelfShadow {
 }
 
 /// The pass's parameters as the graph names them.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ShadeParams {
     pub self_shadow: SelfShadow,

@@ -62,7 +62,7 @@ pub static SKIN_SHADOW: PassKind<SkinShadowParams, SkinShadowGpu> = PassKind {
 };
 
 /// The pass's parameters, with the talk's values as defaults.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SkinShadowParams {
     /// Grid edge of `density_grid` (as written by `kulikov.density`).

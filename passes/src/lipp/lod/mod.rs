@@ -62,7 +62,7 @@ crate::string_enum! {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LodParams {
     /// Off: every bundle draws N strands of C_max points (frustum culling still applies).

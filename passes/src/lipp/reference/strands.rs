@@ -24,7 +24,7 @@ use crate::reference::bin::store_ribbon;
 use crate::reference::ribbon::{Record, Ribbon};
 use crate::reference::tiles;
 
-#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct StrandsParams {
     /// Curl, twist and noise, as `lipp.raster`'s `styling`.

@@ -1,0 +1,121 @@
+//! Every parameter of a slot's graph as a widget: the pass kind's defaults
+//! ([`PassDef::param_defaults`]) overlaid with what the graph file and the
+//! overrides set. An edit becomes a `--param PASS.PARAM=VALUE` override and
+//! reopens the slot, so it is checked exactly as the command line's is.
+
+use super::app::Viewer;
+use std::collections::BTreeSet;
+use strandgraph_graph::base_name;
+use strandgraph_passes::{Definitions, Registry};
+
+/// The parameter widgets of slot `i` (0: A, 1: B).
+pub fn show(v: &mut Viewer, i: usize, ui: &mut egui::Ui) {
+    let Some(slot) = (if i == 0 { &v.a } else { &v.b }) else {
+        return;
+    };
+    let g = &slot.plan.graph;
+    let mut seen = BTreeSet::new();
+    let mut edit = None;
+    for &p in &slot.plan.order {
+        let pass = &g.passes[p];
+        let base = base_name(&pass.name).to_string();
+        let Some(def) = Registry.definition(&pass.kind) else {
+            continue;
+        };
+        let ron::Value::Map(defaults) = def.param_defaults() else {
+            continue;
+        };
+        if defaults.is_empty() || !seen.insert(base.clone()) {
+            continue;
+        }
+        let header = format!("{base}  ·  {}", pass.kind);
+        egui::CollapsingHeader::new(header)
+            .id_salt((i, &base))
+            .show(ui, |ui| {
+                ui.label(egui::RichText::new(def.summary()).small().weak());
+                for (key, default) in defaults.iter() {
+                    let ron::Value::String(key) = key else {
+                        continue;
+                    };
+                    if key == strandgraph_graph::unroll::MODEL_INDEX {
+                        continue;
+                    }
+                    let current = match &pass.params {
+                        ron::Value::Map(m) => m.get(&ron::Value::String(key.clone())),
+                        _ => None,
+                    };
+                    let value = current.unwrap_or(default);
+                    if let Some(new) = widget(ui, (i, &base, key), key, value) {
+                        edit = Some(format!("{base}.{key}={new}"));
+                    }
+                }
+            });
+    }
+    if let Some(spec) = edit {
+        let prefix = spec.split_once('=').map_or("", |(k, _)| k).to_string() + "=";
+        let mut overrides: Vec<String> = slot
+            .overrides
+            .iter()
+            .filter(|o| !o.starts_with(&prefix))
+            .cloned()
+            .collect();
+        overrides.push(spec);
+        v.pending.push((i, slot.graph.clone(), overrides));
+    }
+}
+
+/// One parameter's widget; the new value in RON when the user changed it.
+fn widget(
+    ui: &mut egui::Ui,
+    id: impl std::hash::Hash + std::fmt::Debug,
+    key: &str,
+    value: &ron::Value,
+) -> Option<String> {
+    ui.horizontal(|ui| match value {
+        ron::Value::Bool(b) => {
+            let mut b = *b;
+            ui.checkbox(&mut b, key).changed().then(|| b.to_string())
+        }
+        ron::Value::Number(n) => {
+            ui.label(key);
+            if is_float(n) {
+                let mut x = n.into_f64();
+                let speed = 0.01 * x.abs().max(0.01);
+                let changed = ui.add(egui::DragValue::new(&mut x).speed(speed)).changed();
+                changed.then(|| format!("{x:?}"))
+            } else {
+                let mut x = n.into_f64() as i64;
+                let changed = ui.add(egui::DragValue::new(&mut x).speed(0.2)).changed();
+                changed.then(|| x.to_string())
+            }
+        }
+        ron::Value::String(s) => {
+            ui.label(key);
+            // Edited in a buffer and applied on Enter or leaving the field,
+            // so a half-typed name does not reopen the graph.
+            let buffer_id = ui.make_persistent_id(id);
+            let mut text = ui
+                .data(|d| d.get_temp::<String>(buffer_id))
+                .unwrap_or_else(|| s.clone());
+            let response = ui.text_edit_singleline(&mut text);
+            ui.data_mut(|d| d.insert_temp(buffer_id, text.clone()));
+            let done = response.lost_focus() && text != *s;
+            if response.lost_focus() {
+                ui.data_mut(|d| d.remove::<String>(buffer_id));
+            }
+            done.then(|| format!("{text:?}"))
+        }
+        other => {
+            ui.label(format!(
+                "{key}: {}",
+                ron::to_string(other).unwrap_or_default()
+            ));
+            None
+        }
+    })
+    .inner
+}
+
+fn is_float(n: &ron::Number) -> bool {
+    matches!(n, ron::Number::F32(_) | ron::Number::F64(_))
+}
