@@ -1,6 +1,7 @@
-//! The built-in demo scene (`render --demo`): `scenes/showcase.ron` and the
-//! graph it names, built into the binary, so an installed `strandgraph`
-//! renders with no checkout. Scenes name their files relative to the scene
+//! The built-in demo scene (`render --demo`, `view --demo`):
+//! `scenes/showcase.ron` and every shipped graph beside it (the viewer
+//! switches between them), built into the binary, so an installed
+//! `strandgraph` renders with no checkout. Scenes name their files relative to the scene
 //! file, so the two are written to a private temporary directory for the
 //! loader, which is removed when the [`Demo`] is dropped.
 
@@ -9,10 +10,31 @@ use std::path::{Path, PathBuf};
 
 /// The showcase scene as shipped.
 pub const SCENE: &str = include_str!("../scenes/showcase.ron");
-/// The graph it names (`graph: "graphs/kulikov.ron"`).
-pub const GRAPH: &str = include_str!("../scenes/graphs/kulikov.ron");
 /// Where the scene looks for its graph, relative to the scene file.
+#[cfg(test)]
 const GRAPH_PATH: &str = "graphs/kulikov.ron";
+
+macro_rules! graphs {
+    ($($name:literal),+ $(,)?) => {
+        [$(($name, include_str!(concat!("../scenes/graphs/", $name)))),+]
+    };
+}
+
+/// Every shipped graph (`scenes/graphs/*.ron`) by file name; the scene
+/// names `kulikov.ron`; a test below checks the list is complete.
+pub const GRAPHS: [(&str, &str); 11] = graphs![
+    "hw_mesh.ron",
+    "hw_strands.ron",
+    "kulikov.ron",
+    "kulikov_reference.ron",
+    "kulikov_visibility.ron",
+    "lipp.ron",
+    "lipp_msaa.ron",
+    "lipp_reference.ron",
+    "roofline.ron",
+    "scheuermann.ron",
+    "scheuermann_reference.ron",
+];
 
 /// The demo scene written out; the directory goes with it.
 pub struct Demo {
@@ -39,7 +61,9 @@ impl Demo {
             dir,
         };
         write(&demo.scene, SCENE)?;
-        write(&demo.dir.join(GRAPH_PATH), GRAPH)?;
+        for (name, text) in GRAPHS {
+            write(&demo.dir.join("graphs").join(name), text)?;
+        }
         Ok(demo)
     }
 }
@@ -60,6 +84,18 @@ mod tests {
         let demo = Demo::write().unwrap();
         let desc = strandgraph_assets::Scene::parse(&demo.scene, SCENE).unwrap();
         assert!(demo.scene.parent().unwrap().join(&desc.graph).is_file());
+        // Every shipped graph is built in.
+        let shipped = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/graphs"))
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .path()
+                    .extension()
+                    .is_some_and(|x| x == "ron")
+            })
+            .count();
+        assert_eq!(GRAPHS.len(), shipped, "add new graphs to demo::GRAPHS");
         let dir = demo.dir.clone();
         drop(demo);
         assert!(!dir.exists(), "the directory goes with the demo");

@@ -6,7 +6,8 @@
 //! - [`camera`]: the orbit camera;
 //! - [`slot`]: one graph running on the window's device;
 //! - [`display`] (+ `display.wgsl`): the tone mapper that shows a slot;
-//! - [`app`]: the window's frame loop, input and split screen;
+//! - [`app`]: the window's frame loop, keys, screenshots and dropped files;
+//! - [`picture`]: the picture (one graph, or a split) and mouse steering;
 //! - [`panel`] and [`params`]: the side panel and its parameter widgets;
 //! - [`dropped`]: scenes and grooms dropped on the window.
 
@@ -16,6 +17,7 @@ mod display;
 mod dropped;
 mod panel;
 mod params;
+mod picture;
 mod slot;
 
 use miette::{IntoDiagnostic, Result};

@@ -52,16 +52,22 @@ pub fn show(v: &mut Viewer, i: usize, ui: &mut egui::Ui) {
             });
     }
     if let Some(spec) = edit {
-        let prefix = spec.split_once('=').map_or("", |(k, _)| k).to_string() + "=";
-        let mut overrides: Vec<String> = slot
-            .overrides
-            .iter()
-            .filter(|o| !o.starts_with(&prefix))
-            .cloned()
-            .collect();
-        overrides.push(spec);
+        let overrides = with_override(&slot.overrides, spec);
         v.pending.push((i, slot.graph.clone(), overrides));
     }
+}
+
+/// `overrides` with `spec` (`PASS.PARAM=VALUE`) in place of any earlier
+/// override of the same parameter.
+fn with_override(overrides: &[String], spec: String) -> Vec<String> {
+    let target = |o: &str| o.split_once('=').map(|(k, _)| k.trim().to_string());
+    let mut kept: Vec<String> = overrides
+        .iter()
+        .filter(|o| target(o) != target(&spec))
+        .cloned()
+        .collect();
+    kept.push(spec);
+    kept
 }
 
 /// One parameter's widget; the new value in RON when the user changed it.
@@ -118,4 +124,27 @@ fn widget(
 
 fn is_float(n: &ron::Number) -> bool {
     matches!(n, ron::Number::F32(_) | ron::Number::F64(_))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_edit_replaces_the_override_of_its_parameter_only() {
+        let start = vec![
+            "raster.loop_flattening=false".to_string(),
+            "shade.exposure=1.0".to_string(),
+            "raster.loop_flattening_x=1".to_string(),
+        ];
+        let after = with_override(&start, "raster.loop_flattening=true".into());
+        assert_eq!(
+            after,
+            [
+                "shade.exposure=1.0",
+                "raster.loop_flattening_x=1",
+                "raster.loop_flattening=true"
+            ]
+        );
+    }
 }
