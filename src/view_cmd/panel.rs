@@ -146,32 +146,47 @@ fn times(v: &Viewer, ui: &mut egui::Ui) {
         .flat_map(|(_, s)| s.timings.iter().map(|t| t.millis))
         .fold(0.0f64, f64::max)
         .max(1e-3);
-    ui.label("GPU time per pass (timestamp queries)");
+    ui.label("GPU time (timestamp queries)");
     for &(i, slot) in &slots {
         let total: f64 = slot.timings.iter().map(|t| t.millis).sum();
-        ui.colored_label(COLOURS[i], format!("{}: {total:.3} ms", slot.graph.name));
-        for t in &slot.timings {
-            let (rect, _) =
-                ui.allocate_exact_size(Vec2::new(ui.available_width(), 14.0), egui::Sense::hover());
-            let bar = Rect::from_min_size(
-                rect.min,
-                Vec2::new(
-                    rect.width() * 0.45 * (t.millis / longest) as f32,
-                    rect.height() - 2.0,
-                ),
-            );
-            ui.painter()
-                .rect_filled(bar, 1.0, COLOURS[i].gamma_multiply(0.6));
-            ui.painter().text(
-                Pos2::new(rect.left() + rect.width() * 0.47, rect.center().y),
-                egui::Align2::LEFT_CENTER,
-                format!("{:.3}  {}", t.millis, t.name),
-                egui::FontId::monospace(10.0),
-                ui.visuals().text_color(),
-            );
-        }
+        ui.colored_label(
+            COLOURS[i],
+            format!("{}: {total:.3} ms a frame", slot.graph.name),
+        );
     }
     plot(v, ui, &slots);
+    for &(i, slot) in &slots {
+        egui::CollapsingHeader::new(format!("per pass: {}", slot.graph.name))
+            .id_salt(("passes", i))
+            .default_open(true)
+            .show(ui, |ui| {
+                for t in &slot.timings {
+                    bar(ui, i, t, longest);
+                }
+            });
+    }
+}
+
+/// One pass's time as a bar scaled to the longest pass shown.
+fn bar(ui: &mut egui::Ui, i: usize, t: &strandgraph_wgpu::PassTiming, longest: f64) {
+    let (rect, _) =
+        ui.allocate_exact_size(Vec2::new(ui.available_width(), 13.0), egui::Sense::hover());
+    let bar = Rect::from_min_size(
+        rect.min,
+        Vec2::new(
+            rect.width() * 0.45 * (t.millis / longest) as f32,
+            rect.height() - 2.0,
+        ),
+    );
+    ui.painter()
+        .rect_filled(bar, 1.0, COLOURS[i].gamma_multiply(0.6));
+    ui.painter().text(
+        Pos2::new(rect.left() + rect.width() * 0.47, rect.center().y),
+        egui::Align2::LEFT_CENTER,
+        format!("{:.3}  {}", t.millis, t.name),
+        egui::FontId::monospace(10.0),
+        ui.visuals().text_color(),
+    );
 }
 
 /// Milliseconds per frame over the last frames, one line per slot.
