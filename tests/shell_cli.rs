@@ -10,7 +10,7 @@ fn strandgraph(args: &[&str]) -> Output {
         .expect("strandgraph runs")
 }
 
-const SUBCOMMANDS: [&str; 10] = [
+const SUBCOMMANDS: [&str; 11] = [
     "graph",
     "info",
     "render",
@@ -19,6 +19,7 @@ const SUBCOMMANDS: [&str; 10] = [
     "compare",
     "report",
     "tables",
+    "view",
     "completions",
     "man",
 ];
