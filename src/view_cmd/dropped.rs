@@ -128,7 +128,11 @@ pub struct Scratch(PathBuf);
 
 impl Scratch {
     pub fn new() -> Scratch {
-        Scratch(std::env::temp_dir().join(format!("strandgraph-view-{}", std::process::id())))
+        // One a viewer; the count keeps tests running side by side apart.
+        static COUNT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let name = format!("strandgraph-view-{}-{n}", std::process::id());
+        Scratch(std::env::temp_dir().join(name))
     }
 
     fn write(&self, name: &str, text: &str) -> Result<PathBuf> {
@@ -166,5 +170,45 @@ mod tests {
         ));
         let e = classify(Path::new("head.obj")).err().unwrap().to_string();
         assert!(e.contains("head.obj") && e.contains(".tfx"), "{e}");
+    }
+
+    /// A groom in centimetres (30 units across) dropped on the viewer:
+    /// read as centimetres, with a note, and framed by the camera.
+    #[test]
+    fn a_dropped_groom_in_centimetres_is_scaled_and_framed() {
+        use strandgraph_assets::Groom;
+        let dir = Scratch::new();
+        let strands: Vec<Vec<glam::Vec3>> = (0..50)
+            .map(|i| {
+                let x = -15.0 + 0.6 * i as f32;
+                (0..8)
+                    .map(|k| glam::Vec3::new(x, 170.0 - 4.0 * k as f32, 10.0))
+                    .collect()
+            })
+            .collect();
+        let groom = Groom::from_strands(strands, 0.008);
+        let bytes = strandgraph_assets::loaders::cyhair::write(&groom).unwrap();
+        let file = dir.write("cm.hair", "").unwrap();
+        std::fs::write(&file, bytes).unwrap();
+        let graph = Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/scenes/graphs/kulikov.ron"
+        ));
+
+        let (scene, note) = load(&file, Some(graph), &dir).unwrap();
+        assert!(note.unwrap().contains("centimetres"));
+        let bounds = scene.grooms[0].world_bounds();
+        assert!((bounds.size().x - 0.294).abs() < 1e-3, "{bounds:?}");
+        let Camera::LookAt {
+            position, target, ..
+        } = scene.desc.camera
+        else {
+            panic!("the camera is placed with LookAt");
+        };
+        let c = bounds.center();
+        assert!((glam::Vec3::from(target) - c).length() < 1e-4);
+        // In front of the hair (+Z), far enough to see all of it.
+        assert!(position[2] > c.z + bounds.size().length());
+        assert_eq!(scene.graph, std::fs::canonicalize(graph).unwrap());
     }
 }
