@@ -224,6 +224,32 @@ pub fn non_negative(key: &str, value: f32) -> Result<(), Invalid> {
     }
 }
 
+/// How a [`string_enum!`] refuses a name: the valid names, then the one
+/// found. [`choices`] reads the names back out of it.
+pub fn one_of(names: &[&str], found: &str) -> String {
+    format!(
+        "expected one of \"{}\", found \"{found}\"",
+        names.join("\", \"")
+    )
+}
+
+/// The names a string-valued parameter `key` of `def` accepts (a
+/// [`string_enum!`]), found by offering it a name no switch has; `None`
+/// for a parameter that takes any string or no string.
+pub fn choices(def: &dyn crate::PassDef, key: &str) -> Option<Vec<String>> {
+    const PROBE: &str = "\u{1}";
+    let mut map = ron::Map::new();
+    map.insert(
+        ron::Value::String(key.into()),
+        ron::Value::String(PROBE.into()),
+    );
+    let message = def.check_params(&ron::Value::Map(map)).err()?.message;
+    let start = message.find("expected one of \"")? + "expected one of \"".len();
+    let end = message.find(&format!("\", found \"{PROBE}\""))?;
+    let names = message.get(start..end)?;
+    Some(names.split("\", \"").map(str::to_string).collect())
+}
+
 /// A string-valued switch (`"self_shadow": "Baked"`): ron's `Value` keeps no
 /// enum variants, so the variants are matched by name, and a wrong one lists
 /// the valid names.
@@ -249,10 +275,9 @@ macro_rules! string_enum {
                 let s = <String as serde::Deserialize>::deserialize(d)?;
                 match s.as_str() {
                     $(stringify!($variant) => Ok(Self::$variant),)+
-                    _ => Err(serde::de::Error::custom(format!(
-                        "expected one of \"{}\", found \"{s}\"",
-                        Self::NAMES.join("\", \"")
-                    ))),
+                    _ => Err(serde::de::Error::custom(
+                        $crate::params::one_of(Self::NAMES, &s),
+                    )),
                 }
             }
         }
@@ -387,6 +412,37 @@ fn check_override(pass: &str, kind: &str, params: &ron::Map, param: &str) -> Res
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every string-valued parameter of every kind lists its names, its
+    /// default among them, and each name is accepted.
+    #[test]
+    fn every_string_switch_lists_names_it_accepts() {
+        let mut switches = 0;
+        for def in crate::PASSES {
+            let ron::Value::Map(map) = def.param_defaults() else {
+                continue;
+            };
+            for (key, value) in map.iter() {
+                let (ron::Value::String(key), ron::Value::String(default)) = (key, value) else {
+                    continue;
+                };
+                let names =
+                    choices(*def, key).unwrap_or_else(|| panic!("{}.{key}: no names", def.kind()));
+                assert!(names.contains(default), "{}.{key}: {names:?}", def.kind());
+                for name in &names {
+                    let mut one = ron::Map::new();
+                    one.insert(
+                        ron::Value::String(key.clone()),
+                        ron::Value::String(name.clone()),
+                    );
+                    def.check_params(&ron::Value::Map(one))
+                        .unwrap_or_else(|e| panic!("{}.{key}={name}: {e}", def.kind()));
+                }
+                switches += 1;
+            }
+        }
+        assert!(switches >= 3, "only {switches} string switches found");
+    }
 
     /// Every kind's defaults are a map a graph file could write back: each
     /// name is one the kind accepts and each value one it parses to the

@@ -2,10 +2,13 @@
 //! ([`PassDef::param_defaults`]) overlaid with what the graph file and the
 //! overrides set. An edit becomes a `--param PASS.PARAM=VALUE` override and
 //! reopens the slot, so it is checked exactly as the command line's is.
+//! Switches are check boxes, numbers drag values, named switches
+//! (`"Baked"`) combo boxes of the names the kind accepts.
 
 use super::app::Viewer;
 use std::collections::BTreeSet;
 use strandgraph_graph::base_name;
+use strandgraph_passes::params::choices;
 use strandgraph_passes::{Definitions, Registry};
 
 /// The parameter widgets of slot `i` (0: A, 1: B).
@@ -45,7 +48,10 @@ pub fn show(v: &mut Viewer, i: usize, ui: &mut egui::Ui) {
                         _ => None,
                     };
                     let value = current.unwrap_or(default);
-                    if let Some(new) = widget(ui, (i, &base, key), key, value) {
+                    let names = matches!(value, ron::Value::String(_))
+                        .then(|| choices(def, key))
+                        .flatten();
+                    if let Some(new) = widget(ui, (i, &base, key), key, value, names) {
                         edit = Some(format!("{base}.{key}={new}"));
                     }
                 }
@@ -76,6 +82,7 @@ fn widget(
     id: impl std::hash::Hash + std::fmt::Debug,
     key: &str,
     value: &ron::Value,
+    choices: Option<Vec<String>>,
 ) -> Option<String> {
     ui.horizontal(|ui| match value {
         ron::Value::Bool(b) => {
@@ -97,19 +104,18 @@ fn widget(
         }
         ron::Value::String(s) => {
             ui.label(key);
-            // Edited in a buffer and applied on Enter or leaving the field,
-            // so a half-typed name does not reopen the graph.
-            let buffer_id = ui.make_persistent_id(id);
-            let mut text = ui
-                .data(|d| d.get_temp::<String>(buffer_id))
-                .unwrap_or_else(|| s.clone());
-            let response = ui.text_edit_singleline(&mut text);
-            ui.data_mut(|d| d.insert_temp(buffer_id, text.clone()));
-            let done = response.lost_focus() && text != *s;
-            if response.lost_focus() {
-                ui.data_mut(|d| d.remove::<String>(buffer_id));
-            }
-            done.then(|| format!("{text:?}"))
+            let names = choices.unwrap_or_default();
+            let mut picked = None;
+            egui::ComboBox::from_id_salt(id)
+                .selected_text(s.as_str())
+                .show_ui(ui, |ui| {
+                    for name in &names {
+                        if ui.selectable_label(name == s, name.as_str()).clicked() && name != s {
+                            picked = Some(format!("{name:?}"));
+                        }
+                    }
+                });
+            picked
         }
         other => {
             ui.label(format!(
