@@ -14,27 +14,8 @@ pub const SCENE: &str = include_str!("../scenes/showcase.ron");
 #[cfg(test)]
 const GRAPH_PATH: &str = "graphs/kulikov.ron";
 
-macro_rules! graphs {
-    ($($name:literal),+ $(,)?) => {
-        [$(($name, include_str!(concat!("../scenes/graphs/", $name)))),+]
-    };
-}
-
-/// Every shipped graph (`scenes/graphs/*.ron`) by file name; the scene
-/// names `kulikov.ron`; a test below checks the list is complete.
-pub const GRAPHS: [(&str, &str); 11] = graphs![
-    "hw_mesh.ron",
-    "hw_strands.ron",
-    "kulikov.ron",
-    "kulikov_reference.ron",
-    "kulikov_visibility.ron",
-    "lipp.ron",
-    "lipp_msaa.ron",
-    "lipp_reference.ron",
-    "roofline.ron",
-    "scheuermann.ron",
-    "scheuermann_reference.ron",
-];
+/// Every shipped graph, written beside the scene.
+pub use strandgraph_passes::shipped::GRAPHS;
 
 /// The demo scene written out; the directory goes with it.
 pub struct Demo {
@@ -84,18 +65,16 @@ mod tests {
         let demo = Demo::write().unwrap();
         let desc = strandgraph_assets::Scene::parse(&demo.scene, SCENE).unwrap();
         assert!(demo.scene.parent().unwrap().join(&desc.graph).is_file());
-        // Every shipped graph is built in.
-        let shipped = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/graphs"))
-            .unwrap()
-            .filter(|e| {
-                e.as_ref()
+        for (name, _) in GRAPHS {
+            assert!(
+                demo.scene
+                    .parent()
                     .unwrap()
-                    .path()
-                    .extension()
-                    .is_some_and(|x| x == "ron")
-            })
-            .count();
-        assert_eq!(GRAPHS.len(), shipped, "add new graphs to demo::GRAPHS");
+                    .join("graphs")
+                    .join(name)
+                    .is_file()
+            );
+        }
         let dir = demo.dir.clone();
         drop(demo);
         assert!(!dir.exists(), "the directory goes with the demo");

@@ -20,26 +20,8 @@ use strandgraph_graph::schema::ResourceDecl;
 use strandgraph_graph::{Plan, Quantities, compile_str};
 use strandgraph_passes::Registry;
 use strandgraph_passes::params::override_param;
+use strandgraph_passes::shipped::GRAPHS;
 
-macro_rules! graphs {
-    ($($name:literal),+ $(,)?) => {
-        [$(($name, include_str!(concat!("../../scenes/graphs/", $name)))),+]
-    };
-}
-
-const GRAPHS: [(&str, &str); 11] = graphs![
-    "hw_mesh.ron",
-    "hw_strands.ron",
-    "kulikov.ron",
-    "kulikov_reference.ron",
-    "kulikov_visibility.ron",
-    "lipp.ron",
-    "lipp_msaa.ron",
-    "lipp_reference.ron",
-    "roofline.ron",
-    "scheuermann.ron",
-    "scheuermann_reference.ron",
-];
 
 /// Each graph compiled for one and for two hair models (index 2g + m - 1).
 fn plans() -> &'static [Plan] {

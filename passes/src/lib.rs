@@ -31,6 +31,7 @@ pub mod params;
 pub mod raster_state;
 pub mod reference;
 pub mod scheuermann;
+pub mod shipped;
 pub mod spirv;
 pub mod upload;
 pub mod wgsl;

@@ -52,8 +52,7 @@ impl Gpu {
         (instance, adapter): (wgpu::Instance, wgpu::Adapter),
         features: wgpu::Features,
     ) -> Result<Gpu, WgpuError> {
-        let info = adapter.get_info();
-        let name = format!("{} ({:?}, {})", info.name, info.backend, info.driver);
+        let name = adapter_name(&adapter);
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("strandgraph"),
             required_features: features,
@@ -92,6 +91,12 @@ impl Gpu {
             Err(WgpuError::Validation(format!("{what}: {all}")))
         }
     }
+}
+
+/// The adapter's name, backend and driver, as errors and notes give it.
+pub(crate) fn adapter_name(adapter: &wgpu::Adapter) -> String {
+    let info = adapter.get_info();
+    format!("{} ({:?}, {})", info.name, info.backend, info.driver)
 }
 
 /// wgpu 30 exposes mesh shaders only to a device created with its

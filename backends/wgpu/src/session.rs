@@ -3,7 +3,7 @@
 //! the passes. History resources keep their contents between runs.
 
 use super::*;
-use crate::gpu::{Gpu, required_features};
+use crate::gpu::{Gpu, adapter_name, required_features};
 use crate::memory::{create_memory, upload};
 use crate::pipelines::{Built, build};
 use crate::prepare::prepare;
@@ -53,11 +53,9 @@ impl WgpuBackend {
         plan: &Plan,
         instance: &Instance,
     ) -> Result<Session, WgpuError> {
-        let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
-        let prepared = prepare(defs, plan, instance, &mut shaders)?;
+        let prepared = self.prepare(defs, plan, instance)?;
         let (wgpu_instance, adapter) = self.adapter()?;
-        let info = adapter.get_info();
-        let name = format!("{} ({:?}, {})", info.name, info.backend, info.driver);
+        let name = adapter_name(&adapter);
         let features = required_features(&adapter, &name, adapter.features(), plan, &prepared)?;
         let gpu = Gpu::new((wgpu_instance, adapter), features)?;
         Session::new(&gpu, plan, instance, prepared, features)
@@ -73,8 +71,7 @@ impl WgpuBackend {
         plan: &Plan,
         instance: &Instance,
     ) -> Result<Session, WgpuError> {
-        let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
-        let prepared = prepare(defs, plan, instance, &mut shaders)?;
+        let prepared = self.prepare(defs, plan, instance)?;
         let features = required_features(
             &gpu.adapter,
             &gpu.name,
@@ -83,6 +80,17 @@ impl WgpuBackend {
             &prepared,
         )?;
         Session::new(gpu, plan, instance, prepared, features)
+    }
+
+    /// Every live pass with its composed shader and parameters.
+    fn prepare(
+        &self,
+        defs: &'static dyn Definitions,
+        plan: &Plan,
+        instance: &Instance,
+    ) -> Result<Vec<Prepared<'static>>, WgpuError> {
+        let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
+        prepare(defs, plan, instance, &mut shaders)
     }
 }
 
