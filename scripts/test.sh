@@ -3,9 +3,8 @@
 # (Graphviz for the DOT export check; Chromium for the HTML report's; Xvfb
 # for the viewer's window; a Vulkan driver, lavapipe, and the Vulkan loader
 # for the wgpu differential test when no Vulkan device is installed), then
-# the workspace tests and a
-# quick pass of the criterion benches so they keep building and running, and
-# a smoke run of every fuzz target.
+# the workspace tests, a quick pass of the criterion benches so they keep
+# building and running, and a smoke run of every fuzz target.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
