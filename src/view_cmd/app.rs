@@ -129,7 +129,7 @@ impl Viewer {
             let slot = match opened {
                 Ok(slot) => slot,
                 Err(e) if self.script.is_none() => {
-                    self.status = Some(format!("{}: {e:?}", graph.name));
+                    self.status = Some(format!("{}: {}", graph.name, message(&e)));
                     continue;
                 }
                 Err(e) => return Err(e),
@@ -173,10 +173,10 @@ impl Viewer {
                 let graph = self.a.as_ref().map(|s| s.graph.path.clone());
                 match dropped::load(path, graph.as_deref(), &self.scratch) {
                     Ok((scene, note)) => self.set_scene(scene, note),
-                    Err(e) => self.status = Some(format!("{e:?}")),
+                    Err(e) => self.status = Some(message(&e)),
                 }
             }
-            Err(e) => self.status = Some(format!("{e:?}")),
+            Err(e) => self.status = Some(message(&e)),
         }
     }
 
@@ -254,7 +254,7 @@ impl Viewer {
             let saved = save_png(&image, &path);
             match (&saved, self.script.is_some()) {
                 (Ok(()), _) => self.status = Some(format!("saved {}", path.display())),
-                (Err(e), false) => self.status = Some(format!("{e:?}")),
+                (Err(e), false) => self.status = Some(message(&e)),
                 (Err(_), true) => {}
             }
             if self.script.is_some() {
@@ -296,7 +296,7 @@ impl eframe::App for Viewer {
             if self.script.is_some() {
                 return self.finish(&ctx, Err(e));
             }
-            self.status = Some(format!("{e:?}"));
+            self.status = Some(message(&e));
         }
         // After the frame, so the panel shows this frame's times; its edits
         // take effect on the next one.
@@ -317,6 +317,15 @@ impl eframe::App for Viewer {
         }
         ctx.request_repaint();
     }
+}
+
+/// An error as one line for the panel: the chain of causes, without the
+/// terminal report's colours and line wrapping.
+fn message(e: &miette::Report) -> String {
+    e.chain()
+        .map(|c| c.to_string())
+        .collect::<Vec<_>>()
+        .join(": ")
 }
 
 /// Writes an egui screenshot (sRGB RGBA) as PNG.
