@@ -254,7 +254,7 @@ impl Viewer {
             let saved = save_png(&image, &path);
             match (&saved, self.script.is_some()) {
                 (Ok(()), _) => self.status = Some(format!("saved {}", path.display())),
-                (Err(e), false) => self.status = Some(message(&e)),
+                (Err(e), false) => self.status = Some(message(e)),
                 (Err(_), true) => {}
             }
             if self.script.is_some() {
