@@ -2,8 +2,10 @@
 //! installs it), presenting through wgpu on lavapipe. The viewer renders
 //! the built-in demo for 30 frames and saves its window; that picture must
 //! be the one `render` writes for the same scene, camera and size on wgpu,
-//! hair included. Fails, never skips, without Xvfb.
+//! hair included. Split-screen against a second graph, each half must be
+//! that graph's render. Fails, never skips, without Xvfb.
 
+use image::RgbaImage;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use strandgraph::compare::flip;
@@ -28,55 +30,44 @@ fn run(command: &mut Command, what: &str) {
     );
 }
 
+/// `strandgraph view ARGS --size SIZE --no-panel --screenshot SHOT` in a
+/// virtual X server, the window read back.
+fn view(args: &[&str], shot: &Path) -> RgbaImage {
+    let _ = std::fs::remove_file(shot);
+    // -a: a free display number; the screen is larger than the window.
+    let mut c = Command::new("xvfb-run");
+    c.args([
+        "-a",
+        "-s",
+        "-screen 0 800x600x24",
+        env!("CARGO_BIN_EXE_strandgraph"),
+    ])
+    .arg("view")
+    .args(args)
+    .args(["--size", SIZE, "--no-panel", "--screenshot"])
+    .arg(shot);
+    run(&mut c, "strandgraph view under xvfb-run");
+    image::open(shot).unwrap().to_rgba8()
+}
+
+/// `strandgraph render ARGS --backend wgpu --size SIZE -o PICTURE`, read back.
+fn render(args: &[&str], picture: &Path) -> RgbaImage {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_strandgraph"));
+    c.arg("render")
+        .args(args)
+        .args(["--backend", "wgpu", "--size", SIZE, "-o"])
+        .arg(picture);
+    run(&mut c, "strandgraph render");
+    image::open(picture).unwrap().to_rgba8()
+}
+
 #[test]
 fn the_viewer_window_shows_the_demo_as_render_writes_it() {
     let dir = out_dir();
-    let (shot, rendered, coverage) = (
-        dir.join("viewer.png"),
-        dir.join("render.png"),
-        dir.join("coverage.png"),
-    );
-    let _ = std::fs::remove_file(&shot);
-    // -a: a free display number; the screen is larger than the window.
-    run(
-        Command::new("xvfb-run")
-            .args([
-                "-a",
-                "-s",
-                "-screen 0 800x600x24",
-                env!("CARGO_BIN_EXE_strandgraph"),
-            ])
-            .args([
-                "view",
-                "--demo",
-                "--size",
-                SIZE,
-                "--no-panel",
-                "--frames",
-                "30",
-            ])
-            .arg("--screenshot")
-            .arg(&shot),
-        "strandgraph view under xvfb-run",
-    );
-    run(
-        Command::new(env!("CARGO_BIN_EXE_strandgraph"))
-            .args([
-                "render",
-                "--demo",
-                "--backend",
-                "wgpu",
-                "--size",
-                SIZE,
-                "-o",
-            ])
-            .arg(&rendered)
-            .arg("--coverage")
-            .arg(&coverage),
-        "strandgraph render",
-    );
-    let shot = image::open(&shot).unwrap().to_rgba8();
-    let rendered = image::open(&rendered).unwrap().to_rgba8();
+    let shot = view(&["--demo", "--frames", "30"], &dir.join("viewer.png"));
+    let coverage = dir.join("coverage.png");
+    let cov = coverage.to_str().unwrap();
+    let rendered = render(&["--demo", "--coverage", cov], &dir.join("render.png"));
     let coverage = image::open(&coverage).unwrap().to_luma16();
     assert_eq!(
         shot.dimensions(),
@@ -115,5 +106,40 @@ fn the_viewer_window_shows_the_demo_as_render_writes_it() {
     assert!(
         off < 2.0,
         "hair pixels differ by {off:.2} of 255 on average"
+    );
+}
+
+#[test]
+fn split_screen_shows_each_graph_on_its_side() {
+    let dir = out_dir();
+    let root = env!("CARGO_MANIFEST_DIR");
+    let scene = format!("{root}/scenes/showcase.ron");
+    let other = format!("{root}/scenes/graphs/scheuermann.ron");
+    let args = [scene.as_str(), "--compare", &other, "--frames", "3"];
+    let shot = view(&args, &dir.join("split.png"));
+    let left = render(&[&scene], &dir.join("split_kulikov.png"));
+    let right = render(
+        &[&scene, "--graph", &other],
+        &dir.join("split_scheuermann.png"),
+    );
+
+    // The divider is a 2-point line in the middle: compare beside it.
+    let (w, h) = shot.dimensions();
+    let half = w / 2 - 4;
+    let crop = |img: &RgbaImage, x: u32| image::imageops::crop_imm(img, x, 0, half, h).to_image();
+    for (name, reference, x) in [("kulikov", &left, 0), ("scheuermann", &right, w - half)] {
+        let diff = flip(&crop(reference, x), &crop(&shot, x)).unwrap();
+        assert!(
+            diff.mean < 0.005,
+            "{name}'s side against its render: mean FLIP {}",
+            diff.mean
+        );
+    }
+    // Else the comparison proves nothing.
+    let apart = flip(&crop(&left, w - half), &crop(&right, w - half)).unwrap();
+    assert!(
+        apart.mean > 0.02,
+        "the two graphs render alike: mean FLIP {}",
+        apart.mean
     );
 }
