@@ -1,9 +1,9 @@
 //! The built-in demo scene (`render --demo`, `view --demo`):
 //! `scenes/showcase.ron` and every shipped graph beside it (the viewer
 //! switches between them), built into the binary, so an installed
-//! `strandgraph` renders with no checkout. Scenes name their files relative to the scene
-//! file, so the two are written to a private temporary directory for the
-//! loader, which is removed when the [`Demo`] is dropped.
+//! `strandgraph` renders with no checkout. Scenes name their files relative
+//! to the scene file, so they are written to a private temporary directory
+//! for the loader, which is removed when the [`Demo`] is dropped.
 
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::{Path, PathBuf};

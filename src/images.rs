@@ -34,10 +34,7 @@ pub fn to_picture(
     height: u32,
     display: Display,
 ) -> Option<RgbaImage> {
-    let r = plan.graph.physical(resource);
-    let ResourceDecl::Image { format, .. } = plan.graph.resources[r].decl else {
-        return None;
-    };
+    let format = picture_format(plan, resource)?;
     let texels = (width * height) as usize;
     let mut img = RgbaImage::new(width, height);
     match format {
@@ -58,6 +55,21 @@ pub fn to_picture(
         _ => return None,
     }
     Some(img)
+}
+
+/// The format of image resource `resource` when it makes a picture:
+/// `Rgba16Float` (scene-linear, tone-mapped) or `Rgba8Unorm` (shown as it
+/// is); `None` for buffers and other formats.
+pub fn picture_format(plan: &Plan, resource: usize) -> Option<ImageFormat> {
+    let r = plan.graph.physical(resource);
+    match plan.graph.resources[r].decl {
+        ResourceDecl::Image { format, .. }
+            if matches!(format, ImageFormat::Rgba16Float | ImageFormat::Rgba8Unorm) =>
+        {
+            Some(format)
+        }
+        _ => None,
+    }
 }
 
 /// An `Rgba16Float` image resource as linear float RGBA, for EXR; `None`

@@ -22,7 +22,6 @@ use strandgraph_passes::Registry;
 use strandgraph_passes::params::override_param;
 use strandgraph_passes::shipped::GRAPHS;
 
-
 /// Each graph compiled for one and for two hair models (index 2g + m - 1).
 fn plans() -> &'static [Plan] {
     static PLANS: OnceLock<Vec<Plan>> = OnceLock::new();

@@ -445,8 +445,8 @@ mod tests {
     }
 
     /// Every kind's defaults are a map a graph file could write back: each
-    /// name is one the kind accepts and each value one it parses to the
-    /// same default (what the viewer's widgets start from).
+    /// name is one the kind accepts, each value one it parses (what the
+    /// viewer's widgets start from).
     #[test]
     fn every_kinds_defaults_are_parameters_it_accepts() {
         for def in crate::PASSES {

@@ -8,11 +8,11 @@ use super::camera::Orbit;
 use super::display::DisplayTarget;
 use miette::{IntoDiagnostic, Result};
 use std::path::{Path, PathBuf};
-use strandgraph::images::Display;
+use strandgraph::images::{Display, picture_format};
 use strandgraph_assets::Scene;
 use strandgraph_assets::scene::Camera;
 use strandgraph_graph::Plan;
-use strandgraph_graph::schema::{ImageFormat, ResourceDecl};
+use strandgraph_graph::schema::ImageFormat;
 use strandgraph_passes::Registry;
 use strandgraph_passes::layout::words_of;
 use strandgraph_passes::upload::{Upload, frame};
@@ -126,18 +126,10 @@ impl Slot {
 }
 
 /// The first image output that makes a picture (as `render` picks its main
-/// image, [`crate::images::main_picture`]), and its format.
+/// image, [`strandgraph::images::main_picture`]), and its format.
 fn main_image(plan: &Plan) -> Option<(String, ImageFormat)> {
     plan.graph.outputs.iter().find_map(|&(r, _)| {
-        let physical = plan.graph.physical(r);
-        match plan.graph.resources[physical].decl {
-            ResourceDecl::Image { format, .. }
-                if matches!(format, ImageFormat::Rgba16Float | ImageFormat::Rgba8Unorm) =>
-            {
-                Some((plan.graph.resources[r].name.clone(), format))
-            }
-            _ => None,
-        }
+        picture_format(plan, r).map(|f| (plan.graph.resources[r].name.clone(), f))
     })
 }
 

@@ -11,7 +11,7 @@ impl api::Session for Session {
     }
 
     fn device(&self) -> String {
-        self.adapter.clone()
+        self.gpu.name.clone()
     }
 
     fn clock(&self) -> Clock {

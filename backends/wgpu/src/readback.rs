@@ -75,7 +75,9 @@ impl Session {
         let r = plan.graph.physical(r);
         let bytes = match &self.memory[r] {
             None => return Ok(None),
-            Some(Memory::Buffer(b, _)) => read_buffer(&self.device, &self.queue, b, b.size())?,
+            Some(Memory::Buffer(b, _)) => {
+                read_buffer(&self.gpu.device, &self.gpu.queue, b, b.size())?
+            }
             Some(Memory::Texture {
                 texture,
                 format,
@@ -86,13 +88,13 @@ impl Session {
                 // wgpu copies rows at 256-byte strides (COPY_BYTES_PER_ROW_ALIGNMENT).
                 let stride = row.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
                 let layers = extent[2].max(1);
-                let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+                let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("readback"),
                     size: u64::from(stride) * u64::from(extent[1] * layers),
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 });
-                let mut encoder = self.device.create_command_encoder(&Default::default());
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
                 encoder.copy_texture_to_buffer(
                     wgpu::TexelCopyTextureInfo {
                         texture,
@@ -114,8 +116,8 @@ impl Session {
                     },
                     texture.size(),
                 );
-                self.queue.submit([encoder.finish()]);
-                let padded = map_and_read(&self.device, &staging)?;
+                self.gpu.queue.submit([encoder.finish()]);
+                let padded = map_and_read(&self.gpu.device, &staging)?;
                 padded
                     .chunks(stride as usize)
                     .flat_map(|r| &r[..row as usize])

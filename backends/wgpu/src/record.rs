@@ -39,7 +39,7 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
         Some(Memory::Buffer(b, _)) => Some(b),
         _ => None,
     };
-    let mut encoder = s.device.create_command_encoder(&Default::default());
+    let mut encoder = s.gpu.device.create_command_encoder(&Default::default());
     let mut workgroups = Vec::with_capacity(s.built.len());
     for (i, (prep, built)) in s.prepared.iter().zip(&s.built).enumerate() {
         let pass = &g.passes[prep.p];
@@ -142,10 +142,15 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
         }
     }
     encoder.resolve_query_set(&ts.queries, 0..ts.count, &ts.resolved, 0);
-    s.queue.submit([encoder.finish()]);
-    let ticks = read_buffer(&s.device, &s.queue, &ts.resolved, u64::from(ts.count) * 8)?;
+    s.gpu.queue.submit([encoder.finish()]);
+    let ticks = read_buffer(
+        &s.gpu.device,
+        &s.gpu.queue,
+        &ts.resolved,
+        u64::from(ts.count) * 8,
+    )?;
     let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&ticks);
-    let period = f64::from(s.queue.get_timestamp_period());
+    let period = f64::from(s.gpu.queue.get_timestamp_period());
     let mut timings = Vec::new();
     for (i, prep) in s.prepared.iter().enumerate() {
         let pass = &g.passes[prep.p];
@@ -156,7 +161,7 @@ pub(crate) fn record_and_run(s: &Session) -> Result<Vec<PassTiming>, WgpuError> 
             && let Some((_, r)) = prep.bindings.iter().find(|(n, _)| n == binding)
             && let Some(buf) = buffer_of(*r)
         {
-            let bytes = read_buffer(&s.device, &s.queue, buf, (word as u64 + 1) * 4)?;
+            let bytes = read_buffer(&s.gpu.device, &s.gpu.queue, buf, (word as u64 + 1) * 4)?;
             let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
             groups = words.get(word).copied().unwrap_or(0);
         }

@@ -11,8 +11,6 @@ use crate::record::{Timestamps, record_and_run};
 
 /// A plan on a wgpu device, ready to run frames.
 pub struct Session {
-    pub(crate) device: wgpu::Device,
-    pub(crate) queue: wgpu::Queue,
     pub(crate) plan: Plan,
     pub(crate) instance: Instance,
     pub(crate) prepared: Vec<Prepared<'static>>,
@@ -25,7 +23,6 @@ pub struct Session {
     pub timings: Vec<PassTiming>,
     /// What the adapter is, and how the plan degraded on wgpu.
     pub notes: Vec<String>,
-    pub adapter: String,
 }
 
 /// A session after one frame ([`WgpuBackend::execute`]).
@@ -121,8 +118,6 @@ impl Session {
             .collect::<Result<Vec<_>, _>>()?;
         let timestamps = Timestamps::new(device, prepared.len());
         let session = Session {
-            device: gpu.device.clone(),
-            queue: gpu.queue.clone(),
             plan: plan.clone(),
             instance: instance.clone(),
             prepared,
@@ -132,7 +127,6 @@ impl Session {
             gpu: gpu.clone(),
             timings: Vec::new(),
             notes,
-            adapter: gpu.name.clone(),
         };
         session.gpu.check("creating resources and pipelines")?;
         Ok(session)
@@ -149,16 +143,11 @@ impl Session {
         }
     }
 
-    /// The frame's quantities (counts and resolution) the plan was sized for.
-    pub fn quantities(&self) -> &strandgraph_graph::Quantities {
-        &self.instance.quantities
-    }
-
     /// Uploads `inputs` and runs one frame; returns its per-pass GPU times.
     pub fn run(&mut self, inputs: &Upload) -> Result<&[PassTiming], WgpuError> {
         upload(
-            &self.device,
-            &self.queue,
+            &self.gpu.device,
+            &self.gpu.queue,
             &self.plan,
             &self.instance,
             &self.memory,
