@@ -8,5 +8,6 @@ pub mod demo;
 pub mod frame;
 pub mod images;
 pub mod runner;
+pub mod sequence;
 pub mod tables;
 pub mod tonemap;

@@ -24,7 +24,8 @@ pub enum Backend {
 #[command(after_help = "Examples:
   strandgraph render scenes/showcase.ron -o showcase.png
   strandgraph render --demo --size 480x270 -o demo.png            # no checkout needed
-  strandgraph render scenes/showcase.ron --graph scenes/graphs/lipp.ron --backend all")]
+  strandgraph render scenes/showcase.ron --graph scenes/graphs/lipp.ron --backend all
+  strandgraph render scenes/animated.ron --frames 90 --fps 30 -o turn/   # a sequence (+ MP4 with ffmpeg)")]
 pub struct Args {
     /// The scene (RON), e.g. scenes/showcase.ron.
     #[arg(required_unless_present = "demo")]
@@ -36,9 +37,18 @@ pub struct Args {
     #[arg(long, value_enum, default_value = "cpu")]
     pub backend: Backend,
     /// Where to write the main image: PNG (sRGB), or linear EXR when the
-    /// name ends in `.exr`; other image outputs go beside it.
+    /// name ends in `.exr`; other image outputs go beside it. With
+    /// `--frames` above 1, a directory for the sequence.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// Render this many frames of the scene's animation (hair simulated
+    /// frame to frame) as `frame_NNNN.png` into the `-o` directory, and an
+    /// MP4 beside them where ffmpeg is installed.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: u32,
+    /// Frames per second of the sequence (the simulation's time step).
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f32,
     /// Also write the view depth (metres, EXR) of `scene.depth` here.
     #[arg(long, value_name = "FILE.exr")]
     pub depth: Option<PathBuf>,
@@ -88,7 +98,10 @@ pub fn run(args: Args) -> Result<()> {
         (None, None) => miette::bail!("name a scene, or pass --demo"),
     };
     // Overrides apply before packing and baking (a `"Baked"` override bakes).
-    let p = prepare_with(&scene, args.graph.as_deref(), size, &args.params)?;
+    if !(args.fps > 0.0 && args.fps <= 1000.0) {
+        miette::bail!("--fps {}: expected a rate in (0, 1000]", args.fps);
+    }
+    let mut p = prepare_with(&scene, args.graph.as_deref(), size, &args.params)?;
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",
@@ -133,6 +146,14 @@ pub fn run(args: Args) -> Result<()> {
         let tag = (i > 0).then_some(backend.name());
         let t1 = Instant::now();
         let mut session = runner::open(backend, &p.plan, &p.instance, options)?;
+        if args.frames > 1 {
+            let dir = args
+                .output
+                .clone()
+                .unwrap_or_else(|| main.with_extension(""));
+            sequence(&mut p, session.as_mut(), &args, &dir, tag)?;
+            continue;
+        }
         let times = session.run(&p.upload)?;
         let wall = t1.elapsed().as_secs_f64() * 1e3;
         runner::check_frame(&p.plan, &p.instance, session.as_ref())?;
@@ -154,6 +175,79 @@ pub fn run(args: Args) -> Result<()> {
         print_side_by_side(&p.plan, &all);
     }
     Ok(())
+}
+
+/// `--frames N`: the animation frame by frame through one session, each
+/// frame's images into `dir` (`frame_0000.png`, tagged per backend), then an
+/// MP4 of them where ffmpeg is installed.
+fn sequence(
+    p: &mut Prepared,
+    session: &mut dyn runner::Session,
+    args: &Args,
+    dir: &Path,
+    tag: Option<&str>,
+) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("creating {}", dir.display()))?;
+    let bar = indicatif::ProgressBar::new(u64::from(args.frames));
+    let extras = Extras {
+        depth: None,
+        motion: None,
+        coverage: None,
+        ..Extras::of(args, tag)
+    };
+    let name = |k: u32| tagged(&dir.join(format!("frame_{k:04}.png")), tag);
+    let mut millis = Vec::new();
+    for k in 0..args.frames {
+        let up = strandgraph::sequence::frame_upload(p, k, args.fps)?;
+        let times = session.run(&up)?;
+        millis.push(frame_millis(&times));
+        bar.suspend(|| write_outputs(p, &name(k), &extras, |n| Ok(session.read(n)?)))?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    millis.sort_by(f64::total_cmp);
+    println!(
+        "{} backend: {} frames into {}, median frame {:.3} ms ({})",
+        session.backend(),
+        args.frames,
+        dir.display(),
+        millis[millis.len() / 2],
+        session.device()
+    );
+    encode_mp4(dir, tag, args.fps);
+    Ok(())
+}
+
+/// `dir/sequence.mp4` (tagged) from its frames with ffmpeg, when installed.
+fn encode_mp4(dir: &Path, tag: Option<&str>, fps: f32) {
+    let pattern = tagged(&dir.join("frame_%04d.png"), tag);
+    let out = tagged(&dir.join("sequence.mp4"), tag);
+    let status = std::process::Command::new("ffmpeg")
+        .args([
+            "-loglevel",
+            "error",
+            "-y",
+            "-framerate",
+            &fps.to_string(),
+            "-i",
+        ])
+        .arg(&pattern)
+        .args(["-c:v", "libx264", "-pix_fmt", "yuv420p", "-crf", "18"])
+        .arg(&out)
+        .status();
+    match status {
+        Ok(s) if s.success() => println!("wrote {}", out.display()),
+        Ok(s) => println!(
+            "ffmpeg failed ({s}): no MP4, the frames are in {}",
+            dir.display()
+        ),
+        Err(_) => println!(
+            "ffmpeg not found: no MP4, the frames are in {}",
+            dir.display()
+        ),
+    }
 }
 
 /// The images written beside the main one, named for one backend.

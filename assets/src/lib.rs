@@ -19,6 +19,7 @@
 //! - [`hairpatch::HairPatches`]: layered, textured ribbon patches with baked per-vertex
 //!   AO in a static inside-to-outside draw order, generated from any groom, and their
 //!   procedural [`hairpatch::texture::HairTexture`] (Scheuermann 2004).
+//! - [`mesh_sdf::MeshSdf::bake`]: a mesh's signed distance field for hair collisions (Kulikov).
 //! - [`skinning::bake`]: `hairRootSkinningInfo_t` records for strand roots (Kulikov).
 
 #![forbid(unsafe_code)]
@@ -32,6 +33,7 @@ pub mod hairmesh;
 pub mod hairpatch;
 pub mod loaders;
 pub mod mesh;
+pub mod mesh_sdf;
 pub mod octahedral;
 pub mod procedural;
 pub mod scene;

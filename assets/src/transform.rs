@@ -42,6 +42,17 @@ impl Transform {
             Vec3::from_array(self.translation),
         )
     }
+    /// The transform of a matrix made of a uniform scale, a rotation and a
+    /// translation (what [`Transform::matrix`] makes).
+    pub fn from_matrix(m: Mat4) -> Self {
+        let (scale, rotation, translation) = m.to_scale_rotation_translation();
+        let (x, y, z) = rotation.to_euler(EulerRot::XYZ);
+        Transform {
+            translation: translation.to_array(),
+            rotation_deg: [x, y, z].map(f32::to_degrees),
+            scale: scale.x,
+        }
+    }
     pub fn apply(&self, p: Vec3) -> Vec3 {
         self.matrix().transform_point3(p)
     }
@@ -72,5 +83,11 @@ mod tests {
         };
         let p = t.apply(Vec3::X);
         assert!((p - Vec3::new(1.0, 0.0, -2.0)).length() < 1e-5, "{p}");
+        let back = Transform::from_matrix(t.matrix()).matrix();
+        assert!(
+            back.abs_diff_eq(t.matrix(), 1e-5),
+            "{back} vs {}",
+            t.matrix()
+        );
     }
 }

@@ -21,7 +21,14 @@ pub struct FrameData {
     pub light_count: u32,
     /// Pixels per world unit at view depth 1 (`proj[1][1] * height / 2`).
     pub pixels_per_unit: f32,
-    pub _pad: [u32; 19],
+    /// Seconds since the animation's start, and since the last frame (0 for
+    /// a still image): the simulation's time step.
+    pub time: f32,
+    pub delta_time: f32,
+    /// 1: the simulation starts over from the rest pose this frame (the
+    /// first frame of a sequence, every frame of a still image).
+    pub sim_reset: u32,
+    pub _pad: [u32; 16],
 }
 
 /// `models`: one hair model (groom) each (64 words).

@@ -32,6 +32,7 @@ pub mod raster_state;
 pub mod reference;
 pub mod scheuermann;
 pub mod shipped;
+pub mod sim;
 pub mod spirv;
 pub mod upload;
 pub mod wgsl;
@@ -53,6 +54,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &opaque_mesh::opaque::OPAQUE,
     &opaque_mesh::depth_attachment::DEPTH_ATTACHMENT,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
+    &sim::pbd::PBD,
     &kulikov::lod::LOD,
     &kulikov::skin::SKIN,
     &kulikov::density::DENSITY,

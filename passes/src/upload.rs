@@ -60,7 +60,10 @@ pub fn frame(scene: &Scene, width: u32, height: u32, models: u32) -> FrameData {
         model_count: models,
         light_count: scene.desc.lights.len() as u32,
         pixels_per_unit: proj.y_axis.y * height as f32 * 0.5,
-        _pad: [0; 19],
+        time: 0.0,
+        delta_time: 0.0,
+        sim_reset: 1,
+        _pad: [0; 16],
     }
 }
 

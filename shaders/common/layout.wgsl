@@ -21,7 +21,12 @@ struct FrameData {
     light_count: u32,
     // Pixels per world unit at view depth 1.
     pixels_per_unit: f32,
-    _pad: array<u32, 19>,
+    // Seconds since the animation's start and since the last frame.
+    time: f32,
+    delta_time: f32,
+    // 1: the simulation starts over from the rest pose.
+    sim_reset: u32,
+    _pad: array<u32, 16>,
 }
 
 // `models`: one hair model (256 bytes).

@@ -96,6 +96,10 @@ pub(super) fn check(desc: &SceneDesc) -> Result<(), Problem> {
         }
         groom(g).map_err(|e| at(quoted(&g.name), format!("groom {:?}: {e}", g.name)))?;
     }
+    if let Some(a) = &desc.animation {
+        super::animation::check(a, desc)
+            .map_err(|(needle, m)| at(needle, format!("animation: {m}")))?;
+    }
     Ok(())
 }
 

@@ -30,6 +30,8 @@ pub struct SceneGroom {
     /// (parent's transform composed with the groom's).
     pub groom: Groom,
     pub world: glam::Mat4,
+    /// `world` in the rest pose ([`Scene::pose_at`] moves `world`).
+    pub rest_world: glam::Mat4,
     pub parent: Option<usize>,
     /// Kulikov: one hairRootSkinningInfo_t per strand root, against the parent mesh.
     pub skinning: Option<Vec<RootSkinningInfo>>,
@@ -42,6 +44,8 @@ pub struct SceneGroom {
     pub lod: LodSettings,
     pub facial_hair: bool,
     pub fedora: Option<super::Fedora>,
+    /// Simulated by the PBD passes (`GroomDesc::simulate`).
+    pub simulate: bool,
 }
 
 impl SceneGroom {
@@ -315,6 +319,7 @@ fn load_groom(
         name: g.name.clone(),
         groom,
         world,
+        rest_world: world,
         parent,
         skinning,
         hair_mesh,
@@ -323,6 +328,7 @@ fn load_groom(
         lod: g.lod,
         facial_hair: g.facial_hair,
         fedora: g.fedora,
+        simulate: g.simulate,
     })
 }
 

@@ -5,6 +5,7 @@
 //! so a procedural source reads `Procedural(style: Long, strands: 40000)` and optional
 //! values need no `Some(..)`.
 
+mod animation;
 mod check;
 mod load;
 
@@ -16,6 +17,7 @@ use crate::loaders::Units;
 use crate::procedural::{BodyParams, GroomParams, HeadParams};
 use crate::transform::Transform;
 
+pub use animation::{Animation, CameraKey, Joint, JointKey, Pose};
 pub use check::{MAX_BODY_RESOLUTION, MAX_RESOLUTION};
 pub use load::{Scene, SceneCounts, SceneGroom, SceneMesh};
 
@@ -36,6 +38,9 @@ pub struct SceneDesc {
     pub grooms: Vec<GroomDesc>,
     /// The render graph to run, relative to the scene file (e.g. "graphs/kulikov.ron").
     pub graph: String,
+    /// Joints and a camera path ([`Scene::pose_at`]); a scene without one is still.
+    #[serde(default)]
+    pub animation: Option<Animation>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -159,6 +164,12 @@ pub struct GroomDesc {
     /// Kulikov's "fedora culling" shapes around a hat, in world space.
     #[serde(default)]
     pub fedora: Option<Fedora>,
+    /// Simulate the strands (Kulikov: "Enabled per asset by artists"): the
+    /// PBD pass moves them with gravity and the parent's joint, against
+    /// the parent mesh's signed distance field. Off, they follow the
+    /// parent rigidly.
+    #[serde(default)]
+    pub simulate: bool,
 }
 
 /// Kulikov: segments inside the exclusion box are culled unless they are

@@ -148,7 +148,10 @@ pub(crate) mod testing {
             model_count: 0,
             light_count: 0,
             pixels_per_unit: proj.y_axis.y * h as f32 * 0.5,
-            _pad: [0; 19],
+            time: 0.0,
+            delta_time: 0.0,
+            sim_reset: 1,
+            _pad: [0; 16],
         }
     }
 

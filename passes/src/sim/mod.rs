@@ -1,0 +1,63 @@
+//! Hair simulation: Kulikov's "PBD solver, based on 'Fast Simulation of
+//! Inextensible Hair and Fur' [Müller12]", run before skinning on the
+//! graphics queue.
+//!
+//! Kulikov: "Every strand and every strand vertex is simulated. Outputs
+//! vertex positions, velocities and density voxel grid. Skinned to head
+//! joint (no blend shapes). Prebuilt SDFs for head collisions (0.25MB per
+//! head). ... Once simulation step is over we output local positions for
+//! hair vertices and their velocities for following passes."
+//!
+//! - [`pbd`]: the solver pass `sim.pbd`, one lane per strand: dynamic
+//!   follow-the-leader with Müller's damping correction, gravity, the head
+//!   joint's motion, collisions with the parent mesh's SDF and friction. It
+//!   writes `sim.vertices` in the layout of `groom.vertices` (local
+//!   positions, thickness), which `kulikov.skin` reads in its place, so root
+//!   skinning runs as before; the density grid (`kulikov.density`) is
+//!   splatted from the skinned, so simulated, positions.
+//! - [`sdf`]: the field's sampling, shared by the solver and its tests.
+//! - [`upload`]: `sim.models` (per groom: the inverse joint, rest gravity,
+//!   the field's placement) and `sim.sdf` (the baked fields).
+
+pub mod pbd;
+pub mod sdf;
+pub mod upload;
+
+#[cfg(test)]
+mod tests;
+
+use bytemuck::{Pod, Zeroable};
+
+/// `sim.models` flag: the groom is simulated (`GroomDesc::simulate`).
+pub const SIM_SIMULATE: u32 = 1;
+/// `sim.models` flag: the groom has a collision field in `sim.sdf`.
+pub const SIM_COLLIDER: u32 = 2;
+
+/// `sim.models`: what the solver needs per groom beyond `models` (32 words).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SimModel {
+    /// Column-major world → groom local at this frame (`models.world`'s inverse).
+    pub inv_world: [f32; 16],
+    /// The direction that was down in the rest pose, in groom-local space
+    /// (w unused): the rest shape is taken to balance gravity along it.
+    pub rest_down: [f32; 4],
+    /// The collision field's grid point (0, 0, 0) in groom-local space, and
+    /// its spacing in w.
+    pub sdf_min: [f32; 4],
+    /// World units per local unit (the transform's uniform scale).
+    pub scale: f32,
+    /// [`SIM_SIMULATE`] | [`SIM_COLLIDER`].
+    pub flags: u32,
+    pub _pad: [u32; 2],
+}
+
+/// `sim.state`: one record per vertex, kept between frames.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
+pub struct SimVertex {
+    /// World position; w is 1 once written (a History buffer starts at 0).
+    pub position: [f32; 4],
+    /// World velocity in metres per second (w unused).
+    pub velocity: [f32; 4],
+}

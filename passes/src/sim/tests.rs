@@ -1,0 +1,221 @@
+//! The solver's promises, on the CPU kernel: inextensible under a fast head
+//! turn, never inside the head, still at rest, and a sag without the
+//! gravity preload.
+
+use super::pbd::{PBD, PbdParams};
+use super::sdf::{FIELD_WORDS, sample};
+use super::upload::{MODELS, SDF, pack, repose};
+use super::{SimModel, SimVertex};
+use crate::kernel::harness::Harness;
+use crate::layout::{FrameData, words_of};
+use crate::upload::{Upload, upload};
+use glam::{Mat4, Vec3};
+use strandgraph_assets::Scene;
+
+const FPS: f32 = 60.0;
+
+/// A head with long simulated hair; `animation` is the scene's RON field.
+fn scene(animation: &str) -> Scene {
+    let text = format!(
+        r#"Scene(
+    resolution: (64, 64),
+    camera: LookAt(position: (0.0, 1.6, 1.2), target: (0.0, 1.5, 0.0), fov_deg: 30.0),
+    meshes: [(name: "head", source: Head(resolution: 96), transform: (translation: (0.0, 1.6, 0.0)))],
+    grooms: [(
+        name: "hair",
+        source: Procedural(style: Long, strands: 400, points: 16, seed: 3),
+        parent: "head",
+        simulate: true,
+    )],
+    graph: "graphs/kulikov.ron",
+    {animation}
+)"#
+    );
+    let dir = std::env::temp_dir().join(format!("strandgraph-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!(
+        "{:x}.ron",
+        text.len() ^ animation.as_ptr() as usize
+    ));
+    std::fs::write(&path, text).unwrap();
+    Scene::load(&path).unwrap()
+}
+
+/// Runs the scene's animation for `frames` at 60 fps through the CPU kernel;
+/// `check` sees each frame's state.
+struct Run {
+    scene: Scene,
+    up: Upload,
+    harness: Harness,
+    params: PbdParams,
+}
+
+impl Run {
+    fn new(scene: Scene, params: PbdParams) -> Self {
+        let mut up = upload(&scene, 64, 64);
+        pack(&scene, |_| true, &mut up);
+        let mut harness = Harness::new(up.quantities);
+        for name in ["models", "groom.vertices", "groom.strands", SDF, MODELS] {
+            harness.buffer(name, up.resources[name].clone());
+        }
+        let vertices = up.quantities.vertices as usize;
+        harness.buffer("sim.state", vec![0; vertices * 8]);
+        harness.buffer("sim.vertices", vec![0; vertices * 4]);
+        Run {
+            scene,
+            up,
+            harness,
+            params,
+        }
+    }
+
+    fn frame(&mut self, k: u32) {
+        let t = k as f32 / FPS;
+        self.scene.pose_at(t);
+        let posed = upload(&self.scene, 64, 64);
+        self.up
+            .resources
+            .insert("models".into(), posed.resources["models"].clone());
+        repose(&self.scene, &mut self.up);
+        let mut frame: FrameData = posed.frame.unwrap();
+        frame.time = t;
+        frame.delta_time = if k == 0 { 0.0 } else { 1.0 / FPS };
+        frame.sim_reset = u32::from(k == 0);
+        self.harness
+            .buffer("frame", words_of(&[frame]))
+            .buffer("models", self.up.resources["models"].clone())
+            .buffer(MODELS, self.up.resources[MODELS].clone());
+        let kernel = (PBD.kernel)(&self.params);
+        let groups = (self.up.quantities.strands as u32).div_ceil(64);
+        self.harness.run(kernel.as_ref(), groups, 64);
+    }
+
+    fn state(&self) -> Vec<SimVertex> {
+        bytemuck::pod_collect_to_vec(&self.harness.read("sim.state"))
+    }
+
+    /// Each vertex's world position at rest in the current pose.
+    fn rest(&self) -> Vec<Vec3> {
+        let g = &self.scene.grooms[0];
+        let verts: Vec<[f32; 4]> =
+            bytemuck::pod_collect_to_vec(&self.up.resources["groom.vertices"]);
+        verts
+            .iter()
+            .map(|v| g.world.transform_point3(Vec3::new(v[0], v[1], v[2])))
+            .collect()
+    }
+
+    fn strands(&self) -> Vec<[u32; 2]> {
+        bytemuck::pod_collect_to_vec(&self.up.resources["groom.strands"])
+    }
+
+    /// The field's distance at world point `p` (metres); `None` off the grid.
+    fn distance(&self, p: Vec3) -> Option<f32> {
+        let sims: Vec<SimModel> = bytemuck::pod_collect_to_vec(&self.up.resources[MODELS]);
+        let field = &self.up.resources[SDF][..FIELD_WORDS];
+        let q = Mat4::from_cols_array(&sims[0].inv_world).transform_point3(p);
+        sample(|i| f32::from_bits(field[i]), sims[0].sdf_min, q.to_array())
+            .map(|(d, _)| d * sims[0].scale)
+    }
+}
+
+const TURN: &str = "animation: (joints: [(mesh: \"head\", pivot: (0.0, 1.5, 0.0), keys: [
+    (time: 0.0), (time: 0.25, rotation_deg: (0.0, 90.0, 0.0)), (time: 0.5, rotation_deg: (-20.0, -60.0, 0.0)), (time: 0.75)])]),";
+
+#[test]
+fn a_fast_head_turn_keeps_lengths_and_stays_out_of_the_head() {
+    let mut run = Run::new(scene(TURN), PbdParams::default());
+    let rest = run.rest();
+    let strands = run.strands();
+    let (mut worst_length, mut deepest, mut moved) = (0.0f32, 0.0f32, 0.0f32);
+    for k in 0..60 {
+        run.frame(k);
+        let state = run.state();
+        let now = run.rest();
+        for &[first, count] in &strands {
+            for v in first as usize + 1..(first + count) as usize {
+                let p = |i: usize| Vec3::from_slice(&state[i].position);
+                let want = rest[v].distance(rest[v - 1]);
+                worst_length = worst_length.max((p(v).distance(p(v - 1)) - want).abs() / want);
+                deepest = deepest.min(run.distance(p(v)).unwrap_or(0.0));
+                moved = moved.max(p(v).distance(now[v]));
+            }
+        }
+    }
+    eprintln!(
+        "worst length change {:.4}%, deepest {:.4} mm, largest lag {:.1} mm",
+        worst_length * 100.0,
+        -deepest * 1e3,
+        moved * 1e3
+    );
+    assert!(
+        worst_length < 0.01,
+        "a segment changed length by {:.3}%",
+        worst_length * 100.0
+    );
+    assert!(
+        deepest >= -1e-4,
+        "a vertex ended {:.3} mm inside the head",
+        -deepest * 1e3
+    );
+    // The hair lagged behind the head: it is simulated, not carried.
+    assert!(
+        moved > 0.02,
+        "hair moved at most {moved} m from the carried pose"
+    );
+}
+
+#[test]
+fn a_groom_at_rest_stays_at_rest_for_1000_steps() {
+    let params = PbdParams::default();
+    let mut run = Run::new(scene(""), params);
+    let rest = run.rest();
+    let frames = 1000 / params.substeps;
+    for k in 0..=frames {
+        run.frame(k);
+    }
+    let state = run.state();
+    let drift = state
+        .iter()
+        .zip(&rest)
+        .map(|(s, r)| Vec3::from_slice(&s.position).distance(*r))
+        .fold(0.0, f32::max);
+    assert!(
+        drift < 1e-4,
+        "a vertex drifted {:.4} mm in 1000 steps",
+        drift * 1e3
+    );
+    let speed = state
+        .iter()
+        .map(|s| Vec3::from_slice(&s.velocity).length())
+        .fold(0.0, f32::max);
+    assert!(speed < 1e-3, "still moving at {speed} m/s");
+}
+
+#[test]
+fn without_the_preload_gravity_pulls_the_style_down() {
+    let params = PbdParams {
+        gravity_preload: false,
+        shape_stiffness: 0.0,
+        ..PbdParams::default()
+    };
+    let mut run = Run::new(scene(""), params);
+    let rest = run.rest();
+    for k in 0..30 {
+        run.frame(k);
+    }
+    let state = run.state();
+    let tips: Vec<(Vec3, Vec3)> = run
+        .strands()
+        .iter()
+        .map(|&[first, count]| {
+            let tip = (first + count - 1) as usize;
+            (Vec3::from_slice(&state[tip].position), rest[tip])
+        })
+        .collect();
+    let drop = tips.iter().map(|(p, r)| r.y - p.y).sum::<f32>() / tips.len() as f32;
+    assert!(
+        drop > 0.01,
+        "tips fell {drop} m on average in half a second"
+    );
+}

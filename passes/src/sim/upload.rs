@@ -1,0 +1,95 @@
+//! The simulation's imported resources: `sim.sdf`, each simulated groom's
+//! collision field, baked once from its parent mesh in the groom's local
+//! space (so the field moves with the head joint); and `sim.models`, per
+//! groom the inverse of this frame's world transform, the rest pose's down
+//! direction and the field's placement, repacked every animated frame.
+
+use super::sdf::FIELD_WORDS;
+use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel};
+use crate::layout::words_of;
+use crate::upload::Upload;
+use glam::{Mat4, Vec3};
+use strandgraph_assets::Scene;
+use strandgraph_assets::mesh_sdf::MeshSdf;
+
+pub const MODELS: &str = "sim.models";
+pub const SDF: &str = "sim.sdf";
+
+/// Space around the head the field covers, in the mesh's units: hair
+/// further out cannot reach it within a frame.
+const FIELD_PADDING: f32 = 0.03;
+
+/// Bakes the fields of the grooms `simulated` picks (each with a parent
+/// mesh) into `sim.sdf` and writes `sim.models` for the scene's pose.
+pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
+    let start = std::time::Instant::now();
+    let mut sdf = vec![0u32; FIELD_WORDS * scene.grooms.len()];
+    let mut placement = vec![None; scene.grooms.len()];
+    for (i, g) in scene.grooms.iter().enumerate() {
+        let Some(parent) = g.parent.filter(|_| simulated(i)) else {
+            continue;
+        };
+        let mesh = &scene.meshes[parent].mesh;
+        // Groom local → mesh local: the groom's transform relative to its parent.
+        let to_mesh = mesh.transform.matrix().inverse() * g.rest_world;
+        let region = mesh.bounds().transformed(&to_mesh.inverse());
+        let scale = to_mesh.x_axis.truncate().length();
+        let Some(field) = MeshSdf::bake(mesh, to_mesh, region, FIELD_PADDING / scale) else {
+            continue;
+        };
+        let words = &mut sdf[i * FIELD_WORDS..(i + 1) * FIELD_WORDS];
+        for (w, v) in words.iter_mut().zip(&field.values) {
+            *w = v.to_bits();
+        }
+        placement[i] = Some([field.min.x, field.min.y, field.min.z, 1.0 / field.voxel]);
+    }
+    let baked = placement.iter().flatten().count();
+    if baked > 0 {
+        tracing::info!(
+            fields = baked,
+            seconds = start.elapsed().as_secs_f32(),
+            "baked head collision fields"
+        );
+    }
+    let models: Vec<SimModel> = scene
+        .grooms
+        .iter()
+        .enumerate()
+        .map(|(i, g)| {
+            let rest_down = g
+                .rest_world
+                .inverse()
+                .transform_vector3(Vec3::NEG_Y)
+                .normalize_or_zero();
+            let mut flags = if g.simulate { SIM_SIMULATE } else { 0 };
+            if placement[i].is_some() {
+                flags |= SIM_COLLIDER;
+            }
+            SimModel {
+                inv_world: Mat4::IDENTITY.to_cols_array(),
+                rest_down: [rest_down.x, rest_down.y, rest_down.z, 0.0],
+                sdf_min: placement[i].unwrap_or([0.0; 4]),
+                scale: 1.0,
+                flags,
+                _pad: [0; 2],
+            }
+        })
+        .collect();
+    up.set(SDF, sdf);
+    up.set(MODELS, words_of(&models));
+    repose(scene, up);
+}
+
+/// Rewrites `sim.models`' per-frame part (the inverse world transform and
+/// scale) for the scene's current pose; nothing without `sim.models`.
+pub fn repose(scene: &Scene, up: &mut Upload) {
+    let Some(words) = up.resources.get_mut(MODELS) else {
+        return;
+    };
+    let mut models: Vec<SimModel> = bytemuck::pod_collect_to_vec(words);
+    for (m, g) in models.iter_mut().zip(&scene.grooms) {
+        m.inv_world = g.world.inverse().to_cols_array();
+        m.scale = g.world.x_axis.truncate().length();
+    }
+    *words = words_of(&models);
+}
