@@ -215,8 +215,8 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
         var contact = false;
         var normal = vec3<f32>(0.0);
         let limit = threshold(s, v, margin);
-        for (var pass = 0u; pass < COLLISION_PASSES; pass++) {
-            let c = collide(s, fixed, limit, f32(pass + 1u));
+        for (var k = 0u; k < COLLISION_PASSES; k++) {
+            let c = collide(s, fixed, limit, f32(k + 1u));
             if !c.hit {
                 break;
             }
