@@ -411,6 +411,8 @@ fn frames(
     upload: &Upload,
     args: &Args,
 ) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
+    // A game's frames at 60 fps: the simulation steps every frame.
+    let upload = &strandgraph::sequence::running(upload, 60.0);
     for _ in 0..args.warmup {
         session.run(upload)?;
     }

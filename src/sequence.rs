@@ -41,3 +41,18 @@ pub fn frame_upload(p: &mut Prepared, index: u32, fps: f32) -> Result<Upload> {
     up.frame = Some(frame);
     Ok(up)
 }
+
+/// `up` as a frame of a running sequence at `fps` with nothing moving: the
+/// simulation steps by `1 / fps` from the state it kept (a session's first
+/// frame finds no state and starts from the rest pose). What the bench
+/// times, so the solver's substeps are in every Kulikov frame.
+pub fn running(up: &Upload, fps: f32) -> Upload {
+    let mut up = up.clone();
+    if let Some(mut frame) = up.frame {
+        frame.delta_time = 1.0 / fps;
+        frame.sim_reset = 0;
+        up.set("frame", words_of(&[frame]));
+        up.frame = Some(frame);
+    }
+    up
+}

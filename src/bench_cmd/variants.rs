@@ -33,6 +33,15 @@ pub const VARIANTS: &[Variant] = &[
     },
     Variant {
         pipeline: "Kulikov",
+        // Kulikov: "2 milliseconds for simulation plus rendering".
+        name: "simulating every groom",
+        graph: KULIKOV,
+        overrides: &["simulate.models=\"All\""],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
         name: "no loop flattening",
         graph: KULIKOV,
         overrides: &["raster.loop_flattening=false"],
