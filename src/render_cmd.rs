@@ -195,25 +195,39 @@ fn sequence(
         depth: None,
         motion: None,
         coverage: None,
+        quiet: true,
         ..Extras::of(args, tag)
     };
     let name = |k: u32| tagged(&dir.join(format!("frame_{k:04}.png")), tag);
-    let mut millis = Vec::new();
+    let mut frames = Vec::new();
     for k in 0..args.frames {
         let up = strandgraph::sequence::frame_upload(p, k, args.fps)?;
         let times = session.run(&up)?;
-        millis.push(frame_millis(&times));
         bar.suspend(|| write_outputs(p, &name(k), &extras, |n| Ok(session.read(n)?)))?;
+        frames.push(times);
         bar.inc(1);
     }
     bar.finish_and_clear();
-    millis.sort_by(f64::total_cmp);
+    // Per pass, the median over the frames after the first (which starts
+    // the simulation and carries no motion).
+    let moving = &frames[1..];
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied()
+    };
+    let mut medians = frames[frames.len() - 1].clone();
+    for (i, t) in medians.iter_mut().enumerate() {
+        t.millis = median(moving.iter().filter_map(|f| f[i].millis).collect());
+        t.span = None;
+    }
+    print_timings(&p.plan, &medians, false);
+    let totals = moving.iter().map(|f| frame_millis(f)).collect();
     println!(
         "{} backend: {} frames into {}, median frame {:.3} ms ({})",
         session.backend(),
         args.frames,
         dir.display(),
-        millis[millis.len() / 2],
+        median(totals).unwrap_or(f64::NAN),
         session.device()
     );
     encode_mp4(dir, tag, args.fps);
@@ -256,6 +270,8 @@ struct Extras {
     motion: Option<PathBuf>,
     coverage: Option<PathBuf>,
     display: Display,
+    /// Say nothing per file (a sequence's frames).
+    quiet: bool,
 }
 
 impl Extras {
@@ -268,6 +284,7 @@ impl Extras {
                 tonemap: args.tonemap,
                 exposure: args.exposure,
             },
+            quiet: false,
         }
     }
 }
@@ -347,7 +364,9 @@ fn write_outputs(
         saved
             .into_diagnostic()
             .wrap_err_with(|| format!("writing {}", path.display()))?;
-        println!("wrote {} ({name})", path.display());
+        if !extras.quiet {
+            println!("wrote {} ({name})", path.display());
+        }
         if let (false, Some(matte)) = (wrote_main, &extras.coverage) {
             write_coverage(p, r, &words, matte)?;
         }
