@@ -6,10 +6,11 @@
 use crate::frame::{Prepared, complete_upload};
 use miette::Result;
 use strandgraph_passes::layout::words_of;
+use strandgraph_passes::sim::upload::{self as sim, MODELS, REST, SDF};
 use strandgraph_passes::upload::{SHADOW_SH, Upload, upload};
 
 /// Inputs that do not depend on the pose: baked once, carried to every frame.
-const CARRIED: [&str; 2] = [SHADOW_SH, strandgraph_passes::sim::upload::SDF];
+const CARRIED: [&str; 3] = [SHADOW_SH, SDF, REST];
 
 /// The inputs of frame `index` of a sequence at `fps`: the scene posed at
 /// `index / fps` seconds, the simulation stepped by `1 / fps` (the first

@@ -6,8 +6,6 @@
 #import strandgraph::layout::{FrameData, ModelData}
 
 struct PbdParams {
-    // 0 Flagged, 1 All, 2 None.
-    models: u32,
     substeps: u32,
     gravity: f32,
     gravity_preload: u32,
@@ -19,6 +17,7 @@ struct PbdParams {
     strands: u32,
     _pad0: u32,
     _pad1: u32,
+    _pad2: u32,
 }
 
 // passes/src/sim/mod.rs: SimModel.
@@ -44,10 +43,12 @@ struct SimVertex {
 @group(0) @binding(2) var<storage, read> models: array<ModelData>;
 @group(0) @binding(3) var<storage, read> sim_models: array<SimModel>;
 @group(0) @binding(4) var<storage, read> sim_sdf: array<f32>;
-@group(0) @binding(5) var<storage, read> groom_vertices: array<vec4<f32>>;
+// The rest pose: xyz groom local, w thickness.
+@group(0) @binding(5) var<storage, read> sim_rest: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> groom_strands: array<vec2<u32>>;
 @group(0) @binding(7) var<storage, read_write> sim_state: array<SimVertex>;
-@group(0) @binding(8) var<storage, read_write> sim_vertices: array<vec4<f32>>;
+// Simulated strands' local positions go here; the others keep their rest pose.
+@group(0) @binding(8) var<storage, read_write> groom_vertices: array<vec4<f32>>;
 
 const GROUP: u32 = 64u;
 const SDF_RES: u32 = 40u;
@@ -138,7 +139,7 @@ struct Strand {
 }
 
 fn rest_local(s: Strand, v: u32) -> vec3<f32> {
-    return groom_vertices[s.first + v].xyz;
+    return sim_rest[s.first + v].xyz;
 }
 
 fn store(s: Strand, v: u32, x: vec3<f32>, u: vec3<f32>) {
@@ -282,22 +283,13 @@ fn pbd(@builtin(global_invocation_id) gid: vec3<u32>) {
     let range = groom_strands[g];
     let first = range.x;
     let count = range.y;
-    var simulated = false;
-    switch params.models {
-        case 0u: { simulated = (sim.flags & SIM_SIMULATE) != 0u; }
-        case 1u: { simulated = true; }
-        default: { simulated = false; }
-    }
-    if !simulated {
-        for (var v = first; v < first + count; v++) {
-            sim_vertices[v] = groom_vertices[v];
-        }
+    if (sim.flags & SIM_SIMULATE) == 0u {
         return;
     }
     let s = Strand(m, models[m].world, sim.inv_world, sim.scale, first);
     simulate(s, count);
     for (var v = 0u; v < count; v++) {
         let l = point(s.inv_world, sim_state[first + v].position.xyz);
-        sim_vertices[first + v] = vec4<f32>(l, groom_vertices[first + v].w);
+        groom_vertices[first + v] = vec4<f32>(l, sim_rest[first + v].w);
     }
 }

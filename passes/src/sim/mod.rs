@@ -11,13 +11,15 @@
 //! - [`pbd`]: the solver pass `sim.pbd`, one lane per strand: dynamic
 //!   follow-the-leader with Müller's damping correction, gravity, the head
 //!   joint's motion, collisions with the parent mesh's SDF and friction. It
-//!   writes `sim.vertices` in the layout of `groom.vertices` (local
-//!   positions, thickness), which `kulikov.skin` reads in its place, so root
-//!   skinning runs as before; the density grid (`kulikov.density`) is
+//!   writes the simulated strands' local positions over their rest pose in
+//!   `groom.vertices` (reading the rest pose from `sim.rest`), so
+//!   `kulikov.skin` runs root skinning on them as before and the grooms it
+//!   does not simulate cost nothing; the density grid (`kulikov.density`) is
 //!   splatted from the skinned, so simulated, positions.
 //! - [`sdf`]: the field's sampling, shared by the solver and its tests.
-//! - [`upload`]: `sim.models` (per groom: the inverse joint, rest gravity,
-//!   the field's placement) and `sim.sdf` (the baked fields).
+//! - [`upload`]: `sim.models` (per groom: whether it is simulated, the
+//!   inverse joint, rest gravity, the field's placement), `sim.sdf` (the
+//!   baked fields) and `sim.rest`.
 
 pub mod pbd;
 pub mod sdf;

@@ -49,7 +49,9 @@ crate::string_enum! {
 #[serde(deny_unknown_fields, default)]
 pub struct PbdParams {
     /// `Flagged`: the grooms the scene marks `simulate: true` (Kulikov:
-    /// "Enabled per asset by artists"); `All`; `None`.
+    /// "Enabled per asset by artists"); `All`; `None`. Applied when the
+    /// scene is packed (`sim::upload::pack` marks the grooms in
+    /// `sim.models` and bakes their fields), so the kernel reads one flag.
     pub models: Simulated,
     /// Solver steps per frame.
     pub substeps: u32,
@@ -110,7 +112,6 @@ impl PassParams for PbdParams {
 crate::gpu_block! {
     /// `PbdParams` in shaders/sim/pbd.wgsl.
     pub struct PbdGpu {
-        models: u32,
         substeps: u32,
         gravity: f32,
         gravity_preload: u32,
@@ -122,6 +123,7 @@ crate::gpu_block! {
         strands: u32,
         _pad0: u32,
         _pad1: u32,
+        _pad2: u32,
     }
 }
 
@@ -134,10 +136,10 @@ pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
         Binding::read("models"),
         Binding::read("sim.models"),
         Binding::read("sim.sdf"),
-        Binding::read("groom.vertices"),
+        Binding::read("sim.rest"),
         Binding::read("groom.strands"),
         Binding::write("sim.state"),
-        Binding::write("sim.vertices"),
+        Binding::write("groom.vertices"),
     ]),
     workgroup_size: GROUP,
     dispatch: Dispatch::PerElement {
@@ -147,7 +149,6 @@ pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
     shader: Shader::compute("sim/pbd.wgsl", "pbd"),
     kernel: |p| Box::new(PbdKernel(*p)),
     gpu: |p, q| PbdGpu {
-        models: p.models as u32,
         substeps: p.substeps,
         gravity: p.gravity,
         gravity_preload: flag(p.gravity_preload),
@@ -325,10 +326,10 @@ impl CpuKernel for PbdKernel {
             ctx.words("sim.sdf"),
         );
         let (rest, strands, state, out) = (
-            ctx.words("groom.vertices"),
+            ctx.words("sim.rest"),
             ctx.words("groom.strands"),
             ctx.words("sim.state"),
-            ctx.words("sim.vertices"),
+            ctx.words("groom.vertices"),
         );
         let total = strands.len() / 2;
         for lane in 0..GROUP {
@@ -345,21 +346,14 @@ impl CpuKernel for PbdKernel {
                 continue;
             };
             let sim: SimModel = read(&sims, m);
+            // The others keep their rest pose in `groom.vertices`.
+            if sim.flags & SIM_SIMULATE == 0 {
+                continue;
+            }
             let (first, count) = (
                 strands.load(2 * g) as usize,
                 strands.load(2 * g + 1) as usize,
             );
-            let simulated = match self.0.models {
-                super::pbd::Simulated::Flagged => sim.flags & SIM_SIMULATE != 0,
-                super::pbd::Simulated::All => true,
-                super::pbd::Simulated::None => false,
-            };
-            if !simulated {
-                for v in first..first + count {
-                    out.store_vec4(v, rest.load_vec4(v));
-                }
-                continue;
-            }
             let s = Strand {
                 world: Mat4::from_cols_array(&model.world),
                 sim,

@@ -4,7 +4,7 @@
 
 use super::pbd::{PBD, PbdParams};
 use super::sdf::{FIELD_WORDS, sample};
-use super::upload::{MODELS, SDF, pack, repose};
+use super::upload::{MODELS, REST, SDF, pack, repose};
 use super::{SimModel, SimVertex};
 use crate::kernel::harness::Harness;
 use crate::layout::{FrameData, words_of};
@@ -55,12 +55,18 @@ impl Run {
         let mut up = upload(&scene, 64, 64);
         pack(&scene, |_| true, &mut up);
         let mut harness = Harness::new(up.quantities);
-        for name in ["models", "groom.vertices", "groom.strands", SDF, MODELS] {
+        for name in [
+            "models",
+            "groom.vertices",
+            "groom.strands",
+            SDF,
+            MODELS,
+            REST,
+        ] {
             harness.buffer(name, up.resources[name].clone());
         }
         let vertices = up.quantities.vertices as usize;
         harness.buffer("sim.state", vec![0; vertices * 8]);
-        harness.buffer("sim.vertices", vec![0; vertices * 4]);
         Run {
             scene,
             up,

@@ -14,13 +14,17 @@ use strandgraph_assets::mesh_sdf::MeshSdf;
 
 pub const MODELS: &str = "sim.models";
 pub const SDF: &str = "sim.sdf";
+/// The rest pose the solver keeps (a copy of `groom.vertices`, which it
+/// overwrites with the simulated strands).
+pub const REST: &str = "sim.rest";
 
 /// Space around the head the field covers, in the mesh's units: hair
 /// further out cannot reach it within a frame.
 const FIELD_PADDING: f32 = 0.03;
 
-/// Bakes the fields of the grooms `simulated` picks (each with a parent
-/// mesh) into `sim.sdf` and writes `sim.models` for the scene's pose.
+/// Marks the grooms `simulated` picks in `sim.models` (their fields baked
+/// into `sim.sdf` when they have a parent mesh), keeps the rest pose as
+/// `sim.rest`, and writes `sim.models`' pose part for the scene's pose.
 pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
     let start = std::time::Instant::now();
     let mut sdf = vec![0u32; FIELD_WORDS * scene.grooms.len()];
@@ -61,7 +65,7 @@ pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
                 .inverse()
                 .transform_vector3(Vec3::NEG_Y)
                 .normalize_or_zero();
-            let mut flags = if g.simulate { SIM_SIMULATE } else { 0 };
+            let mut flags = if simulated(i) { SIM_SIMULATE } else { 0 };
             if placement[i].is_some() {
                 flags |= SIM_COLLIDER;
             }
@@ -77,6 +81,9 @@ pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
         .collect();
     up.set(SDF, sdf);
     up.set(MODELS, words_of(&models));
+    if let Some(rest) = up.resources.get("groom.vertices").cloned() {
+        up.set(REST, rest);
+    }
     repose(scene, up);
 }
 
