@@ -25,6 +25,7 @@ use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
 use strandgraph::images::{Picture, main_picture};
 use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
+use strandgraph::sequence;
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
 use strandgraph_passes::bench::RasterBenchParams;
@@ -41,6 +42,8 @@ const VIEWS: [&str; 3] = [
 /// Whole scenes timed after the views (not by `--quick`): one head, and
 /// the crowd of twelve characters.
 const SCENES: [&str; 2] = ["scenes/showcase.ron", "scenes/crowd.ron"];
+/// The frame rate of timed frames: the simulation's step.
+const FPS: f32 = 60.0;
 const ROOFLINE: &str = "scenes/graphs/roofline.ron";
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -270,6 +273,8 @@ pub fn run(mut args: Args) -> Result<()> {
     // A pipeline that cannot run a scene (Lipp needs hair meshes) gets its
     // cells marked skipped with the reason, not a failed bench.
     let mut prepared: BTreeMap<(usize, &str), Result<Prepared, String>> = BTreeMap::new();
+    // An animated scene's frames, timed in motion (sequence::animation_frames).
+    let mut animated: BTreeMap<(usize, &str), Vec<Upload>> = BTreeMap::new();
     for (s, scene) in scenes.iter().enumerate() {
         for graph in rows.iter().map(|v| v.graph) {
             if skipped.contains_key(graph) {
@@ -277,10 +282,21 @@ pub fn run(mut args: Args) -> Result<()> {
             }
             if let std::collections::btree_map::Entry::Vacant(e) = prepared.entry((s, graph)) {
                 tracing::info!(scene = %scene.display(), graph, "preparing");
-                let p = prepare_graph(scene, &locate(graph), size, args.quick);
+                let mut p = prepare_graph(scene, &locate(graph), size, args.quick);
+                if let Ok(p) = &mut p {
+                    let count = args.warmup + args.frames;
+                    if let Some(frames) = sequence::animation_frames(p, count, FPS)? {
+                        animated.insert((s, graph), frames);
+                    }
+                }
                 e.insert(p.map_err(|e| format!("{graph} on {}: {e}", scene.display())));
             }
         }
+    }
+    if !animated.is_empty() {
+        report.note(format!(
+            "animated scenes run their animation at {FPS} fps from its start (simulation in motion) and have no FLIP: the references do not simulate"
+        ));
     }
     let first = prepared
         .values()
@@ -337,7 +353,8 @@ pub fn run(mut args: Args) -> Result<()> {
                         n
                     }
                 };
-                match measure(backend, p, v, &args, cpu, atomics) {
+                let inputs = animated.get(&(s, v.graph)).map(Vec::as_slice);
+                match measure(backend, p, v, &args, cpu, atomics, inputs) {
                     Ok((device, notes, mut stats, picture)) => {
                         report.device(backend, &device, &notes);
                         if let Some(img) = picture {
@@ -408,19 +425,19 @@ pub fn run(mut args: Args) -> Result<()> {
 /// GPU: [`frame_millis`], timestamps only).
 fn frames(
     session: &mut dyn Session,
-    upload: &Upload,
+    inputs: &[Upload],
     args: &Args,
 ) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
-    // A game's frames at 60 fps: the simulation steps every frame.
-    let upload = &strandgraph::sequence::running(upload, 60.0);
-    for _ in 0..args.warmup {
-        session.run(upload)?;
+    // Frame k runs inputs[k], the last one again once they run out.
+    let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
+    for k in 0..args.warmup {
+        session.run(input(k))?;
     }
     let mut passes = Vec::with_capacity(args.frames);
     let mut totals = Vec::with_capacity(args.frames);
-    for _ in 0..args.frames {
+    for k in args.warmup..args.warmup + args.frames {
         let t = Instant::now();
-        let times = session.run(upload)?;
+        let times = session.run(input(k))?;
         let wall = t.elapsed().as_secs_f64() * 1e3;
         totals.push(match session.clock() {
             Clock::CpuWall => wall,
@@ -479,16 +496,20 @@ fn measure(
     args: &Args,
     cpu: CpuOptions,
     atomics: u64,
+    animation: Option<&[Upload]>,
 ) -> Result<(String, Vec<String>, Stats, Option<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
-    let (passes, totals) = frames(session.as_mut(), &p.upload, args)?;
+    // A still scene: a game's frames at 60 fps, the simulation stepping.
+    let still = [sequence::running(&p.upload, FPS)];
+    let (passes, totals) = frames(session.as_mut(), animation.unwrap_or(&still), args)?;
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
     let stats = Stats::new(&passes, &totals, v.raster, atomics);
     // Read back only what a reference will be compared with, or
     // `--pictures` saves.
     let q = p.upload.quantities;
-    let wanted = args.pictures || quality::reference_graph(v.pipeline).is_some();
+    let judged = quality::reference_graph(v.pipeline).is_some() && animation.is_none();
+    let wanted = args.pictures || judged;
     let picture = wanted
         .then(|| {
             main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
@@ -533,7 +554,7 @@ fn roofline(
     drop(counter);
 
     let mut session = runner::open(backend, &plan, &instance, cpu)?;
-    let (passes, _) = frames(session.as_mut(), &upload, args)?;
+    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args)?;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()

@@ -94,40 +94,18 @@ pub fn plan_for(
 /// `--param` overrides, before instantiating the plan.
 pub fn complete_upload(plan: &Plan, scene: &Scene, up: &mut Upload) -> Result<Option<BakeOutcome>> {
     build_patches(plan, scene, up);
-    pack_simulation(plan, scene, up)?;
+    pack_simulation(plan, scene, up);
     bake_shadows(plan, up)
 }
 
 /// The simulation's inputs (`strandgraph_passes::sim::upload`), for a graph
-/// that imports them: head collision fields for the grooms its `sim.pbd`
-/// pass simulates (the scene's flagged ones, or all), baked here. Does
-/// nothing when the upload already holds them.
-fn pack_simulation(plan: &Plan, scene: &Scene, up: &mut Upload) -> Result<()> {
-    use strandgraph_passes::sim::pbd::{PBD, Simulated};
+/// that imports them: the grooms' head collision fields, baked here, and
+/// their rest pose. Does nothing when the upload already holds them.
+fn pack_simulation(plan: &Plan, scene: &Scene, up: &mut Upload) {
     use strandgraph_passes::sim::upload::{SDF, pack};
-    let g = &plan.graph;
-    if g.resource_id(SDF).is_none() || up.resources.contains_key(SDF) {
-        return Ok(());
+    if plan.graph.resource_id(SDF).is_some() && !up.resources.contains_key(SDF) {
+        pack(scene, up);
     }
-    let mut which = Simulated::None;
-    for (p, pass) in g.passes.iter().enumerate() {
-        if plan.live[p] && pass.kind == PBD.kind {
-            let params = PBD
-                .params(&pass.params)
-                .map_err(|e| miette::miette!("{e}"))?;
-            which = params.models;
-        }
-    }
-    pack(
-        scene,
-        |i| match which {
-            Simulated::Flagged => scene.grooms[i].simulate,
-            Simulated::All => true,
-            Simulated::None => false,
-        },
-        up,
-    );
-    Ok(())
 }
 
 /// Scheuermann's hair patches: built from the grooms (and the patch count

@@ -25,13 +25,9 @@ pub fn frame_upload(p: &mut Prepared, index: u32, fps: f32) -> Result<Upload> {
             up.set(name, words.clone());
         }
     }
-    if let Some(models) = p
-        .upload
-        .resources
-        .get(strandgraph_passes::sim::upload::MODELS)
-    {
-        up.set(strandgraph_passes::sim::upload::MODELS, models.clone());
-        strandgraph_passes::sim::upload::repose(&p.scene, &mut up);
+    if let Some(models) = p.upload.resources.get(MODELS) {
+        up.set(MODELS, models.clone());
+        sim::repose(&p.scene, &mut up);
     }
     complete_upload(&p.plan, &p.scene, &mut up)?;
     let mut frame = up.frame.expect("upload sets the frame");
@@ -54,6 +50,45 @@ pub fn running(up: &Upload, fps: f32) -> Upload {
         frame.sim_reset = 0;
         up.set("frame", words_of(&[frame]));
         up.frame = Some(frame);
+    }
+    up
+}
+
+/// The inputs of `count` frames of `p`'s animation at `fps`, for timing
+/// them back to back: the first frame's in full, each later one only what
+/// changed since the frame before (the camera, the poses, the simulation's
+/// per-frame record), so the uploads between frames stay small. `None` for
+/// a scene without animation. Leaves the scene at rest.
+pub fn animation_frames(p: &mut Prepared, count: usize, fps: f32) -> Result<Option<Vec<Upload>>> {
+    if p.scene.desc.animation.is_none() {
+        return Ok(None);
+    }
+    let mut frames = Vec::with_capacity(count);
+    let mut last: Option<Upload> = None;
+    for k in 0..count {
+        let full = frame_upload(p, k as u32, fps)?;
+        frames.push(match &last {
+            None => full.clone(),
+            Some(last) => changed(last, &full),
+        });
+        last = Some(full);
+    }
+    p.scene.pose_at(0.0);
+    Ok(Some(frames))
+}
+
+/// `next` without the resources whose words equal `last`'s.
+fn changed(last: &Upload, next: &Upload) -> Upload {
+    let mut up = Upload {
+        quantities: next.quantities,
+        frame: next.frame,
+        models: next.models.clone(),
+        ..Upload::default()
+    };
+    for (name, words) in &next.resources {
+        if last.resources.get(name) != Some(words) {
+            up.set(name, words.clone());
+        }
     }
     up
 }

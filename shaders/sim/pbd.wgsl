@@ -6,6 +6,8 @@
 #import strandgraph::layout::{FrameData, ModelData}
 
 struct PbdParams {
+    // 0 Flagged, 1 All, 2 None.
+    models: u32,
     substeps: u32,
     gravity: f32,
     gravity_preload: u32,
@@ -17,7 +19,6 @@ struct PbdParams {
     strands: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // passes/src/sim/mod.rs: SimModel.
@@ -283,7 +284,14 @@ fn pbd(@builtin(global_invocation_id) gid: vec3<u32>) {
     let range = groom_strands[g];
     let first = range.x;
     let count = range.y;
-    if (sim.flags & SIM_SIMULATE) == 0u {
+    var simulated = false;
+    switch params.models {
+        case 0u: { simulated = (sim.flags & SIM_SIMULATE) != 0u; }
+        case 1u: { simulated = true; }
+        default: { simulated = false; }
+    }
+    // The others keep their rest pose in groom_vertices.
+    if !simulated {
         return;
     }
     let s = Strand(m, models[m].world, sim.inv_world, sim.scale, first);

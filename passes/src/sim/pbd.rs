@@ -49,9 +49,7 @@ crate::string_enum! {
 #[serde(deny_unknown_fields, default)]
 pub struct PbdParams {
     /// `Flagged`: the grooms the scene marks `simulate: true` (Kulikov:
-    /// "Enabled per asset by artists"); `All`; `None`. Applied when the
-    /// scene is packed (`sim::upload::pack` marks the grooms in
-    /// `sim.models` and bakes their fields), so the kernel reads one flag.
+    /// "Enabled per asset by artists"); `All`; `None`.
     pub models: Simulated,
     /// Solver steps per frame.
     pub substeps: u32,
@@ -112,6 +110,7 @@ impl PassParams for PbdParams {
 crate::gpu_block! {
     /// `PbdParams` in shaders/sim/pbd.wgsl.
     pub struct PbdGpu {
+        models: u32,
         substeps: u32,
         gravity: f32,
         gravity_preload: u32,
@@ -123,7 +122,6 @@ crate::gpu_block! {
         strands: u32,
         _pad0: u32,
         _pad1: u32,
-        _pad2: u32,
     }
 }
 
@@ -149,6 +147,7 @@ pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
     shader: Shader::compute("sim/pbd.wgsl", "pbd"),
     kernel: |p| Box::new(PbdKernel(*p)),
     gpu: |p, q| PbdGpu {
+        models: p.models as u32,
         substeps: p.substeps,
         gravity: p.gravity,
         gravity_preload: flag(p.gravity_preload),
@@ -346,8 +345,13 @@ impl CpuKernel for PbdKernel {
                 continue;
             };
             let sim: SimModel = read(&sims, m);
+            let simulated = match self.0.models {
+                Simulated::Flagged => sim.flags & SIM_SIMULATE != 0,
+                Simulated::All => true,
+                Simulated::None => false,
+            };
             // The others keep their rest pose in `groom.vertices`.
-            if sim.flags & SIM_SIMULATE == 0 {
+            if !simulated {
                 continue;
             }
             let (first, count) = (

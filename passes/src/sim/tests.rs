@@ -53,7 +53,7 @@ struct Run {
 impl Run {
     fn new(scene: Scene, params: PbdParams) -> Self {
         let mut up = upload(&scene, 64, 64);
-        pack(&scene, |_| true, &mut up);
+        pack(&scene, &mut up);
         let mut harness = Harness::new(up.quantities);
         for name in [
             "models",

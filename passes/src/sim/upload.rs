@@ -22,20 +22,33 @@ pub const REST: &str = "sim.rest";
 /// further out cannot reach it within a frame.
 const FIELD_PADDING: f32 = 0.03;
 
-/// Marks the grooms `simulated` picks in `sim.models` (their fields baked
-/// into `sim.sdf` when they have a parent mesh), keeps the rest pose as
+/// Bakes a collision field for every groom with a parent mesh into
+/// `sim.sdf` (grooms placed alike on one mesh share one bake), marks the
+/// grooms the scene simulates in `sim.models`, keeps the rest pose as
 /// `sim.rest`, and writes `sim.models`' pose part for the scene's pose.
-pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
+/// Every groom gets its field, so the pass's `models: "All"` needs no
+/// packing of its own.
+pub fn pack(scene: &Scene, up: &mut Upload) {
     let start = std::time::Instant::now();
     let mut sdf = vec![0u32; FIELD_WORDS * scene.grooms.len()];
     let mut placement = vec![None; scene.grooms.len()];
+    let mut baked: Vec<(usize, [u32; 16], usize)> = Vec::new();
     for (i, g) in scene.grooms.iter().enumerate() {
-        let Some(parent) = g.parent.filter(|_| simulated(i)) else {
+        let Some(parent) = g.parent else {
             continue;
         };
         let mesh = &scene.meshes[parent].mesh;
         // Groom local → mesh local: the groom's transform relative to its parent.
         let to_mesh = mesh.transform.matrix().inverse() * g.rest_world;
+        let key = to_mesh.to_cols_array().map(f32::to_bits);
+        if let Some(&(_, _, first)) = baked.iter().find(|b| b.0 == parent && b.1 == key) {
+            sdf.copy_within(
+                first * FIELD_WORDS..(first + 1) * FIELD_WORDS,
+                i * FIELD_WORDS,
+            );
+            placement[i] = placement[first];
+            continue;
+        }
         let region = mesh.bounds().transformed(&to_mesh.inverse());
         let scale = to_mesh.x_axis.truncate().length();
         let Some(field) = MeshSdf::bake(mesh, to_mesh, region, FIELD_PADDING / scale) else {
@@ -46,11 +59,11 @@ pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
             *w = v.to_bits();
         }
         placement[i] = Some([field.min.x, field.min.y, field.min.z, 1.0 / field.voxel]);
+        baked.push((parent, key, i));
     }
-    let baked = placement.iter().flatten().count();
-    if baked > 0 {
+    if !baked.is_empty() {
         tracing::info!(
-            fields = baked,
+            fields = baked.len(),
             seconds = start.elapsed().as_secs_f32(),
             "baked head collision fields"
         );
@@ -65,7 +78,7 @@ pub fn pack(scene: &Scene, simulated: impl Fn(usize) -> bool, up: &mut Upload) {
                 .inverse()
                 .transform_vector3(Vec3::NEG_Y)
                 .normalize_or_zero();
-            let mut flags = if simulated(i) { SIM_SIMULATE } else { 0 };
+            let mut flags = if g.simulate { SIM_SIMULATE } else { 0 };
             if placement[i].is_some() {
                 flags |= SIM_COLLIDER;
             }
