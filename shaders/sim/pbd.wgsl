@@ -143,8 +143,9 @@ fn rest_local(s: Strand, v: u32) -> vec3<f32> {
     return sim_rest[s.first + v].xyz;
 }
 
-fn store(s: Strand, v: u32, x: vec3<f32>, u: vec3<f32>) {
-    sim_state[s.first + v] = SimVertex(vec4<f32>(x, 1.0), vec4<f32>(u, 0.0));
+// The collision threshold rides in the velocity's w.
+fn store(s: Strand, v: u32, x: vec3<f32>, u: vec3<f32>, limit: f32) {
+    sim_state[s.first + v] = SimVertex(vec4<f32>(x, 1.0), vec4<f32>(u, limit));
 }
 
 // Strand::threshold.
@@ -183,7 +184,7 @@ fn collide(s: Strand, p: vec3<f32>, limit: f32, reach: f32) -> Contact {
 }
 
 // PbdKernel::release: velocity of the held vertex.
-fn release(s: Strand, v: u32, x: vec3<f32>, p: vec3<f32>, contact: bool, n: vec3<f32>, d_next: vec3<f32>, dt: f32) {
+fn release(s: Strand, v: u32, x: vec3<f32>, p: vec3<f32>, contact: bool, n: vec3<f32>, limit: f32, d_next: vec3<f32>, dt: f32) {
     let inv_dt = 1.0 / dt;
     var u = (p - x) * inv_dt - d_next * (params.ftl_damping * inv_dt);
     if contact {
@@ -192,11 +193,10 @@ fn release(s: Strand, v: u32, x: vec3<f32>, p: vec3<f32>, contact: bool, n: vec3
         u = tangential * (1.0 - params.friction) + n * max(un, 0.0);
     }
     u = u * max(1.0 - params.damping * dt, 0.0);
-    store(s, v, p, u);
+    store(s, v, p, u, limit);
 }
 
 fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
-    let margin = params.collision_margin * (1.0 / s.scale);
     let root = point(s.world, rest_local(s, 0u));
     // The held vertex.
     var hv = 0u;
@@ -204,6 +204,7 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
     var hp = root;
     var hcontact = false;
     var hn = vec3<f32>(0.0);
+    var hlimit = 0.0;
     for (var v = 1u; v < count; v++) {
         let state = sim_state[s.first + v];
         let x = state.position.xyz;
@@ -216,7 +217,7 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
         var fixed = hp + normalize3(q - hp) * length;
         var contact = false;
         var normal = vec3<f32>(0.0);
-        let limit = threshold(s, v, margin);
+        let limit = state.velocity.w;
         for (var k = 0u; k < COLLISION_PASSES; k++) {
             let c = collide(s, fixed, limit, f32(k + 1u));
             if !c.hit {
@@ -232,21 +233,23 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
             contact = true;
             normal = last.normal;
         }
-        release(s, hv, hx, hp, hcontact, hn, fixed - q, dt);
+        release(s, hv, hx, hp, hcontact, hn, hlimit, fixed - q, dt);
         hv = v;
         hx = x;
         hp = fixed;
         hcontact = contact;
         hn = normal;
+        hlimit = limit;
     }
-    release(s, hv, hx, hp, hcontact, hn, vec3<f32>(0.0), dt);
+    release(s, hv, hx, hp, hcontact, hn, hlimit, vec3<f32>(0.0), dt);
 }
 
 fn simulate(s: Strand, count: u32) {
     let fresh = sim_state[s.first].position.w == 0.0;
     if frame.sim_reset != 0u || fresh {
+        let margin = params.collision_margin * (1.0 / s.scale);
         for (var v = 0u; v < count; v++) {
-            store(s, v, point(s.world, rest_local(s, v)), vec3<f32>(0.0));
+            store(s, v, point(s.world, rest_local(s, v)), vec3<f32>(0.0), threshold(s, v, margin));
         }
     }
     if !(frame.delta_time > 0.0) {

@@ -60,6 +60,7 @@ pub struct SimModel {
 pub struct SimVertex {
     /// World position; w is 1 once written (a History buffer starts at 0).
     pub position: [f32; 4],
-    /// World velocity in metres per second (w unused).
+    /// World velocity in metres per second; w: how near the head the
+    /// vertex may come (its rest distance, at most the margin; local units).
     pub velocity: [f32; 4],
 }

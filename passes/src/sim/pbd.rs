@@ -203,14 +203,16 @@ impl Strand<'_> {
         let fetch = |i: usize| self.sdf.load_f32(self.sdf_base + i);
         sample(fetch, self.sim.sdf_min, q.to_array())
     }
-    fn load(&self, v: usize) -> (Vec3, Vec3) {
+    /// Position, velocity and collision threshold of vertex `v`.
+    fn load(&self, v: usize) -> (Vec3, Vec3, f32) {
         let i = 2 * (self.first + v);
-        (v3(self.state.load_vec4(i)), v3(self.state.load_vec4(i + 1)))
+        let u = self.state.load_vec4(i + 1);
+        (v3(self.state.load_vec4(i)), v3(u), u[3])
     }
-    fn store(&self, v: usize, x: Vec3, u: Vec3) {
+    fn store(&self, v: usize, x: Vec3, u: Vec3, limit: f32) {
         let i = 2 * (self.first + v);
         self.state.store_vec4(i, [x.x, x.y, x.z, 1.0]);
-        self.state.store_vec4(i + 1, [u.x, u.y, u.z, 0.0]);
+        self.state.store_vec4(i + 1, [u.x, u.y, u.z, limit]);
     }
 
     /// Step 4: `p` pushed out of the head to `threshold` (local units), and
@@ -232,7 +234,8 @@ impl Strand<'_> {
     }
 
     /// How near the head vertex `v` may come: its distance at rest, between
-    /// 0 and `margin` (local units).
+    /// 0 and `margin` (local units). Computed when the state starts and
+    /// kept in its velocity's w, as it never changes.
     fn threshold(&self, v: usize, margin: f32) -> f32 {
         self.field(self.rest_local(v))
             .map_or(0.0, |(d, _)| d)
@@ -247,6 +250,8 @@ struct Held {
     x: Vec3,
     p: Vec3,
     contact: Option<Vec3>,
+    /// Its collision threshold ([`Strand::threshold`]).
+    limit: f32,
 }
 
 impl PbdKernel {
@@ -261,23 +266,23 @@ impl PbdKernel {
             u = tangential * (1.0 - p.friction) + n * un.max(0.0);
         }
         u *= (1.0 - p.damping * dt).max(0.0);
-        s.store(h.v, h.p, u);
+        s.store(h.v, h.p, u, h.limit);
     }
 
     /// One substep of strand `s` with `count` vertices.
     fn substep(&self, s: &Strand<'_>, count: usize, dt: f32, accel: Vec3) {
         let p = &self.0;
-        let margin = p.collision_margin * (1.0 / s.sim.scale);
         let root = s.world.transform_point3(s.rest_local(0));
-        let (x0, _) = s.load(0);
+        let (x0, _, _) = s.load(0);
         let mut held = Held {
             v: 0,
             x: x0,
             p: root,
             contact: None,
+            limit: 0.0,
         };
         for v in 1..count {
-            let (x, u) = s.load(v);
+            let (x, u, limit) = s.load(v);
             let u = u + accel * dt;
             let mut q = x + u * dt;
             let rest_now = s.world.transform_point3(s.rest_local(v));
@@ -286,7 +291,6 @@ impl PbdKernel {
             let ftl = |q: Vec3| held.p + normalize(q - held.p) * length;
             let mut fixed = ftl(q);
             let mut contact = None;
-            let limit = s.threshold(v, margin);
             // Out of the head and back on the FTL sphere, alternately, each
             // push reaching further (a vertex wedged in a crease, under the
             // jaw, escapes along the sphere); what the last projection
@@ -310,6 +314,7 @@ impl PbdKernel {
                 x,
                 p: fixed,
                 contact,
+                limit,
             };
         }
         self.release(s, &held, Vec3::ZERO, dt);
@@ -369,7 +374,7 @@ impl CpuKernel for PbdKernel {
             };
             self.strand(&s, count, &frame);
             for v in 0..count {
-                let (x, _) = s.load(v);
+                let (x, _, _) = s.load(v);
                 let l = s.local(x);
                 out.store_vec4(first + v, [l.x, l.y, l.z, rest.load_vec4(first + v)[3]]);
             }
@@ -382,8 +387,10 @@ impl PbdKernel {
     fn strand(&self, s: &Strand<'_>, count: usize, frame: &FrameData) {
         let fresh = s.state.load_vec4(2 * s.first)[3] == 0.0;
         if frame.sim_reset != 0 || fresh {
+            let margin = self.0.collision_margin * (1.0 / s.sim.scale);
             for v in 0..count {
-                s.store(v, s.world.transform_point3(s.rest_local(v)), Vec3::ZERO);
+                let x = s.world.transform_point3(s.rest_local(v));
+                s.store(v, x, Vec3::ZERO, s.threshold(v, margin));
             }
         }
         if !(frame.delta_time > 0.0) {
