@@ -251,7 +251,7 @@ fn keys(times: impl Iterator<Item = f32> + Clone) -> Result<(), String> {
     }
     let mut last = f32::NEG_INFINITY;
     for t in times {
-        if !(t.is_finite() && t >= 0.0 && t <= 1e6) {
+        if !(0.0..=1e6).contains(&t) {
             return Err(format!("key time {t} must be in 0..=1e6 seconds"));
         }
         if t <= last {
