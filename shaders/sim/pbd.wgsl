@@ -33,7 +33,7 @@ struct SimModel {
     _pad1: u32,
 }
 
-// position (w = 1 once written), velocity.
+// position (w = 1 once written), velocity (w: the collision threshold).
 struct SimVertex {
     position: vec4<f32>,
     velocity: vec4<f32>,
@@ -82,7 +82,7 @@ fn lerp(a: f32, b: f32, t: f32) -> f32 {
     return a + (b - a) * t;
 }
 
-// sdf::sample: distance and gradient; w = 0 outside the grid.
+// sdf::sample: distance and gradient; inside_grid is false off the grid.
 struct Field {
     distance: f32,
     gradient: vec3<f32>,
@@ -158,7 +158,7 @@ fn threshold(s: Strand, v: u32, margin: f32) -> f32 {
     return clamp(d, 0.0, margin);
 }
 
-// Strand::collide: w = 1 with the pushed position and normal when in contact.
+// Strand::collide: hit, with the pushed position and world normal, on contact.
 struct Contact {
     hit: bool,
     pushed: vec3<f32>,

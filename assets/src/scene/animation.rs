@@ -71,16 +71,6 @@ pub struct Pose {
 }
 
 impl Animation {
-    /// The time of the last key of any track (0 with no keys).
-    pub fn duration(&self) -> f32 {
-        let joints = self
-            .joints
-            .iter()
-            .flat_map(|j| j.keys.iter().map(|k| k.time));
-        let camera = self.camera.iter().map(|k| k.time);
-        joints.chain(camera).fold(0.0, f32::max)
-    }
-
     /// The pose at `time` seconds of the scene `desc` (whose meshes and camera
     /// are the rest pose). Joints naming no mesh of `desc` move nothing
     /// (`check` refuses them in scene files).

@@ -243,8 +243,8 @@ impl Strand<'_> {
     }
 }
 
-/// The pending vertex of the stream: its start and end of the substep,
-/// velocity after prediction and contact normal.
+/// The pending vertex of the stream: its position at the start and the end
+/// of the substep, its contact normal and collision threshold.
 struct Held {
     v: usize,
     x: Vec3,
