@@ -295,7 +295,7 @@ pub fn run(mut args: Args) -> Result<()> {
     }
     if !animated.is_empty() {
         report.note(format!(
-            "animated scenes run their animation at {FPS} fps from its start (simulation in motion) and have no FLIP: the references do not simulate"
+            "animated scenes run their animation at {FPS} fps from its start (simulation in motion); their FLIP is the mean over the timed frames, each against the reference's same frame, and their flicker compares frame-to-frame change with the reference's"
         ));
     }
     let first = prepared
@@ -355,20 +355,23 @@ pub fn run(mut args: Args) -> Result<()> {
                 };
                 let inputs = animated.get(&(s, v.graph)).map(Vec::as_slice);
                 match measure(backend, p, v, &args, cpu, atomics, inputs) {
-                    Ok((device, notes, mut stats, picture)) => {
+                    Ok((device, notes, mut stats, pictures)) => {
                         report.device(backend, &device, &notes);
-                        if let Some(img) = picture {
+                        if let Some(img) = pictures.last() {
                             let setup = quality::Setup {
                                 scene: &scenes[s],
                                 size,
                                 quick: args.quick,
                                 cpu,
+                                warmup: args.warmup,
+                                frames: args.frames,
                             };
                             let judged = references
-                                .judge(backend, s, &setup, v, &img)
+                                .judge(backend, s, &setup, v, &args.params, &pictures)
                                 .map_err(|e| miette!("{}: {}: {e}", v.pipeline, v.name))?;
-                            stats.flip = judged.as_ref().map(|j| j.diff.mean);
-                            stats.coverage_error = judged.as_ref().and_then(|j| j.coverage_error);
+                            if let Some(j) = &judged {
+                                stats.judged(j);
+                            }
                             if let Some(saver) = &mut saver {
                                 let saved = saver.save(
                                     backend,
@@ -422,11 +425,13 @@ pub fn run(mut args: Args) -> Result<()> {
 
 /// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
 /// and the frame times (CPU: wall time of the frame, its queues overlap;
-/// GPU: [`frame_millis`], timestamps only).
+/// GPU: [`frame_millis`], timestamps only). `after` sees the session after
+/// each timed frame (reading back is outside the timestamps).
 fn frames(
     session: &mut dyn Session,
     inputs: &[Upload],
     args: &Args,
+    mut after: impl FnMut(&dyn Session),
 ) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
     // Frame k runs inputs[k], the last one again once they run out.
     let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
@@ -444,6 +449,7 @@ fn frames(
             Clock::GpuTimestamps => frame_millis(&times),
         });
         passes.push(times);
+        after(&*session);
     }
     Ok((passes, totals))
 }
@@ -487,8 +493,9 @@ fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptio
 }
 
 /// One cell's timed frames: the device, its notes, the statistics, and
-/// the last frame's picture where its pipeline has a reference or
-/// `--pictures` asks for it.
+/// the pictures its quality is judged on where its pipeline has a
+/// reference or `--pictures` asks for them: the last frame's, or every
+/// timed frame's of an animated scene.
 fn measure(
     backend: Backend,
     p: &Prepared,
@@ -497,27 +504,39 @@ fn measure(
     cpu: CpuOptions,
     atomics: u64,
     animation: Option<&[Upload]>,
-) -> Result<(String, Vec<String>, Stats, Option<Picture>)> {
+) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     // A still scene: a game's frames at 60 fps, the simulation stepping.
     let still = [sequence::running(&p.upload, FPS)];
-    let (passes, totals) = frames(session.as_mut(), animation.unwrap_or(&still), args)?;
-    runner::check_frame(&plan, &p.instance, session.as_ref())?;
-    let stats = Stats::new(&passes, &totals, v.raster, atomics);
     // Read back only what a reference will be compared with, or
     // `--pictures` saves.
     let q = p.upload.quantities;
-    let judged = quality::reference_graph(v.pipeline).is_some() && animation.is_none();
-    let wanted = args.pictures || judged;
-    let picture = wanted
-        .then(|| {
-            main_picture(&plan, q.width, q.height, quality::DISPLAY, |name| {
-                session.read(name).ok().flatten()
-            })
-        })
-        .flatten();
-    Ok((session.device(), session.notes(), stats, picture))
+    let judged = quality::reference_graph(v.pipeline).is_some();
+    let every_frame = judged && animation.is_some();
+    let mut pictures = Vec::new();
+    let (passes, totals) = frames(session.as_mut(), animation.unwrap_or(&still), args, |s| {
+        if every_frame {
+            pictures.extend(picture(&plan, q, s));
+        }
+    })?;
+    runner::check_frame(&plan, &p.instance, session.as_ref())?;
+    let stats = Stats::new(&passes, &totals, v.raster, atomics);
+    if !every_frame && (args.pictures || judged) {
+        pictures.extend(picture(&plan, q, session.as_ref()));
+    }
+    Ok((session.device(), session.notes(), stats, pictures))
+}
+
+/// The main image of the frame `session` last ran, as the bench shows it.
+fn picture(
+    plan: &strandgraph_graph::Plan,
+    q: strandgraph_graph::Quantities,
+    session: &dyn Session,
+) -> Option<Picture> {
+    main_picture(plan, q.width, q.height, quality::DISPLAY, |name| {
+        session.read(name).ok().flatten()
+    })
 }
 
 /// What the roofline run gives one backend.
@@ -554,7 +573,7 @@ fn roofline(
     drop(counter);
 
     let mut session = runner::open(backend, &plan, &instance, cpu)?;
-    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args)?;
+    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args, |_| ())?;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()

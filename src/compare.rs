@@ -92,8 +92,76 @@ pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> Option<ImageDiff> {
     })
 }
 
+/// How a sequence changes from frame to frame against its reference: the
+/// artefacts a still image hides (flicker, popping, a filter's instability).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Temporal {
+    /// Flicker: the mean over pixels and consecutive frame pairs of
+    /// `|ΔY − ΔY_ref|`, `ΔY` a pixel's change of display luma (Rec. 709
+    /// weights on the encoded values, 0..1) from one frame to the next. 0
+    /// when the sequence changes exactly as the reference does, whatever
+    /// its error in each frame.
+    pub flicker: f32,
+    /// The reference's own change, the mean `|ΔY_ref|`: the scale of the
+    /// motion the flicker is measured against.
+    pub reference_motion: f32,
+}
+
+fn luma(p: &image::Rgba<u8>) -> f32 {
+    (0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])) / 255.0
+}
+
+/// [`Temporal`] of `frames` against `reference`, frame for frame; `None`
+/// for fewer than two frames, different counts or different sizes.
+pub fn temporal(frames: &[&RgbaImage], reference: &[&RgbaImage]) -> Option<Temporal> {
+    if frames.len() < 2 || frames.len() != reference.len() {
+        return None;
+    }
+    let size = frames[0].dimensions();
+    if frames.iter().chain(reference).any(|f| f.dimensions() != size) {
+        return None;
+    }
+    let (mut flicker, mut motion, mut n) = (0.0f64, 0.0f64, 0u64);
+    for (t, r) in frames.windows(2).zip(reference.windows(2)) {
+        let pixels = t[0].pixels().zip(t[1].pixels());
+        for ((a, b), (ra, rb)) in pixels.zip(r[0].pixels().zip(r[1].pixels())) {
+            let (change, reference_change) = (luma(b) - luma(a), luma(rb) - luma(ra));
+            flicker += f64::from((change - reference_change).abs());
+            motion += f64::from(reference_change.abs());
+            n += 1;
+        }
+    }
+    let n = n.max(1) as f64;
+    Some(Temporal {
+        flicker: (flicker / n) as f32,
+        reference_motion: (motion / n) as f32,
+    })
+}
+
 #[cfg(test)]
 mod tests {
+    use image::{Rgba, RgbaImage};
+
+    fn grey(v: u8) -> RgbaImage {
+        RgbaImage::from_pixel(4, 2, Rgba([v, v, v, 255]))
+    }
+
+    #[test]
+    fn temporal_measures_change_against_the_reference() {
+        let (a, b, c) = (grey(0), grey(51), grey(102));
+        // A constant error in every frame is no flicker.
+        let t = super::temporal(&[&b, &c], &[&a, &b]).unwrap();
+        assert!(t.flicker.abs() < 1e-6, "{t:?}");
+        assert!((t.reference_motion - 0.2).abs() < 1e-3, "{t:?}");
+        // Still where the reference moves, then jumping: 0.2 both times.
+        let t = super::temporal(&[&a, &a, &c], &[&a, &b, &c]).unwrap();
+        assert!((t.flicker - 0.2).abs() < 1e-3, "{t:?}");
+        assert!(super::temporal(&[&a], &[&a]).is_none());
+        assert!(super::temporal(&[&a, &b], &[&a]).is_none());
+        let small = RgbaImage::new(1, 1);
+        assert!(super::temporal(&[&a, &small], &[&a, &b]).is_none());
+    }
+
     #[test]
     fn flip_text_keeps_three_significant_digits() {
         assert_eq!(super::flip_text(0.031_73), "0.0317");

@@ -8,6 +8,7 @@ use miette::{IntoDiagnostic, Result, WrapErr};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use strandgraph::compare::Temporal;
 use strandgraph::runner::{Backend, PassTime};
 
 /// Median of `v` (mean of the middle two for an even count); NaN if empty.
@@ -59,10 +60,16 @@ pub struct Stats {
     pub raster_atomics: u64,
     /// Every frame's per-pass times (JSON only).
     pub per_frame: Vec<Vec<f64>>,
-    /// Mean FLIP of the last frame against the pipeline's reference.
+    /// Mean FLIP against the pipeline's reference: of the last frame, or
+    /// averaged over an animated scene's timed frames.
     pub flip: Option<f32>,
-    /// Its coverage error against the reference (compare::coverage_error).
+    /// Each judged frame's mean FLIP (one for a still scene).
+    pub flip_frames: Vec<f32>,
+    /// The last frame's coverage error against the reference
+    /// (compare::coverage_error).
     pub coverage_error: Option<f32>,
+    /// An animated scene's flicker against the reference's.
+    pub temporal: Option<Temporal>,
     /// Where `--pictures` saved the last frame, its FLIP map and reference.
     pub pictures: Option<Saved>,
 }
@@ -101,9 +108,19 @@ impl Stats {
                 .map(|f| f.iter().map(|t| t.millis.unwrap_or(f64::NAN)).collect())
                 .collect(),
             flip: None,
+            flip_frames: Vec::new(),
             coverage_error: None,
+            temporal: None,
             pictures: None,
         }
+    }
+
+    /// Takes the quality measures of `j`.
+    pub fn judged(&mut self, j: &quality::Judged) {
+        self.flip = Some(j.flip());
+        self.flip_frames = j.flip_frames.clone();
+        self.coverage_error = j.coverage_error;
+        self.temporal = j.temporal;
     }
 
     /// Raster atomics per second.
@@ -285,15 +302,33 @@ impl Report {
         }
         let mut o = self.metric_table(
             &with,
-            "Quality: mean FLIP of the last frame against the pipeline's reference (0 is identical; ACES, 0 EV)",
+            "Quality: mean FLIP of the last frame (of an animated scene: of every timed frame) against the pipeline's reference (0 is identical; ACES, 0 EV)",
             |st| st.flip,
         );
+        if rows
+            .iter()
+            .any(|(b, v)| (0..self.views.len()).any(|s| self.temporal_at(*b, v, s).is_some()))
+        {
+            o += &self.metric_table(
+                &with,
+                "Flicker: mean |frame-to-frame luma change - the reference's| (animated scenes; 0 changes as the reference does)",
+                |st| st.temporal.map(|t| t.flicker),
+            );
+        }
         o += &self.metric_table(
             &with,
             "Coverage error: mean |alpha - reference alpha| over the pixels with hair in either",
             |st| st.coverage_error,
         );
         o
+    }
+
+    /// The temporal measures of a cell, if it has them.
+    fn temporal_at(&self, b: Backend, v: &Variant, s: usize) -> Option<Temporal> {
+        match self.cell_at(b, v, s) {
+            Some(Cell::Measured(st)) => st.temporal,
+            _ => None,
+        }
     }
 
     /// One line per row of `metric` at every view (three significant digits).
@@ -524,8 +559,15 @@ impl Report {
                             j["flip"] = json!(f);
                             j["flip_reference"] = json!(quality::reference_graph(v.pipeline));
                         }
+                        if st.flip_frames.len() > 1 {
+                            j["flip_frames"] = json!(st.flip_frames);
+                        }
                         if let Some(e) = st.coverage_error {
                             j["coverage_error"] = json!(e);
+                        }
+                        if let Some(t) = st.temporal {
+                            j["flicker"] = json!(t.flicker);
+                            j["reference_motion"] = json!(t.reference_motion);
                         }
                         if let Some(p) = &st.pictures {
                             j["picture"] = json!(p.picture);
