@@ -82,6 +82,11 @@ pub struct Cell {
     /// Mean |alpha − reference alpha| over the pixels with hair in either
     /// (compare::coverage_error).
     pub coverage_error: Option<f64>,
+    /// An animated scene's mean FLIP per timed frame (`flip` is their mean).
+    #[serde(default)]
+    pub flip_frames: Vec<f64>,
+    /// An animated scene's flicker against its reference (compare::Temporal).
+    pub flicker: Option<f64>,
     #[serde(default)]
     pub passes: Vec<Pass>,
     pub picture: Option<String>,

@@ -235,9 +235,17 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
             .fold(f64::INFINITY, f64::min)
     };
     let (best_ms, best_flip) = (best(Cell::ms), best(|c| c.flip));
-    let mut o = String::from(
+    // Animated scenes add their flicker (compare::Temporal).
+    let temporal = s.cells.iter().any(|c| c.flicker.is_some());
+    let best_flicker = best(|c| c.flicker);
+    let mut o = format!(
         "<table class=\"rows\"><thead><tr><th>row</th><th>frame ms</th><th>min–max</th>\
-         <th>raster ms</th><th>FLIP</th><th>coverage err.</th><th title=\"on the Pareto frontier of the rows judged against the same reference\">◆</th></tr></thead><tbody>",
+         <th>raster ms</th><th>FLIP</th><th>coverage err.</th>{}<th title=\"on the Pareto frontier of the rows judged against the same reference\">◆</th></tr></thead><tbody>",
+        if temporal {
+            "<th title=\"mean |frame-to-frame luma change − the reference's|\">flicker</th>"
+        } else {
+            ""
+        }
     );
     for (i, c) in s.cells.iter().enumerate() {
         let colour = charts::pipeline_css(pipes.iter().position(|p| *p == c.pipeline).unwrap_or(0));
@@ -248,7 +256,8 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
         if let Some(why) = &c.skipped {
             let _ = write!(
                 o,
-                "<tr>{label}<td class=\"skip\" colspan=\"6\">skipped: {}</td></tr>",
+                "<tr>{label}<td class=\"skip\" colspan=\"{}\">skipped: {}</td></tr>",
+                6 + usize::from(temporal),
                 esc(why)
             );
             continue;
@@ -262,7 +271,7 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
         let raster = c.raster.as_ref().and_then(|r| r.median_ms);
         let _ = write!(
             o,
-            "<tr data-row=\"{i}\">{label}{}{}{}{}{}<td class=\"front\">{}</td></tr>",
+            "<tr data-row=\"{i}\">{label}{}{}{}{}{}{}<td class=\"front\">{}</td></tr>",
             num(c.ms(), ms, best_ms),
             spread.map_or("<td class=\"na\">—</td>".into(), |(a, b)| format!(
                 "<td class=\"num\">{}–{}</td>",
@@ -270,13 +279,32 @@ fn table(s: &Section<'_>, pipes: &[&str], fronts: &[Option<bool>]) -> String {
                 ms(b)
             )),
             num(raster, ms, f64::NAN),
-            num(c.flip, flip, best_flip),
+            flip_cell(num(c.flip, flip, best_flip), &c.flip_frames),
             num(c.coverage_error, |f| format!("{f:.4}"), f64::NAN),
+            if temporal {
+                num(c.flicker, flip, best_flicker)
+            } else {
+                String::new()
+            },
             if fronts[i] == Some(true) { "◆" } else { "" }
         );
     }
     o.push_str("</tbody></table>");
     o
+}
+
+/// `cell` (a FLIP) with an animated scene's per-frame values on hover.
+fn flip_cell(cell: String, frames: &[f64]) -> String {
+    if frames.len() < 2 {
+        return cell;
+    }
+    let each: Vec<String> = frames.iter().map(|&f| flip(f)).collect();
+    let title = format!(
+        " title=\"mean of {} frames: {}\"",
+        frames.len(),
+        each.join(" ")
+    );
+    cell.replacen("<td", &format!("<td{title}"), 1)
 }
 
 /// Each distinct reference once (pipelines sharing a reference graph
