@@ -573,7 +573,12 @@ fn roofline(
     drop(counter);
 
     let mut session = runner::open(backend, &plan, &instance, cpu)?;
-    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args, |_| ())?;
+    let (passes, _) = frames(
+        session.as_mut(),
+        std::slice::from_ref(&upload),
+        args,
+        |_| (),
+    )?;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()

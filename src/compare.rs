@@ -118,7 +118,11 @@ pub fn temporal(frames: &[&RgbaImage], reference: &[&RgbaImage]) -> Option<Tempo
         return None;
     }
     let size = frames[0].dimensions();
-    if frames.iter().chain(reference).any(|f| f.dimensions() != size) {
+    if frames
+        .iter()
+        .chain(reference)
+        .any(|f| f.dimensions() != size)
+    {
         return None;
     }
     let (mut flicker, mut motion, mut n) = (0.0f64, 0.0f64, 0u64);

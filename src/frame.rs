@@ -100,11 +100,20 @@ pub fn complete_upload(plan: &Plan, scene: &Scene, up: &mut Upload) -> Result<Op
 
 /// The simulation's inputs (`strandgraph_passes::sim::upload`), for a graph
 /// that imports them: the grooms' head collision fields, baked here, and
-/// their rest pose. Does nothing when the upload already holds them.
+/// their rest pose; and for a graph that simulates hair meshes, their
+/// bundle chains (`sim::chains`). Does nothing when the upload already
+/// holds them.
 fn pack_simulation(plan: &Plan, scene: &Scene, up: &mut Upload) {
-    use strandgraph_passes::sim::upload::{SDF, pack};
-    if plan.graph.resource_id(SDF).is_some() && !up.resources.contains_key(SDF) {
-        pack(scene, up);
+    use strandgraph_passes::sim::{chains, upload as sim};
+    let imports = |name: &str| plan.graph.resource_id(name).is_some();
+    if imports(sim::SDF) && !up.resources.contains_key(sim::SDF) {
+        sim::pack(scene, up);
+        if !imports(sim::REST) {
+            up.resources.remove(sim::REST);
+        }
+    }
+    if imports(chains::CHAINS) && !up.resources.contains_key(chains::CHAINS) {
+        chains::pack(scene, up);
     }
 }
 

@@ -1,7 +1,9 @@
 //! The simulation across backends and pipelines, on `scenes/animated.ron`:
 //!
 //! - the CPU simulator, wgpu and ash agree on the simulated positions after
-//!   a short horizon of a fast head turn (the bound is below, with why);
+//!   a short horizon of a fast head turn (the bound is below, with why), for
+//!   Kulikov's strands and for Lipp's bundle chains;
+//! - Lipp's hair-mesh layers follow the simulated chains;
 //! - the scene renders as a sequence (`render --frames`) on every pipeline.
 
 mod common;
@@ -17,12 +19,39 @@ use strandgraph_passes::sim::SimVertex;
 const FRAMES: u32 = 8;
 const FPS: f32 = 30.0;
 
-/// Simulated world positions after `FRAMES` frames on `backend`.
-fn positions(backend: Backend) -> Vec<[f32; 3]> {
-    let scene = root().join("scenes/animated.ron");
+/// What a pipeline simulates: its graph, the overrides that skip what
+/// does not matter here, and the solver's state.
+struct Simulated {
+    graph: &'static str,
+    overrides: &'static [&'static str],
+    state: &'static str,
+}
+
+const KULIKOV: Simulated = Simulated {
+    graph: "scenes/graphs/kulikov.ron",
     // Shading does not matter here: no self-shadowing bake.
-    let overrides = ["shade.self_shadow=\"None\"".to_string()];
-    let mut p = prepare_with(&scene, None, Some((160, 90)), &overrides).unwrap();
+    overrides: &["shade.self_shadow=\"None\""],
+    state: "sim.state",
+};
+
+const LIPP: Simulated = Simulated {
+    graph: "scenes/graphs/lipp.ron",
+    overrides: &[],
+    state: "sim.chain_state",
+};
+
+/// `resource` after `FRAMES` frames of `sim` on `backend`, with `extra`
+/// overrides.
+fn after_frames(sim: &Simulated, backend: Backend, extra: &[&str], resource: &str) -> Vec<u32> {
+    let scene = root().join("scenes/animated.ron");
+    let overrides: Vec<String> = sim
+        .overrides
+        .iter()
+        .chain(extra)
+        .map(|s| s.to_string())
+        .collect();
+    let graph = root().join(sim.graph);
+    let mut p = prepare_with(&scene, Some(&graph), Some((160, 90)), &overrides).unwrap();
     let options = CpuOptions {
         alias: false,
         ..CpuOptions::default()
@@ -37,10 +66,15 @@ fn positions(backend: Backend) -> Vec<[f32; 3]> {
         let up = frame_upload(&mut p, k, FPS).unwrap();
         session.run(&up).unwrap();
     }
-    let words = session
-        .read("sim.state")
+    session
+        .read(resource)
         .unwrap()
-        .expect("sim.state is kept");
+        .unwrap_or_else(|| panic!("{resource} is kept"))
+}
+
+/// Simulated world positions after `FRAMES` frames of `sim` on `backend`.
+fn positions(sim: &Simulated, backend: Backend) -> Vec<[f32; 3]> {
+    let words = after_frames(sim, backend, &[], sim.state);
     let state: Vec<SimVertex> = bytemuck::pod_collect_to_vec(&words);
     state
         .iter()
@@ -63,12 +97,21 @@ const WORST_M: f32 = 1e-2;
 
 #[test]
 fn gpu_backends_agree_with_the_cpu_after_a_head_turn() {
-    let cpu = positions(Backend::Cpu);
+    agree(&KULIKOV);
+}
+
+#[test]
+fn gpu_backends_agree_with_the_cpu_on_lipps_bundles() {
+    agree(&LIPP);
+}
+
+fn agree(sim: &Simulated) {
+    let cpu = positions(sim, Backend::Cpu);
     let moved = cpu.iter().any(|p| p.iter().any(|v| *v != 0.0));
-    assert!(moved, "the CPU simulated nothing");
+    assert!(moved, "{}: the CPU simulated nothing", sim.graph);
     let mut failures = Vec::new();
     for backend in [Backend::Wgpu, Backend::Ash] {
-        let gpu = positions(backend);
+        let gpu = positions(sim, backend);
         assert_eq!(gpu.len(), cpu.len());
         let mut d: Vec<f32> = cpu
             .iter()
@@ -81,7 +124,8 @@ fn gpu_backends_agree_with_the_cpu_after_a_head_turn() {
         let worst = d[d.len() - 1];
         let p999 = d[(d.len() as f64 * 0.999) as usize];
         eprintln!(
-            "{}: {:.3}% identical, {:.3}% within {CLOSE_M} m, 99.9th percentile {p999:e} m, worst {worst:e} m",
+            "{} {}: {:.3}% identical, {:.3}% within {CLOSE_M} m, 99.9th percentile {p999:e} m, worst {worst:e} m",
+            sim.graph,
             backend.name(),
             100.0 * exact,
             100.0 * close
@@ -91,6 +135,54 @@ fn gpu_backends_agree_with_the_cpu_after_a_head_turn() {
         }
     }
     assert!(failures.is_empty(), "outside the bound: {failures:?}");
+}
+
+/// Lipp's layers after the head turn, simulated and carried rigidly: the
+/// simulated bundles lag by centimetres, and (the follow pass turning
+/// nothing at rest) the rigid ones are where the upload puts them.
+#[test]
+fn lipps_layers_follow_the_simulated_bundles() {
+    let layers = |models: &str| -> Vec<f32> {
+        let words = after_frames(
+            &LIPP,
+            Backend::Cpu,
+            &[&format!("simulate.models=\"{models}\"")],
+            "hairmesh.layers",
+        );
+        words.iter().map(|w| f32::from_bits(*w)).collect()
+    };
+    let (simulated, rigid) = (layers("Flagged"), layers("None"));
+    // The upload of the last frame: every layer carried by the head joint.
+    let scene = root().join("scenes/animated.ron");
+    let graph = root().join(LIPP.graph);
+    let mut p = prepare_with(&scene, Some(&graph), Some((160, 90)), &[]).unwrap();
+    let up = frame_upload(&mut p, FRAMES - 1, FPS).unwrap();
+    let carried: Vec<f32> = up.resources["hairmesh.layers"]
+        .iter()
+        .map(|w| f32::from_bits(*w))
+        .collect();
+    // Words 0-2 of each 8-word corner are its position, 4-6 its tangent.
+    let largest = |a: &[f32], b: &[f32], first: usize| {
+        a.chunks(8)
+            .zip(b.chunks(8))
+            .map(|(x, y)| {
+                (first..first + 3)
+                    .map(|k| (x[k] - y[k]).abs())
+                    .fold(0.0, f32::max)
+            })
+            .fold(0.0, f32::max)
+    };
+    let (rigid_moved, rigid_turned) = (largest(&rigid, &carried, 0), largest(&rigid, &carried, 4));
+    let lag = largest(&simulated, &carried, 0);
+    eprintln!(
+        "rigid: {rigid_moved:e} m, tangents {rigid_turned:e}; simulated lag {:.1} mm",
+        lag * 1e3
+    );
+    assert!(
+        rigid_moved < 1e-5 && rigid_turned < 1e-4,
+        "a rigid layer moved: {rigid_moved} m, {rigid_turned}"
+    );
+    assert!(lag > 0.01, "the simulated bundles lag only {lag} m");
 }
 
 #[test]

@@ -55,6 +55,8 @@ pub static PASSES: &[&dyn PassDef] = &[
     &opaque_mesh::depth_attachment::DEPTH_ATTACHMENT,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
     &sim::pbd::PBD,
+    &sim::pbd::PBD_CHAINS,
+    &sim::follow::FOLLOW,
     &kulikov::lod::LOD,
     &kulikov::skin::SKIN,
     &kulikov::density::DENSITY,

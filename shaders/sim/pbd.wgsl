@@ -29,8 +29,9 @@ struct SimModel {
     sdf_min: vec4<f32>,
     scale: f32,
     flags: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // The groom's strands in this pass's numbering (groom_strands).
+    strand_first: u32,
+    strand_count: u32,
 }
 
 // position (w = 1 once written), velocity (w: the collision threshold).
@@ -155,7 +156,7 @@ fn threshold(s: Strand, v: u32, margin: f32) -> f32 {
     if f.inside_grid {
         d = f.distance;
     }
-    return clamp(d, 0.0, margin);
+    return min(d, margin);
 }
 
 // Strand::collide: hit, with the pushed position and world normal, on contact.
@@ -227,7 +228,7 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
             contact = true;
             normal = c.normal;
         }
-        let last = collide(s, fixed, 0.0, 1.0);
+        let last = collide(s, fixed, min(limit, 0.0), 1.0);
         if last.hit {
             fixed = last.pushed;
             contact = true;
@@ -277,7 +278,7 @@ fn pbd(@builtin(global_invocation_id) gid: vec3<u32>) {
         if m >= frame.model_count {
             return;
         }
-        let d = models[m];
+        let d = sim_models[m];
         if g >= d.strand_first && g < d.strand_first + d.strand_count {
             break;
         }

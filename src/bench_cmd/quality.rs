@@ -173,7 +173,12 @@ impl References {
 /// `graph` on `backend` with the simulation overrides `sim`, as pictures:
 /// one frame of a still scene; the row's frames of an animated one, a
 /// picture of each timed frame.
-fn render(backend: Backend, setup: &Setup<'_>, graph: &str, sim: &[String]) -> Result<Vec<Picture>> {
+fn render(
+    backend: Backend,
+    setup: &Setup<'_>,
+    graph: &str,
+    sim: &[String],
+) -> Result<Vec<Picture>> {
     let mut p = prepare_graph(setup.scene, &super::locate(graph), setup.size, setup.quick)?;
     for spec in sim {
         override_param(&mut p.plan, spec)?;

@@ -16,11 +16,18 @@
 //!   `kulikov.skin` runs root skinning on them as before and the grooms it
 //!   does not simulate cost nothing; the density grid (`kulikov.density`) is
 //!   splatted from the skinned, so simulated, positions.
+//! - [`chains`] and [`follow`]: Lipp's hair meshes simulated by the same
+//!   solver: each bundle's four corner chains (its layers' corners, root to
+//!   tip) are strands to `sim.pbd_chains`, and `sim.follow_layers` writes
+//!   the simulated corners and their turned tangents into
+//!   `hairmesh.layers`, so the strands generated from the bundles follow.
 //! - [`sdf`]: the field's sampling, shared by the solver and its tests.
 //! - [`upload`]: `sim.models` (per groom: whether it is simulated, the
 //!   inverse joint, rest gravity, the field's placement), `sim.sdf` (the
 //!   baked fields) and `sim.rest`.
 
+pub mod chains;
+pub mod follow;
 pub mod pbd;
 pub mod sdf;
 pub mod upload;
@@ -51,7 +58,11 @@ pub struct SimModel {
     pub scale: f32,
     /// [`SIM_SIMULATE`] | [`SIM_COLLIDER`].
     pub flags: u32,
-    pub _pad: [u32; 2],
+    /// The strands of this groom in the numbering of the solver's
+    /// `groom.strands`: the groom's strands for Kulikov's graph, its hair
+    /// mesh's corner chains for Lipp's ([`chains`]).
+    pub strand_first: u32,
+    pub strand_count: u32,
 }
 
 /// `sim.state`: one record per vertex, kept between frames.

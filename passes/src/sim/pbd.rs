@@ -12,7 +12,8 @@
 //! 4. head collision: a vertex nearer the head's SDF than it was at rest (or
 //!    than `collision_margin`) is pushed out along the gradient and put back
 //!    on the FTL sphere, up to four times, each push longer; one still inside the head after
-//!    that is pushed to its surface, giving up a little length (Kulikov:
+//!    that is pushed to its surface (or its rest depth, for one inside at
+//!    rest), giving up a little length (Kulikov:
 //!    "Prebuilt SDFs for head collisions");
 //! 5. velocity with Müller's damping correction (§4.2, Eq. 9):
 //!    `v_i = (p_i − x_i) / Δt − s_damping d_{i+1} / Δt`, `d` the correction
@@ -26,6 +27,7 @@
 //! `g (down − R_joint · down_rest)`: a still head keeps its groom exactly,
 //! a tilted one swings it. Off, full gravity pulls the style down.
 
+use super::chains::CORNERS;
 use super::sdf::{FIELD_WORDS, sample};
 use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -125,28 +127,22 @@ crate::gpu_block! {
     }
 }
 
-pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
-    kind: "sim.pbd",
-    summary: "PBD hair: dynamic follow-the-leader with damping correction, gravity, head joint, SDF collisions, friction",
-    source: "Kulikov 2025, 'Simulation'; Müller et al. 2012",
-    bindings: Some(&[
-        Binding::read("frame"),
-        Binding::read("models"),
-        Binding::read("sim.models"),
-        Binding::read("sim.sdf"),
-        Binding::read("sim.rest"),
-        Binding::read("groom.strands"),
-        Binding::write("sim.state"),
-        Binding::write("groom.vertices"),
-    ]),
-    workgroup_size: GROUP,
-    dispatch: Dispatch::PerElement {
-        quantity: Quantity::Strands,
-        per_group: GROUP,
-    },
-    shader: Shader::compute("sim/pbd.wgsl", "pbd"),
-    kernel: |p| Box::new(PbdKernel(*p)),
-    gpu: |p, q| PbdGpu {
+/// What the solver binds, under the names of Kulikov's graph; Lipp's binds
+/// its chains' buffers under them (`as`).
+const BINDINGS: &[Binding] = &[
+    Binding::read("frame"),
+    Binding::read("models"),
+    Binding::read("sim.models"),
+    Binding::read("sim.sdf"),
+    Binding::read("sim.rest"),
+    Binding::read("groom.strands"),
+    Binding::write("sim.state"),
+    Binding::write("groom.vertices"),
+];
+
+/// The uniform block for `strands` strands.
+fn gpu(p: &PbdParams, strands: u32) -> PbdGpu {
+    PbdGpu {
         models: p.models as u32,
         substeps: p.substeps,
         gravity: p.gravity,
@@ -156,9 +152,43 @@ pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
         shape_stiffness: p.shape_stiffness,
         collision_margin: p.collision_margin,
         friction: p.friction,
-        strands: count(q.strands),
+        strands,
         ..PbdGpu::default()
+    }
+}
+
+pub static PBD: PassKind<PbdParams, PbdGpu> = PassKind {
+    kind: "sim.pbd",
+    summary: "PBD hair: dynamic follow-the-leader with damping correction, gravity, head joint, SDF collisions, friction",
+    source: "Kulikov 2025, 'Simulation'; Müller et al. 2012",
+    bindings: Some(BINDINGS),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Strands,
+        per_group: GROUP,
     },
+    shader: Shader::compute("sim/pbd.wgsl", "pbd"),
+    kernel: |p| Box::new(PbdKernel(*p)),
+    gpu: |p, q| gpu(p, count(q.strands)),
+    raster: None,
+};
+
+/// The same solver on Lipp's hair meshes: its strands are the bundles'
+/// corner chains ([`super::chains`]), four per bundle, so a dispatch
+/// covers bundles rather than strands.
+pub static PBD_CHAINS: PassKind<PbdParams, PbdGpu> = PassKind {
+    kind: "sim.pbd_chains",
+    summary: "sim.pbd on hair-mesh bundles: each bundle's four corner chains simulated as strands",
+    source: "Kulikov 2025, 'Simulation'; Müller et al. 2012; Lipp et al. §2 (bundle layers)",
+    bindings: Some(BINDINGS),
+    workgroup_size: GROUP,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Bundles,
+        per_group: GROUP / CORNERS,
+    },
+    shader: Shader::compute("sim/pbd.wgsl", "pbd"),
+    kernel: |p| Box::new(PbdKernel(*p)),
+    gpu: |p, q| gpu(p, CORNERS * count(q.bundles)),
     raster: None,
 };
 
@@ -233,13 +263,15 @@ impl Strand<'_> {
         Some((pushed, normalize(self.world.transform_vector3(n))))
     }
 
-    /// How near the head vertex `v` may come: its distance at rest, between
-    /// 0 and `margin` (local units). Computed when the state starts and
-    /// kept in its velocity's w, as it never changes.
+    /// How near the head vertex `v` may come: its distance at rest, at most
+    /// `margin` (local units); negative for a vertex inside the head at rest
+    /// (a hair mesh's corner near the scalp), which may stay as deep.
+    /// Computed when the state starts and kept in its velocity's w, as it
+    /// never changes.
     fn threshold(&self, v: usize, margin: f32) -> f32 {
         self.field(self.rest_local(v))
             .map_or(0.0, |(d, _)| d)
-            .clamp(0.0, margin)
+            .min(margin)
     }
 }
 
@@ -303,7 +335,7 @@ impl PbdKernel {
                 fixed = ftl(pushed);
                 contact = Some(n);
             }
-            if let Some((pushed, n)) = s.collide(fixed, 0.0, 1.0) {
+            if let Some((pushed, n)) = s.collide(fixed, limit.min(0.0), 1.0) {
                 fixed = pushed;
                 contact = Some(n);
             }
@@ -341,15 +373,16 @@ impl CpuKernel for PbdKernel {
             if g >= total {
                 break;
             }
-            let Some((m, model)) = (0..frame.model_count as usize)
-                .map(|m| (m, read::<ModelData>(&models, m)))
+            // The groom whose range (in this pass's strand numbering) holds g.
+            let Some((m, sim)) = (0..frame.model_count as usize)
+                .map(|m| (m, read::<SimModel>(&sims, m)))
                 .find(|(_, d)| {
                     g >= d.strand_first as usize && g < (d.strand_first + d.strand_count) as usize
                 })
             else {
                 continue;
             };
-            let sim: SimModel = read(&sims, m);
+            let model: ModelData = read(&models, m);
             let simulated = match self.0.models {
                 Simulated::Flagged => sim.flags & SIM_SIMULATE != 0,
                 Simulated::All => true,

@@ -82,13 +82,18 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
             if placement[i].is_some() {
                 flags |= SIM_COLLIDER;
             }
+            let strands = up
+                .models
+                .get(i)
+                .map_or((0, 0), |m| (m.strand_first, m.strand_count));
             SimModel {
                 inv_world: Mat4::IDENTITY.to_cols_array(),
                 rest_down: [rest_down.x, rest_down.y, rest_down.z, 0.0],
                 sdf_min: placement[i].unwrap_or([0.0; 4]),
                 scale: 1.0,
                 flags,
-                _pad: [0; 2],
+                strand_first: strands.0,
+                strand_count: strands.1,
             }
         })
         .collect();
