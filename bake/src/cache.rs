@@ -2,20 +2,16 @@
 //! everything the result depends on (packed vertices and strands, head
 //! triangles, settings, [`FORMAT_VERSION`]).
 //!
-//! File layout (little endian): magic `SGSHBAKE`, format version (u32),
-//! vertex count (u64), the 32-byte key, `count × 4` f32 coefficients, and a
-//! BLAKE3 checksum of those coefficients. A file is only trusted if its size
-//! is exactly what the expected vertex count implies (nothing is allocated
-//! from its header) and every field matches; anything else is logged as an
+//! Files are [`crate::blob`]s (magic `SGSHBAKE`, one item of four f32
+//! coefficients per vertex); one that cannot be trusted is logged as an
 //! error and baked again.
 
+use crate::blob::Kind;
+
 use crate::{BakeError, BakeInput, BakeSettings, FORMAT_VERSION, ShadowSh, bake};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8; 8] = b"SGSHBAKE";
-const HEADER: usize = 8 + 4 + 8 + 32;
-const CHECKSUM: usize = 32;
 
 /// Whether [`bake_cached`] had to bake.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,97 +76,34 @@ pub fn key(input: &BakeInput<'_>, settings: &BakeSettings) -> [u8; 32] {
     *h.finalize().as_bytes()
 }
 
-fn hex(key: &[u8; 32]) -> String {
-    key.iter().map(|b| format!("{b:02x}")).collect()
-}
+/// The self-shadowing bake's files ([`crate::blob`]): items are vertices
+/// of four SH coefficients.
+const FILES: Kind = Kind {
+    magic: MAGIC,
+    version: FORMAT_VERSION,
+    name: "shadow_sh",
+};
 
 /// The file a bake with `key` lives in under `dir`.
 pub fn path(dir: &Path, key: &[u8; 32]) -> PathBuf {
-    dir.join(format!("shadow_sh-{}.bin", hex(key)))
+    FILES.path(dir, key)
 }
 
 /// Reads a bake of `count` vertices: `Ok(None)` if there is none, `Err`
 /// saying what is wrong with a file that is there but unusable.
 pub fn read(path: &Path, key: &[u8; 32], count: usize) -> Result<Option<Vec<ShadowSh>>, String> {
-    let expected = count
-        .checked_mul(16)
-        .and_then(|b| b.checked_add(HEADER + CHECKSUM))
-        .ok_or_else(|| format!("{count} vertices do not fit a cache file"))?;
-    let len = match std::fs::metadata(path) {
-        Ok(m) => m.len(),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(e.to_string()),
-    };
-    if len != expected as u64 {
-        return Err(format!(
-            "{len} bytes, expected {expected} (truncated or foreign)"
-        ));
-    }
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    if bytes.len() != expected {
-        return Err(format!("{} bytes read, expected {expected}", bytes.len()));
-    }
-    let (header, rest) = bytes.split_at(HEADER);
-    let (payload, checksum) = rest.split_at(count * 16);
-    if &header[..8] != MAGIC {
-        return Err("not a strandgraph shadow_sh bake (bad magic)".into());
-    }
-    let version = u32::from_le_bytes(header[8..12].try_into().unwrap_or_default());
-    if version != FORMAT_VERSION {
-        return Err(format!(
-            "format version {version}, expected {FORMAT_VERSION}"
-        ));
-    }
-    let n = u64::from_le_bytes(header[12..20].try_into().unwrap_or_default());
-    if n != count as u64 {
-        return Err(format!("{n} vertices, expected {count}"));
-    }
-    if &header[20..52] != key {
-        return Err("key does not match its file name".into());
-    }
-    if blake3::hash(payload).as_bytes() != checksum {
-        return Err("checksum mismatch (corrupt)".into());
-    }
-    Ok(Some(
-        payload
-            .chunks_exact(16)
-            .map(|c| {
-                std::array::from_fn(|i| {
-                    f32::from_le_bytes([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]])
-                })
-            })
-            .collect(),
-    ))
+    Ok(FILES.read(path, key, count, 4)?.map(|floats| {
+        floats
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect()
+    }))
 }
 
-/// Writes a bake atomically (a temporary file renamed into place), so a
-/// reader never sees half a file, even with two bakes racing.
+/// Writes a bake atomically ([`Kind::write`]).
 pub fn write(path: &Path, key: &[u8; 32], sh: &[ShadowSh]) -> std::io::Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
-    let mut payload = Vec::with_capacity(sh.len() * 16);
-    for c in sh.iter().flatten() {
-        payload.extend_from_slice(&c.to_le_bytes());
-    }
-    let mut bytes = Vec::with_capacity(HEADER + payload.len() + CHECKSUM);
-    bytes.extend_from_slice(MAGIC);
-    bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    bytes.extend_from_slice(&(sh.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(key);
-    bytes.extend_from_slice(&payload);
-    bytes.extend_from_slice(blake3::hash(&payload).as_bytes());
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        path.file_name().and_then(|n| n.to_str()).unwrap_or("bake"),
-        std::process::id()
-    ));
-    let mut f = std::fs::File::create(&tmp)?;
-    f.write_all(&bytes)?;
-    f.sync_all()?;
-    drop(f);
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
+    let floats: Vec<f32> = sh.iter().flatten().copied().collect();
+    FILES.write(path, key, sh.len(), &floats)
 }
 
 /// The bake of `input`, from `dir` if it holds one, else baked and stored

@@ -19,6 +19,7 @@
 //! `visibility = exp(-absorption * max(0, SH · light direction))`.
 
 pub mod bake;
+pub mod blob;
 pub mod bvh;
 pub mod cache;
 pub mod intersect;

@@ -54,6 +54,8 @@ pub static PASSES: &[&dyn PassDef] = &[
     &opaque_mesh::opaque::OPAQUE,
     &opaque_mesh::depth_attachment::DEPTH_ATTACHMENT,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.
+    &sim::grid::SPLAT,
+    &sim::grid::SPLAT_CHAINS,
     &sim::pbd::PBD,
     &sim::pbd::PBD_CHAINS,
     &sim::follow::FOLLOW,

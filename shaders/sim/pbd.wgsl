@@ -17,8 +17,8 @@ struct PbdParams {
     collision_margin: f32,
     friction: f32,
     strands: u32,
+    hair_friction: f32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 // passes/src/sim/mod.rs: SimModel.
@@ -32,6 +32,8 @@ struct SimModel {
     // The groom's strands in this pass's numbering (groom_strands).
     strand_first: u32,
     strand_count: u32,
+    // The velocity grid's corner (groom local) and cells per unit (w).
+    grid_min: vec4<f32>,
 }
 
 // position (w = 1 once written), velocity (w: the collision threshold).
@@ -51,6 +53,8 @@ struct SimVertex {
 @group(0) @binding(7) var<storage, read_write> sim_state: array<SimVertex>;
 // Simulated strands' local positions go here; the others keep their rest pose.
 @group(0) @binding(8) var<storage, read_write> groom_vertices: array<vec4<f32>>;
+// Per groom, RES^3 cells of (sum of velocity x, y, z as fixed point, count).
+@group(0) @binding(9) var<storage, read> sim_grid: array<u32>;
 
 const GROUP: u32 = 64u;
 const SDF_RES: u32 = 40u;
@@ -58,6 +62,9 @@ const FIELD_WORDS: u32 = 64000u;
 const SIM_SIMULATE: u32 = 1u;
 const SIM_COLLIDER: u32 = 2u;
 const COLLISION_PASSES: u32 = 4u;
+const GRID_RES: u32 = 32u;
+const GRID_WORDS: u32 = 131072u;
+const VELOCITY_SCALE: f32 = 4096.0;
 
 fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
@@ -128,6 +135,47 @@ fn sample_field(m: u32, q: vec3<f32>) -> Field {
     let ex1 = lerp(c101 - c001, c111 - c011, t.y);
     out.gradient = vec3<f32>(lerp(ex0, ex1, t.z), lerp(x10 - x00, x11 - x01, t.z), y1 - y0);
     out.inside_grid = true;
+    return out;
+}
+
+// grid::sample: the velocity grid's average about groom-local q.
+struct Flow {
+    found: bool,
+    velocity: vec3<f32>,
+}
+
+fn grid_word(i: u32) -> f32 {
+    return f32(bitcast<i32>(sim_grid[i]));
+}
+
+fn sample_flow(m: u32, q: vec3<f32>) -> Flow {
+    var out: Flow;
+    out.found = false;
+    let placement = sim_models[m].grid_min;
+    let f = (q - placement.xyz) * placement.w;
+    let last = f32(GRID_RES);
+    if !(f.x >= 0.0 && f.x < last && f.y >= 0.0 && f.y < last && f.z >= 0.0 && f.z < last) {
+        return out;
+    }
+    let g = clamp(f - vec3<f32>(0.5), vec3<f32>(0.0), vec3<f32>(last - 1.0));
+    let fi = min(floor(g), vec3<f32>(last - 2.0));
+    let t = g - fi;
+    let i = vec3<u32>(fi);
+    var velocity = vec3<f32>(0.0);
+    var weight = 0.0;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let dx = corner & 1u;
+        let dy = (corner >> 1u) & 1u;
+        let dz = corner >> 2u;
+        let w = select(1.0 - t.x, t.x, dx == 1u) * select(1.0 - t.y, t.y, dy == 1u) * select(1.0 - t.z, t.z, dz == 1u);
+        let c = m * GRID_WORDS + 4u * (i.x + dx + GRID_RES * (i.y + dy + GRID_RES * (i.z + dz)));
+        velocity = velocity + vec3<f32>(grid_word(c), grid_word(c + 1u), grid_word(c + 2u)) * w;
+        weight = weight + f32(sim_grid[c + 3u]) * w;
+    }
+    if weight > 0.0 {
+        out.found = true;
+        out.velocity = velocity * (1.0 / (weight * VELOCITY_SCALE));
+    }
     return out;
 }
 
@@ -209,7 +257,14 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
     for (var v = 1u; v < count; v++) {
         let state = sim_state[s.first + v];
         let x = state.position.xyz;
-        let u = state.velocity.xyz + accel * dt;
+        var u = state.velocity.xyz + accel * dt;
+        // Hair-hair friction (Petrovic et al. 2005, §3).
+        if params.hair_friction > 0.0 {
+            let flow = sample_flow(s.model, point(s.inv_world, x));
+            if flow.found {
+                u = u + (flow.velocity - u) * params.hair_friction;
+            }
+        }
         var q = x + u * dt;
         let rest_now = point(s.world, rest_local(s, v));
         q = q + (rest_now - q) * params.shape_stiffness;

@@ -42,6 +42,15 @@ pub const VARIANTS: &[Variant] = &[
     },
     Variant {
         pipeline: "Kulikov",
+        // Ours: Petrovic 2005's velocity-grid friction switched off.
+        name: "simulating every groom, no hair-hair friction",
+        graph: KULIKOV,
+        overrides: &["simulate.models=\"All\"", "simulate.hair_friction=0.0"],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+    },
+    Variant {
+        pipeline: "Kulikov",
         name: "no loop flattening",
         graph: KULIKOV,
         overrides: &["raster.loop_flattening=false"],
@@ -224,6 +233,15 @@ pub const VARIANTS: &[Variant] = &[
         name: "SWR 1+F+L (as published)",
         graph: LIPP,
         overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    // Every groom's bundles simulated (sim.pbd_chains, passes/src/sim/chains.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, simulating every groom",
+        graph: LIPP,
+        overrides: &["simulate.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

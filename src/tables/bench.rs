@@ -4,7 +4,7 @@ use serde_json::Value;
 use std::fmt::Write;
 
 /// The cells of one backend, in the file's order.
-fn cells<'a>(json: &'a Value, backend: &'a str) -> impl Iterator<Item = &'a Value> + 'a {
+pub(super) fn cells<'a>(json: &'a Value, backend: &'a str) -> impl Iterator<Item = &'a Value> + 'a {
     json["cells"]
         .as_array()
         .into_iter()
@@ -12,7 +12,7 @@ fn cells<'a>(json: &'a Value, backend: &'a str) -> impl Iterator<Item = &'a Valu
         .filter(move |c| c["backend"] == backend)
 }
 
-fn label(cell: &Value) -> String {
+pub(super) fn label(cell: &Value) -> String {
     format!(
         "{}: {}",
         cell["pipeline"].as_str().unwrap_or("?"),
@@ -52,7 +52,7 @@ fn distinct<'a, T: PartialEq>(
     out
 }
 
-fn devices(json: &Value) -> Result<Vec<(String, String)>, String> {
+pub(super) fn devices(json: &Value) -> Result<Vec<(String, String)>, String> {
     let list = json["devices"]
         .as_array()
         .ok_or("no `devices` (not a bench.json)")?;
@@ -68,7 +68,7 @@ fn devices(json: &Value) -> Result<Vec<(String, String)>, String> {
 }
 
 /// What the run was, for a table's caption.
-fn caption(json: &Value, backend: &str, device: &str) -> String {
+pub(super) fn caption(json: &Value, backend: &str, device: &str) -> String {
     format!(
         "{device}, {backend}, {}, {} timed frames after {} warm-up",
         json["size"].as_str().unwrap_or("?"),

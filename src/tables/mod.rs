@@ -17,6 +17,8 @@
 //! - `bench FILE.json`: frame medians per pipeline variant and view;
 //! - `bench-flip FILE.json`: mean FLIP against the reference per variant
 //!   and view, for the variants whose pipeline has one;
+//! - `bench-motion FILE.json`: per cell, the simulation passes' time, the
+//!   frame's, FLIP and flicker ([`motion`]);
 //! - `bench-passes FILE.json VARIANT [VIEW...]`: one variant's per-pass
 //!   medians per view, or only the views named (`_` in VARIANT stands for a
 //!   space: `Kulikov:_all_optimisations`);
@@ -24,6 +26,7 @@
 //!   medians in two runs of the same device, and the change.
 
 pub mod bench;
+mod motion;
 
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -109,6 +112,9 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
         [kind, file] if kind == "bench-flip" => {
             bench::flip_table(&read(file)?).map_err(|e| format!("{file}: {e}"))
         }
+        [kind, file] if kind == "bench-motion" => {
+            motion::table(&read(file)?).map_err(|e| format!("{file}: {e}"))
+        }
         [kind, file, variant, views @ ..] if kind == "bench-passes" => {
             bench::pass_table(&read(file)?, &variant.replace('_', " "), views)
                 .map_err(|e| format!("{file}: {e}"))
@@ -120,7 +126,7 @@ pub fn generate(command: &[String], root: &Path) -> Result<String, String> {
             view,
         ),
         _ => Err(format!(
-            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-flip FILE.json, bench-passes FILE.json VARIANT [VIEW...], bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
+            "unknown generator `{}` (agree FILE.json..., bench FILE.json, bench-flip FILE.json, bench-motion FILE.json, bench-passes FILE.json VARIANT [VIEW...], bench-delta BEFORE.json AFTER.json VARIANT VIEW)",
             command.join(" ")
         )),
     }

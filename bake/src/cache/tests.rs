@@ -82,7 +82,7 @@ fn damaged_files_are_baked_again_not_trusted() {
         ("empty", Vec::new()),
         ("flipped payload bit", {
             let mut b = bytes.clone();
-            b[HEADER + 5] ^= 0x10;
+            b[crate::blob::HEADER + 5] ^= 0x10;
             b
         }),
         ("bad magic", {

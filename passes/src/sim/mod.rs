@@ -21,13 +21,17 @@
 //!   tip) are strands to `sim.pbd_chains`, and `sim.follow_layers` writes
 //!   the simulated corners and their turned tangents into
 //!   `hairmesh.layers`, so the strands generated from the bundles follow.
+//! - [`grid`]: hair-hair friction, `sim.splat` filling each groom's
+//!   velocity grid from last frame's state for the solver to read.
 //! - [`sdf`]: the field's sampling, shared by the solver and its tests.
 //! - [`upload`]: `sim.models` (per groom: whether it is simulated, the
 //!   inverse joint, rest gravity, the field's placement), `sim.sdf` (the
 //!   baked fields) and `sim.rest`.
 
 pub mod chains;
+pub mod field_cache;
 pub mod follow;
+pub mod grid;
 pub mod pbd;
 pub mod sdf;
 pub mod upload;
@@ -63,6 +67,9 @@ pub struct SimModel {
     /// mesh's corner chains for Lipp's ([`chains`]).
     pub strand_first: u32,
     pub strand_count: u32,
+    /// The velocity grid's cell (0, 0, 0) corner in groom-local space, and
+    /// its cells per local unit in w ([`grid::placement`]).
+    pub grid_min: [f32; 4],
 }
 
 /// `sim.state`: one record per vertex, kept between frames.

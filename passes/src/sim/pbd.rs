@@ -3,8 +3,9 @@
 //! (Müller, Kim, Chentanez 2012, "Fast Simulation of Inextensible Hair and
 //! Fur", Algorithm 1). Per substep and vertex, root to tip:
 //!
-//! 1. predict: `v += a Δt`, `p = x + v Δt` (the root is pinned to where the
-//!    head joint carries its rest position);
+//! 1. predict: `v += a Δt`, hair-hair friction `v += f (v_grid − v)` from
+//!    the velocity grid ([`super::grid`], Petrovic et al. 2005), `p = x + v Δt`
+//!    (the root is pinned to where the head joint carries its rest position);
 //! 2. ours, TressFX's global shape constraint: `p += k (rest_now − p)`, so a
 //!    styled groom returns to its style (`shape_stiffness`; 0 is Müller's
 //!    pure FTL, under which hair only hangs);
@@ -28,6 +29,7 @@
 //! a tilted one swings it. Off, full gravity pulls the style down.
 
 use super::chains::CORNERS;
+use super::grid;
 use super::sdf::{FIELD_WORDS, sample};
 use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -70,6 +72,10 @@ pub struct PbdParams {
     pub collision_margin: f32,
     /// The fraction of tangential velocity a contact removes.
     pub friction: f32,
+    /// Hair-hair friction (Petrovic et al. 2005): the pull of a vertex's
+    /// velocity towards the velocity grid's average there, per substep,
+    /// 0..=1; 0 ignores the grid.
+    pub hair_friction: f32,
 }
 
 impl Default for PbdParams {
@@ -84,6 +90,7 @@ impl Default for PbdParams {
             shape_stiffness: 0.04,
             collision_margin: 0.002,
             friction: 0.3,
+            hair_friction: 0.1,
         }
     }
 }
@@ -95,6 +102,7 @@ impl PassParams for PbdParams {
             ("ftl_damping", self.ftl_damping),
             ("shape_stiffness", self.shape_stiffness),
             ("friction", self.friction),
+            ("hair_friction", self.hair_friction),
         ] {
             if !(0.0..=1.0).contains(&v) {
                 return Err(Invalid::new(name, format!("{v} is outside 0..=1")));
@@ -122,8 +130,8 @@ crate::gpu_block! {
         collision_margin: f32,
         friction: f32,
         strands: u32,
+        hair_friction: f32,
         _pad0: u32,
-        _pad1: u32,
     }
 }
 
@@ -138,6 +146,7 @@ const BINDINGS: &[Binding] = &[
     Binding::read("groom.strands"),
     Binding::write("sim.state"),
     Binding::write("groom.vertices"),
+    Binding::read("sim.grid"),
 ];
 
 /// The uniform block for `strands` strands.
@@ -152,6 +161,7 @@ fn gpu(p: &PbdParams, strands: u32) -> PbdGpu {
         shape_stiffness: p.shape_stiffness,
         collision_margin: p.collision_margin,
         friction: p.friction,
+        hair_friction: p.hair_friction,
         strands,
         ..PbdGpu::default()
     }
@@ -214,6 +224,8 @@ struct Strand<'a> {
     sim: SimModel,
     sdf: &'a Words<'a>,
     sdf_base: usize,
+    grid: &'a Words<'a>,
+    grid_base: usize,
     rest: &'a Words<'a>,
     state: &'a Words<'a>,
     first: usize,
@@ -232,6 +244,11 @@ impl Strand<'_> {
         }
         let fetch = |i: usize| self.sdf.load_f32(self.sdf_base + i);
         sample(fetch, self.sim.sdf_min, q.to_array())
+    }
+    /// The velocity grid's average about world point `x` (hair-hair friction).
+    fn flow(&self, x: Vec3) -> Option<Vec3> {
+        let fetch = |i: usize| self.grid.load(self.grid_base + i);
+        grid::sample(fetch, self.sim.grid_min, self.local(x))
     }
     /// Position, velocity and collision threshold of vertex `v`.
     fn load(&self, v: usize) -> (Vec3, Vec3, f32) {
@@ -315,7 +332,13 @@ impl PbdKernel {
         };
         for v in 1..count {
             let (x, u, limit) = s.load(v);
-            let u = u + accel * dt;
+            let mut u = u + accel * dt;
+            // Hair-hair friction (Petrovic et al. 2005, §3).
+            if p.hair_friction > 0.0
+                && let Some(flow) = s.flow(x)
+            {
+                u += (flow - u) * p.hair_friction;
+            }
             let mut q = x + u * dt;
             let rest_now = s.world.transform_point3(s.rest_local(v));
             q += (rest_now - q) * p.shape_stiffness;
@@ -356,10 +379,11 @@ impl PbdKernel {
 impl CpuKernel for PbdKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let frame: FrameData = read(&ctx.words("frame"), 0);
-        let (models, sims, sdf) = (
+        let (models, sims, sdf, grid) = (
             ctx.words("models"),
             ctx.words("sim.models"),
             ctx.words("sim.sdf"),
+            ctx.words("sim.grid"),
         );
         let (rest, strands, state, out) = (
             ctx.words("sim.rest"),
@@ -401,6 +425,8 @@ impl CpuKernel for PbdKernel {
                 sim,
                 sdf: &sdf,
                 sdf_base: m * FIELD_WORDS,
+                grid: &grid,
+                grid_base: m * grid::GRID_WORDS,
                 rest: &rest,
                 state: &state,
                 first,

@@ -1,16 +1,17 @@
 //! The simulation's imported resources: `sim.sdf`, each simulated groom's
 //! collision field, baked once from its parent mesh in the groom's local
-//! space (so the field moves with the head joint); and `sim.models`, per
+//! space (so the field moves with the head joint) and cached on disk
+//! ([`super::field_cache`]); and `sim.models`, per
 //! groom the inverse of this frame's world transform, the rest pose's down
 //! direction and the field's placement, repacked every animated frame.
 
+use super::field_cache;
 use super::sdf::FIELD_WORDS;
 use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel};
 use crate::layout::words_of;
 use crate::upload::Upload;
 use glam::{Mat4, Vec3};
 use strandgraph_assets::Scene;
-use strandgraph_assets::mesh_sdf::MeshSdf;
 
 pub const MODELS: &str = "sim.models";
 pub const SDF: &str = "sim.sdf";
@@ -51,7 +52,10 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
         }
         let region = mesh.bounds().transformed(&to_mesh.inverse());
         let scale = to_mesh.x_axis.truncate().length();
-        let Some(field) = MeshSdf::bake(mesh, to_mesh, region, FIELD_PADDING / scale) else {
+        let cache = strandgraph_bake::cache_dir();
+        let padding = FIELD_PADDING / scale;
+        let Some(field) = field_cache::bake(mesh, to_mesh, region, padding, cache.as_deref())
+        else {
             continue;
         };
         let words = &mut sdf[i * FIELD_WORDS..(i + 1) * FIELD_WORDS];
@@ -94,6 +98,7 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
                 flags,
                 strand_first: strands.0,
                 strand_count: strands.1,
+                grid_min: super::grid::placement(&g.groom.bounds()),
             }
         })
         .collect();

@@ -1,0 +1,88 @@
+// sim.splat / sim.splat_chains: each simulated vertex's velocity and a count
+// into its groom's velocity grid, for hair-hair friction. Port of
+// passes/src/sim/grid.rs (the method and its citation are there).
+
+#import strandgraph::layout::FrameData
+
+struct SplatParams {
+    strands: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// passes/src/sim/mod.rs: SimModel (as shaders/sim/pbd.wgsl).
+struct SimModel {
+    inv_world: mat4x4<f32>,
+    rest_down: vec4<f32>,
+    sdf_min: vec4<f32>,
+    scale: f32,
+    flags: u32,
+    strand_first: u32,
+    strand_count: u32,
+    grid_min: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> params: SplatParams;
+@group(0) @binding(1) var<storage, read> frame: FrameData;
+@group(0) @binding(2) var<storage, read> sim_models: array<SimModel>;
+@group(0) @binding(3) var<storage, read> groom_strands: array<vec2<u32>>;
+// position (w = 1 once written), velocity.
+@group(0) @binding(4) var<storage, read> sim_state: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read_write> sim_grid: array<atomic<u32>>;
+
+const GRID_RES: u32 = 32u;
+const GRID_WORDS: u32 = 131072u;
+const VELOCITY_SCALE: f32 = 4096.0;
+
+fn point(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
+    return (m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]).xyz;
+}
+
+// grid::fixed.
+fn fixed(v: f32) -> u32 {
+    return bitcast<u32>(i32(clamp(floor(v * VELOCITY_SCALE + 0.5), -1e9, 1e9)));
+}
+
+@compute @workgroup_size(64)
+fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let g = gid.x;
+    if g >= params.strands || frame.sim_reset != 0u {
+        return;
+    }
+    var m = 0u;
+    loop {
+        if m >= frame.model_count {
+            return;
+        }
+        let d = sim_models[m];
+        if g >= d.strand_first && g < d.strand_first + d.strand_count {
+            break;
+        }
+        m++;
+    }
+    let sim = sim_models[m];
+    let range = groom_strands[g];
+    // A strand the solver has never written is skipped at its root.
+    if range.y == 0u || sim_state[2u * range.x].w == 0.0 {
+        return;
+    }
+    let last = f32(GRID_RES);
+    for (var v = range.x; v < range.x + range.y; v++) {
+        let x = sim_state[2u * v];
+        if x.w == 0.0 {
+            continue;
+        }
+        let f = (point(sim.inv_world, x.xyz) - sim.grid_min.xyz) * sim.grid_min.w;
+        if !(all(f >= vec3<f32>(0.0)) && all(f < vec3<f32>(last))) {
+            continue;
+        }
+        let i = vec3<u32>(f);
+        let o = m * GRID_WORDS + 4u * (i.x + GRID_RES * (i.y + GRID_RES * i.z));
+        let u = sim_state[2u * v + 1u];
+        atomicAdd(&sim_grid[o], fixed(u.x));
+        atomicAdd(&sim_grid[o + 1u], fixed(u.y));
+        atomicAdd(&sim_grid[o + 2u], fixed(u.z));
+        atomicAdd(&sim_grid[o + 3u], 1u);
+    }
+}
