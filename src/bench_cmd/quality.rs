@@ -189,18 +189,30 @@ fn render(
             None => (vec![p.upload.clone()], 0),
         };
     let mut session = runner::open(backend, &p.plan, &p.instance, setup.cpu)?;
-    let q = p.upload.quantities;
+    sequence_pictures(session.as_mut(), &p.plan, &p.instance, &inputs, judged_from)
+}
+
+/// Runs `inputs` frame after frame in `session`, and returns the picture of
+/// every frame from `judged_from` on.
+pub fn sequence_pictures(
+    session: &mut dyn runner::Session,
+    plan: &strandgraph_graph::Plan,
+    instance: &strandgraph_graph::Instance,
+    inputs: &[strandgraph_passes::upload::Upload],
+    judged_from: usize,
+) -> Result<Vec<Picture>> {
     let mut pictures = Vec::new();
     for (k, input) in inputs.iter().enumerate() {
         session.run(input)?;
         if k < judged_from {
             continue;
         }
-        runner::check_frame(&p.plan, &p.instance, session.as_ref())?;
-        let picture = main_picture(&p.plan, q.width, q.height, DISPLAY, |name| {
+        runner::check_frame(plan, instance, &*session)?;
+        let q = input.quantities;
+        let picture = main_picture(plan, q.width, q.height, DISPLAY, |name| {
             session.read(name).ok().flatten()
         })
-        .ok_or_else(|| miette::miette!("{graph} has no image output"))?;
+        .ok_or_else(|| miette::miette!("{} has no image output", plan.graph.name))?;
         pictures.push(picture);
     }
     Ok(pictures)
