@@ -68,6 +68,9 @@ fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let last = f32(GRID_RES);
+    // grid::splat_strand: a run of vertices in one cell is added once.
+    var run_cell = 0xffffffffu;
+    var run = vec4<u32>(0u);
     for (var v = range.x; v < range.x + range.y; v++) {
         let x = sim_state[2u * v];
         if x.w == 0.0 {
@@ -78,11 +81,27 @@ fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
             continue;
         }
         let i = vec3<u32>(f);
-        let o = m * GRID_WORDS + 4u * (i.x + GRID_RES * (i.y + GRID_RES * i.z));
+        let cell = i.x + GRID_RES * (i.y + GRID_RES * i.z);
         let u = sim_state[2u * v + 1u];
-        atomicAdd(&sim_grid[o], fixed(u.x));
-        atomicAdd(&sim_grid[o + 1u], fixed(u.y));
-        atomicAdd(&sim_grid[o + 2u], fixed(u.z));
-        atomicAdd(&sim_grid[o + 3u], 1u);
+        let add = vec4<u32>(fixed(u.x), fixed(u.y), fixed(u.z), 1u);
+        if cell == run_cell {
+            run = run + add;
+        } else {
+            flush(m, run_cell, run);
+            run_cell = cell;
+            run = add;
+        }
     }
+    flush(m, run_cell, run);
+}
+
+fn flush(m: u32, cell: u32, sum: vec4<u32>) {
+    if cell == 0xffffffffu {
+        return;
+    }
+    let o = m * GRID_WORDS + 4u * cell;
+    atomicAdd(&sim_grid[o], sum.x);
+    atomicAdd(&sim_grid[o + 1u], sum.y);
+    atomicAdd(&sim_grid[o + 2u], sum.z);
+    atomicAdd(&sim_grid[o + 3u], sum.w);
 }

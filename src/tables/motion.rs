@@ -2,7 +2,8 @@
 //! backend, a line per measured cell: the simulation passes' summed median
 //! (every pass of a `sim.*` kind: the velocity grid's splat, the solver,
 //! Lipp's write-back), the frame median, the mean FLIP against the
-//! reference (over the timed frames of an animated scene) and the flicker
+//! reference (over the timed frames of an animated scene), the flicker and
+//! the reference's own frame-to-frame change it is measured against
 //! (src/compare.rs: `Temporal`).
 
 use super::bench::{caption, cells, devices, label};
@@ -35,19 +36,22 @@ pub fn table(json: &Value) -> Result<String, String> {
             continue;
         }
         let _ = writeln!(md, "{}; ms, medians:\n", caption(json, &backend, &device));
-        md.push_str("| scene | variant | simulation ms | frame ms | FLIP | flicker |\n");
-        md.push_str("|---|---|---:|---:|---:|---:|\n");
+        md.push_str(
+            "| scene | variant | simulation ms | frame ms | FLIP | flicker | reference motion |\n",
+        );
+        md.push_str("|---|---|---:|---:|---:|---:|---:|\n");
         for c in measured {
             let flip = |key: &str| number(c[key].as_f64(), crate::compare::flip_text);
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} |",
                 c["view"].as_str().unwrap_or("?"),
                 label(c),
                 number(simulation_ms(c), |v| format!("{v:.3}")),
                 number(c["frame"]["median_ms"].as_f64(), |v| format!("{v:.2}")),
                 flip("flip"),
                 flip("flicker"),
+                flip("reference_motion"),
             );
         }
         md.push('\n');
@@ -65,7 +69,7 @@ mod tests {
         let json: serde_json::Value = serde_json::from_str(
             r#"{"devices":[{"backend":"ash","device":"GPU"}],"size":"1280x720","frames":10,"warmup":2,
             "cells":[{"backend":"ash","pipeline":"Kulikov","variant":"v","view":"animated",
-            "frame":{"median_ms":1.5},"flip":0.1,"flicker":0.004,
+            "frame":{"median_ms":1.5},"flip":0.1,"flicker":0.004,"reference_motion":0.005,
             "passes":[{"pass":"splat","kind":"sim.splat","median_ms":0.01},
                       {"pass":"simulate","kind":"sim.pbd","median_ms":0.125},
                       {"pass":"raster","kind":"kulikov.raster","median_ms":0.5}]}]}"#,
@@ -73,7 +77,7 @@ mod tests {
         .unwrap();
         let md = super::table(&json).unwrap();
         assert!(
-            md.contains("| animated | Kulikov: v | 0.135 | 1.50 | 0.100 | 0.00400 |"),
+            md.contains("| animated | Kulikov: v | 0.135 | 1.50 | 0.100 | 0.00400 | 0.00500 |"),
             "{md}"
         );
     }

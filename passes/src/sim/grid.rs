@@ -12,7 +12,8 @@
 //!   chain), every vertex the solver has written added to the cell it lies
 //!   in: three velocity components and a count, as integers (fixed point,
 //!   [`VELOCITY_SCALE`]), so the sums do not depend on the order of the
-//!   atomics and every backend gets the same grid. It runs before the
+//!   atomics and every backend gets the same grid. A run of vertices in one
+//!   cell is summed in the lane and added once (ours). It runs before the
 //!   solver on last frame's state; a frame that resets the state splats
 //!   nothing.
 //! - The solver samples the grid trilinearly ([`sample`]): the weighted
@@ -195,7 +196,10 @@ impl CpuKernel for SplatKernel {
     }
 }
 
-/// Adds the written vertices `first..first + n` of `state` to the grid at `base`.
+/// Adds the written vertices `first..first + n` of `state` to the grid at
+/// `base`. Consecutive vertices of a strand often share a cell: a lane sums
+/// them and adds once per run (the sums are integers, so this changes no
+/// result, only how many atomics contend for a cell).
 fn splat_strand(
     state: &Words<'_>,
     grid: &Words<'_>,
@@ -210,22 +214,36 @@ fn splat_strand(
         return;
     }
     let inv_world = Mat4::from_cols_array(&sim.inv_world);
+    let flush = |run: Option<(usize, [u32; 4])>| {
+        if let Some((c, sum)) = run {
+            for (k, v) in sum.into_iter().enumerate() {
+                grid.fetch_add(base + 4 * c + k, v);
+            }
+        }
+    };
+    let mut run: Option<(usize, [u32; 4])> = None;
     for v in first..first + n {
         let x = state.load_vec4(2 * v);
-        if x[3] == 0.0 {
-            continue;
-        }
         let q = inv_world.transform_point3(Vec3::new(x[0], x[1], x[2]));
-        let Some(c) = cell(sim.grid_min, q) else {
+        let cell = (x[3] != 0.0).then(|| cell(sim.grid_min, q)).flatten();
+        let Some(c) = cell else {
             continue;
         };
         let u = state.load_vec4(2 * v + 1);
-        let o = base + 4 * c;
-        for k in 0..3 {
-            grid.fetch_add(o + k, fixed(u[k]));
+        let add = [fixed(u[0]), fixed(u[1]), fixed(u[2]), 1];
+        match &mut run {
+            Some((rc, sum)) if *rc == c => {
+                for (s, a) in sum.iter_mut().zip(add) {
+                    *s = s.wrapping_add(a);
+                }
+            }
+            _ => {
+                flush(run.take());
+                run = Some((c, add));
+            }
         }
-        grid.fetch_add(o + 3, 1);
     }
+    flush(run);
 }
 
 #[cfg(test)]
