@@ -3,6 +3,7 @@
 // glam's operation order.
 
 #import strandgraph::layout::ModelData
+#import strandgraph::sim::{dot3, normalize3, point}
 
 struct FollowParams {
     bundles: u32,
@@ -26,20 +27,8 @@ const MAX_LAYERS: u32 = 16u;
 const BUNDLE_WORDS: u32 = 16u;
 const CORNERS: u32 = 4u;
 
-fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
 fn cross3(a: vec3<f32>, b: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y);
-}
-
-fn normalize3(v: vec3<f32>) -> vec3<f32> {
-    let len = sqrt(dot3(v, v));
-    if len > 0.0 {
-        return v * (1.0 / len);
-    }
-    return vec3<f32>(0.0);
 }
 
 // follow::turn.
@@ -84,8 +73,8 @@ fn follow(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
         let first = CORNERS * first_layer + c * n;
         let t_local = turn(sim_chain_tangents[first + l].xyz, rest_direction(first, l, n), point_direction(first, l, n));
         let p_local = sim_chain_points[first + l].xyz;
-        // glam's transform_point3 and Mat3 * Vec3: column by column.
-        let p = world[0].xyz * p_local.x + world[1].xyz * p_local.y + world[2].xyz * p_local.z + world[3].xyz;
+        let p = point(world, p_local);
+        // glam's Mat3 * Vec3: column by column.
         let t = normalize3(world[0].xyz * t_local.x + world[1].xyz * t_local.y + world[2].xyz * t_local.z);
         let i = 2u * (4u * layer + c);
         hairmesh_layers[i] = vec4<f32>(p, hairmesh_layers[i].w);

@@ -4,6 +4,7 @@
 // glam's operation order.
 
 #import strandgraph::layout::{FrameData, ModelData}
+#import strandgraph::sim::{SimModel, dot3, normalize3, point}
 
 struct PbdParams {
     // 0 Flagged, 1 All, 2 None.
@@ -19,21 +20,6 @@ struct PbdParams {
     strands: u32,
     hair_friction: f32,
     _pad0: u32,
-}
-
-// passes/src/sim/mod.rs: SimModel.
-struct SimModel {
-    inv_world: mat4x4<f32>,
-    rest_down: vec4<f32>,
-    // xyz: grid point 0 (groom local); w: grid points per unit.
-    sdf_min: vec4<f32>,
-    scale: f32,
-    flags: u32,
-    // The groom's strands in this pass's numbering (groom_strands).
-    strand_first: u32,
-    strand_count: u32,
-    // The velocity grid's corner (groom local) and cells per unit (w).
-    grid_min: vec4<f32>,
 }
 
 // position (w = 1 once written), velocity (w: the collision threshold).
@@ -65,22 +51,6 @@ const COLLISION_PASSES: u32 = 4u;
 const GRID_RES: u32 = 32u;
 const GRID_WORDS: u32 = 131072u;
 const VELOCITY_SCALE: f32 = 4096.0;
-
-fn dot3(a: vec3<f32>, b: vec3<f32>) -> f32 {
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-fn normalize3(v: vec3<f32>) -> vec3<f32> {
-    let len = sqrt(dot3(v, v));
-    if len > 0.0 {
-        return v * (1.0 / len);
-    }
-    return vec3<f32>(0.0);
-}
-
-fn point(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
-    return (m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]).xyz;
-}
 
 fn direction(m: mat4x4<f32>, v: vec3<f32>) -> vec3<f32> {
     return (m[0] * v.x + m[1] * v.y + m[2] * v.z).xyz;

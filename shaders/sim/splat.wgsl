@@ -3,24 +3,13 @@
 // passes/src/sim/grid.rs (the method and its citation are there).
 
 #import strandgraph::layout::FrameData
+#import strandgraph::sim::{SimModel, point}
 
 struct SplatParams {
     strands: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
-}
-
-// passes/src/sim/mod.rs: SimModel (as shaders/sim/pbd.wgsl).
-struct SimModel {
-    inv_world: mat4x4<f32>,
-    rest_down: vec4<f32>,
-    sdf_min: vec4<f32>,
-    scale: f32,
-    flags: u32,
-    strand_first: u32,
-    strand_count: u32,
-    grid_min: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> params: SplatParams;
@@ -34,10 +23,6 @@ struct SimModel {
 const GRID_RES: u32 = 32u;
 const GRID_WORDS: u32 = 131072u;
 const VELOCITY_SCALE: f32 = 4096.0;
-
-fn point(m: mat4x4<f32>, p: vec3<f32>) -> vec3<f32> {
-    return (m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3]).xyz;
-}
 
 // grid::fixed.
 fn fixed(v: f32) -> u32 {

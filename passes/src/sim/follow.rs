@@ -17,6 +17,7 @@
 //! between frames whatever the uploads skip.
 
 use super::chains::{CORNERS, POINTS, REST, TANGENTS};
+use super::normalize;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -67,16 +68,6 @@ pub static FOLLOW: PassKind<NoParams, FollowGpu> = PassKind {
 };
 
 struct FollowKernel;
-
-/// `v / |v|` as the WGSL writes it (one reciprocal); zero for a zero vector.
-fn normalize(v: Vec3) -> Vec3 {
-    let len = v.dot(v).sqrt();
-    if len > 0.0 {
-        v * (1.0 / len)
-    } else {
-        Vec3::ZERO
-    }
-}
 
 /// `t` turned by the rotation taking unit `a` to unit `b` (Rodrigues with
 /// `v = a × b`, `c = a · b`); unturned when either is zero or they oppose.

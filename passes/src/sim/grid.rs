@@ -24,8 +24,8 @@
 //! bounds' centre ([`placement`]): hair swinging out stays inside. A vertex
 //! outside adds nothing and feels no friction.
 
-use super::SimModel;
 use super::chains::CORNERS;
+use super::{SimModel, model_of};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -179,12 +179,7 @@ impl CpuKernel for SplatKernel {
             if g >= strands.len() / 2 {
                 break;
             }
-            let Some((m, sim)) = (0..frame.model_count as usize)
-                .map(|m| (m, read::<SimModel>(&sims, m)))
-                .find(|(_, d)| {
-                    g >= d.strand_first as usize && g < (d.strand_first + d.strand_count) as usize
-                })
-            else {
+            let Some((m, sim)) = model_of(&sims, frame.model_count, g) else {
                 continue;
             };
             let (first, n) = (

@@ -39,7 +39,10 @@ pub mod upload;
 #[cfg(test)]
 mod tests;
 
+use crate::kernel::Words;
+use crate::layout::read;
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 
 /// `sim.models` flag: the groom is simulated (`GroomDesc::simulate`).
 pub const SIM_SIMULATE: u32 = 1;
@@ -81,4 +84,25 @@ pub struct SimVertex {
     /// World velocity in metres per second; w: how near the head the
     /// vertex may come (its rest distance, at most the margin; local units).
     pub velocity: [f32; 4],
+}
+
+/// The groom whose range in `sims` (`sim.models`, in the pass's strand
+/// numbering) holds strand `g`, and its record; `None` for a strand of no
+/// groom's.
+pub(crate) fn model_of(sims: &Words<'_>, model_count: u32, g: usize) -> Option<(usize, SimModel)> {
+    (0..model_count as usize)
+        .map(|m| (m, read::<SimModel>(sims, m)))
+        .find(|(_, d)| {
+            g >= d.strand_first as usize && g < (d.strand_first + d.strand_count) as usize
+        })
+}
+
+/// `v / |v|` as the WGSL writes it (one reciprocal); zero for a zero vector.
+pub(crate) fn normalize(v: Vec3) -> Vec3 {
+    let len = v.dot(v).sqrt();
+    if len > 0.0 {
+        v * (1.0 / len)
+    } else {
+        Vec3::ZERO
+    }
 }

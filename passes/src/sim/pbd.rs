@@ -31,7 +31,7 @@
 use super::chains::CORNERS;
 use super::grid;
 use super::sdf::{FIELD_WORDS, sample};
-use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel};
+use super::{SIM_COLLIDER, SIM_SIMULATE, SimModel, model_of, normalize};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -206,16 +206,6 @@ struct PbdKernel(PbdParams);
 
 fn v3(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
-}
-
-/// `v / |v|` as the WGSL writes it (one reciprocal); zero for a zero vector.
-fn normalize(v: Vec3) -> Vec3 {
-    let len = v.dot(v).sqrt();
-    if len > 0.0 {
-        v * (1.0 / len)
-    } else {
-        Vec3::ZERO
-    }
 }
 
 /// What one lane needs about its groom this frame.
@@ -397,13 +387,7 @@ impl CpuKernel for PbdKernel {
             if g >= total {
                 break;
             }
-            // The groom whose range (in this pass's strand numbering) holds g.
-            let Some((m, sim)) = (0..frame.model_count as usize)
-                .map(|m| (m, read::<SimModel>(&sims, m)))
-                .find(|(_, d)| {
-                    g >= d.strand_first as usize && g < (d.strand_first + d.strand_count) as usize
-                })
-            else {
+            let Some((m, sim)) = model_of(&sims, frame.model_count, g) else {
                 continue;
             };
             let model: ModelData = read(&models, m);
