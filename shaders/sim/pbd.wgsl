@@ -19,7 +19,7 @@ struct PbdParams {
     friction: f32,
     strands: u32,
     hair_friction: f32,
-    _pad0: u32,
+    collision_iterations: u32,
 }
 
 // position (w = 1 once written), velocity (w: the collision threshold).
@@ -47,7 +47,6 @@ const SDF_RES: u32 = 40u;
 const FIELD_WORDS: u32 = 64000u;
 const SIM_SIMULATE: u32 = 1u;
 const SIM_COLLIDER: u32 = 2u;
-const COLLISION_PASSES: u32 = 4u;
 const GRID_RES: u32 = 32u;
 const GRID_WORDS: u32 = 131072u;
 const VELOCITY_SCALE: f32 = 4096.0;
@@ -244,7 +243,7 @@ fn substep(s: Strand, count: u32, dt: f32, accel: vec3<f32>) {
         var contact = false;
         var normal = vec3<f32>(0.0);
         let limit = state.velocity.w;
-        for (var k = 0u; k < COLLISION_PASSES; k++) {
+        for (var k = 0u; k < params.collision_iterations; k++) {
             let c = collide(s, fixed, limit, f32(k + 1u));
             if !c.hit {
                 break;

@@ -12,10 +12,10 @@
 //! 3. FTL (Müller §4): `p_i = p_{i−1} + l_i (p_i − p_{i−1}) / |p_i − p_{i−1}|`;
 //! 4. head collision: a vertex nearer the head's SDF than it was at rest (or
 //!    than `collision_margin`) is pushed out along the gradient and put back
-//!    on the FTL sphere, up to four times, each push longer; one still inside the head after
-//!    that is pushed to its surface (or its rest depth, for one inside at
-//!    rest), giving up a little length (Kulikov:
-//!    "Prebuilt SDFs for head collisions");
+//!    on the FTL sphere, up to `collision_iterations` times (4), each push
+//!    longer; one still inside the head after that is pushed to its surface
+//!    (or its rest depth, for one inside at rest), giving up a little length
+//!    (Kulikov: "Prebuilt SDFs for head collisions");
 //! 5. velocity with Müller's damping correction (§4.2, Eq. 9):
 //!    `v_i = (p_i − x_i) / Δt − s_damping d_{i+1} / Δt`, `d` the correction
 //!    FTL gave the next vertex; then friction on contact and air damping.
@@ -41,8 +41,6 @@ use glam::{Mat4, Vec3};
 use strandgraph_graph::schema::Quantity;
 
 const GROUP: u32 = 64;
-/// Alternations of the collision push and the FTL projection per vertex.
-const COLLISION_PASSES: u32 = 4;
 
 crate::string_enum! {
     /// Which grooms the pass simulates; the others are copied unchanged.
@@ -76,6 +74,10 @@ pub struct PbdParams {
     /// velocity towards the velocity grid's average there, per substep,
     /// 0..=1; 0 ignores the grid.
     pub hair_friction: f32,
+    /// Collision iterations per vertex and substep: alternations of the
+    /// push out of the head and the FTL projection, each push reaching
+    /// further (step 4).
+    pub collision_iterations: u32,
 }
 
 impl Default for PbdParams {
@@ -91,6 +93,7 @@ impl Default for PbdParams {
             collision_margin: 0.002,
             friction: 0.3,
             hair_friction: 0.1,
+            collision_iterations: 4,
         }
     }
 }
@@ -98,6 +101,7 @@ impl Default for PbdParams {
 impl PassParams for PbdParams {
     fn validate(&self) -> Result<(), Invalid> {
         in_range("substeps", self.substeps, 1..=64)?;
+        in_range("collision_iterations", self.collision_iterations, 1..=16)?;
         for (name, v) in [
             ("ftl_damping", self.ftl_damping),
             ("shape_stiffness", self.shape_stiffness),
@@ -131,7 +135,7 @@ crate::gpu_block! {
         friction: f32,
         strands: u32,
         hair_friction: f32,
-        _pad0: u32,
+        collision_iterations: u32,
     }
 }
 
@@ -162,6 +166,7 @@ fn gpu(p: &PbdParams, strands: u32) -> PbdGpu {
         collision_margin: p.collision_margin,
         friction: p.friction,
         hair_friction: p.hair_friction,
+        collision_iterations: p.collision_iterations,
         strands,
         ..PbdGpu::default()
     }
@@ -340,7 +345,7 @@ impl PbdKernel {
             // push reaching further (a vertex wedged in a crease, under the
             // jaw, escapes along the sphere); what the last projection
             // leaves inside is pushed out regardless.
-            for pass in 0..COLLISION_PASSES {
+            for pass in 0..p.collision_iterations {
                 let reach = (pass + 1) as f32;
                 let Some((pushed, n)) = s.collide(fixed, limit, reach) else {
                     break;
