@@ -131,7 +131,7 @@ impl Stats {
 
 #[derive(Debug, Clone)]
 pub enum Cell {
-    Measured(Stats),
+    Measured(Box<Stats>),
     Skipped(String),
 }
 

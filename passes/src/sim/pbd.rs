@@ -168,7 +168,6 @@ fn gpu(p: &PbdParams, strands: u32) -> PbdGpu {
         hair_friction: p.hair_friction,
         collision_iterations: p.collision_iterations,
         strands,
-        ..PbdGpu::default()
     }
 }
 
