@@ -21,13 +21,18 @@ pub struct Saved {
     pub reference: Option<String>,
 }
 
+/// A reference picture, and where it was written.
+type Written = (RgbaImage, String);
+
 /// Writes the pictures of one bench run under `out/pictures/`.
 pub struct Saver {
     out: PathBuf,
     /// Paths taken so far, so two rows whose names slug alike stay apart.
     taken: BTreeSet<String>,
-    /// The reference of each (backend, view, pipeline), written once.
-    references: BTreeMap<(Backend, String, &'static str), String>,
+    /// The references of each (backend, view, pipeline), each written
+    /// once: one, or more where rows simulate differently (a row's
+    /// `simulate.*` overrides carry over to its reference).
+    references: BTreeMap<(Backend, String, &'static str), Vec<Written>>,
 }
 
 /// `Kulikov: no sort` as `kulikov-no-sort`: file names that need no
@@ -83,7 +88,7 @@ impl Saver {
     }
 
     /// Saves row `v`'s `picture` on `backend` at `view`, with its error map
-    /// and (once per backend, view and pipeline) its reference.
+    /// and (once per backend, view, pipeline and picture) its reference.
     pub fn save(
         &mut self,
         backend: Backend,
@@ -119,12 +124,16 @@ impl Saver {
         image: &RgbaImage,
     ) -> Result<String> {
         let key = (backend, view.to_string(), pipeline);
-        if let Some(rel) = self.references.get(&key) {
+        let mut known = self.references.get(&key).into_iter().flatten();
+        if let Some((_, rel)) = known.find(|(seen, _)| seen == image) {
             return Ok(rel.clone());
         }
         let rel = self.claim(backend, view, &format!("reference-{}", slug(pipeline)));
         self.write(&rel, image)?;
-        self.references.insert(key, rel.clone());
+        self.references
+            .entry(key)
+            .or_default()
+            .push((image.clone(), rel.clone()));
         Ok(rel)
     }
 }
