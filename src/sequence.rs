@@ -6,11 +6,20 @@
 use crate::frame::{Prepared, complete_upload};
 use miette::Result;
 use strandgraph_passes::layout::words_of;
+use strandgraph_passes::sim::chains::{self, CHAIN_MODELS};
 use strandgraph_passes::sim::upload::{self as sim, MODELS, REST, SDF};
 use strandgraph_passes::upload::{SHADOW_SH, Upload, upload};
 
 /// Inputs that do not depend on the pose: baked once, carried to every frame.
-const CARRIED: [&str; 3] = [SHADOW_SH, SDF, REST];
+const CARRIED: [&str; 7] = [
+    SHADOW_SH,
+    SDF,
+    REST,
+    chains::CHAINS,
+    chains::REST,
+    chains::POINTS,
+    chains::TANGENTS,
+];
 
 /// The inputs of frame `index` of a sequence at `fps`: the scene posed at
 /// `index / fps` seconds, the simulation stepped by `1 / fps` (the first
@@ -25,10 +34,13 @@ pub fn frame_upload(p: &mut Prepared, index: u32, fps: f32) -> Result<Upload> {
             up.set(name, words.clone());
         }
     }
-    if let Some(models) = p.upload.resources.get(MODELS) {
-        up.set(MODELS, models.clone());
-        sim::repose(&p.scene, &mut up);
+    // The simulation's records, posed (sim::repose).
+    for name in [MODELS, CHAIN_MODELS] {
+        if let Some(words) = p.upload.resources.get(name) {
+            up.set(name, words.clone());
+        }
     }
+    sim::repose(&p.scene, &mut up);
     complete_upload(&p.plan, &p.scene, &mut up)?;
     let mut frame = up.frame.expect("upload sets the frame");
     frame.time = time;

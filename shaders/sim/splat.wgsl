@@ -7,7 +7,7 @@
 
 struct SplatParams {
     strands: u32,
-    _pad0: u32,
+    enabled: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -32,7 +32,7 @@ fn fixed(v: f32) -> u32 {
 @compute @workgroup_size(64)
 fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
     let g = gid.x;
-    if g >= params.strands || frame.sim_reset != 0u {
+    if g >= params.strands || params.enabled == 0u || frame.sim_reset != 0u {
         return;
     }
     var m = 0u;

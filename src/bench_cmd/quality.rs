@@ -5,7 +5,7 @@
 //! The reference of a scene is rendered once per backend, on that backend,
 //! and the row's last timed frame is compared with it. An animated scene's
 //! reference runs the same frames (its graph simulates as the row's does,
-//! with the row's `simulate.*` overrides), and every timed frame is
+//! with the row's `simulate.*` and `splat.*` overrides), and every timed frame is
 //! compared: FLIP per frame, and the flicker of the sequence against the
 //! reference's ([`strandgraph::compare::Temporal`]). Both go through the
 //! display transform `render` uses by default (ACES, 0 EV), since FLIP
@@ -40,10 +40,10 @@ pub const DISPLAY: Display = Display {
     exposure: 0.0,
 };
 
-/// The pass every graph that simulates names `simulate`: overrides of it
-/// change what the hair does, not how it is drawn, so a row's carry over
-/// to its reference.
-const SIMULATE: &str = "simulate.";
+/// The passes every graph that simulates names `simulate` and `splat`
+/// (its velocity grid): overrides of them change what the hair does, not
+/// how it is drawn, so a row's carry over to its reference.
+const SIMULATION: [&str; 2] = ["simulate.", "splat."];
 
 /// The overrides of `v` and `extra` (`--param`) its reference takes.
 pub fn simulation_overrides(v: &Variant, extra: &[String]) -> Vec<String> {
@@ -51,7 +51,7 @@ pub fn simulation_overrides(v: &Variant, extra: &[String]) -> Vec<String> {
         .iter()
         .copied()
         .chain(extra.iter().map(String::as_str))
-        .filter(|spec| spec.starts_with(SIMULATE))
+        .filter(|spec| SIMULATION.iter().any(|p| spec.starts_with(p)))
         .map(str::to_string)
         .collect()
 }

@@ -45,7 +45,12 @@ pub const VARIANTS: &[Variant] = &[
         // Ours: Petrovic 2005's velocity-grid friction switched off.
         name: "simulating every groom, no hair-hair friction",
         graph: KULIKOV,
-        overrides: &["simulate.models=\"All\"", "simulate.hair_friction=0.0"],
+        // The grid's splat goes too: the friction is its only reader.
+        overrides: &[
+            "simulate.models=\"All\"",
+            "simulate.hair_friction=0.0",
+            "splat.enabled=false",
+        ],
         raster: &["raster"],
         ceiling: "atomic_min32",
     },

@@ -26,11 +26,12 @@
 
 use super::chains::CORNERS;
 use super::{SimModel, model_of};
+use crate::contract::flag;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, read};
-use crate::params::NoParams;
+use crate::params::PassParams;
 use glam::{Mat4, Vec3};
 use strandgraph_assets::bounds::Aabb;
 use strandgraph_graph::schema::Quantity;
@@ -105,17 +106,33 @@ const BINDINGS: &[Binding] = &[
     Binding::atomic("sim.grid"),
 ];
 
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SplatParams {
+    /// Off, the grid stays empty and costs nothing: what a graph sets with
+    /// the solver's `hair_friction: 0`, the grid's only reader.
+    pub enabled: bool,
+}
+
+impl Default for SplatParams {
+    fn default() -> Self {
+        Self { enabled: true }
+    }
+}
+
+impl PassParams for SplatParams {}
+
 crate::gpu_block! {
     /// `SplatParams` in shaders/sim/splat.wgsl.
     pub struct SplatGpu {
         strands: u32,
-        _pad0: u32,
+        enabled: u32,
         _pad1: u32,
         _pad2: u32,
     }
 }
 
-pub static SPLAT: PassKind<NoParams, SplatGpu> = PassKind {
+pub static SPLAT: PassKind<SplatParams, SplatGpu> = PassKind {
     kind: "sim.splat",
     summary: "velocity grid: each simulated vertex's velocity and a count, per groom",
     source: "Petrovic et al. 2005, §3 (hair-hair friction); Kulikov 2025, 'Simulation'",
@@ -126,16 +143,17 @@ pub static SPLAT: PassKind<NoParams, SplatGpu> = PassKind {
         per_group: GROUP,
     },
     shader: Shader::compute("sim/splat.wgsl", "splat"),
-    kernel: |_| Box::new(SplatKernel),
-    gpu: |_, q| SplatGpu {
+    kernel: |p| Box::new(SplatKernel(*p)),
+    gpu: |p, q| SplatGpu {
         strands: count(q.strands),
+        enabled: flag(p.enabled),
         ..SplatGpu::default()
     },
     raster: None,
 };
 
 /// [`SPLAT`] over Lipp's bundle chains, four per bundle.
-pub static SPLAT_CHAINS: PassKind<NoParams, SplatGpu> = PassKind {
+pub static SPLAT_CHAINS: PassKind<SplatParams, SplatGpu> = PassKind {
     kind: "sim.splat_chains",
     summary: "velocity grid of the simulated bundle chains, per groom",
     source: "Petrovic et al. 2005, §3 (hair-hair friction)",
@@ -146,15 +164,16 @@ pub static SPLAT_CHAINS: PassKind<NoParams, SplatGpu> = PassKind {
         per_group: GROUP / CORNERS,
     },
     shader: Shader::compute("sim/splat.wgsl", "splat"),
-    kernel: |_| Box::new(SplatKernel),
-    gpu: |_, q| SplatGpu {
+    kernel: |p| Box::new(SplatKernel(*p)),
+    gpu: |p, q| SplatGpu {
         strands: CORNERS * count(q.bundles),
+        enabled: flag(p.enabled),
         ..SplatGpu::default()
     },
     raster: None,
 };
 
-struct SplatKernel;
+struct SplatKernel(SplatParams);
 
 /// Metres per second as the grid's fixed point (nearest, halves up, as
 /// the WGSL's `floor(x + 0.5)`), saturating far beyond any hair's speed.
@@ -165,7 +184,7 @@ fn fixed(v: f32) -> u32 {
 impl CpuKernel for SplatKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let frame: FrameData = read(&ctx.words("frame"), 0);
-        if frame.sim_reset != 0 {
+        if !self.0.enabled || frame.sim_reset != 0 {
             return;
         }
         let (sims, strands, state, grid) = (

@@ -130,7 +130,6 @@ impl Run {
             .resources
             .insert("models".into(), posed.resources["models"].clone());
         repose(&self.scene, &mut self.up);
-        chains::repose(&self.scene, &mut self.up);
         let mut frame: FrameData = posed.frame.unwrap();
         frame.time = t;
         frame.delta_time = if k == 0 { 0.0 } else { 1.0 / FPS };
@@ -147,7 +146,9 @@ impl Run {
         let groups = (lanes as u32).div_ceil(64);
         let grid_words = GRID_WORDS * self.scene.grooms.len();
         self.harness.buffer("sim.grid", vec![0; grid_words]);
-        let splat = (splat.kernel)(&Default::default());
+        let splat = (splat.kernel)(&grid::SplatParams {
+            enabled: self.params.hair_friction > 0.0,
+        });
         self.harness.run(splat.as_ref(), groups, 64);
         let kernel = (pass.kernel)(&self.params);
         self.harness.run(kernel.as_ref(), groups, 64);

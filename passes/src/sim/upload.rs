@@ -111,7 +111,8 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
 }
 
 /// Rewrites `sim.models`' per-frame part (the inverse world transform and
-/// scale) for the scene's current pose; nothing without `sim.models`.
+/// scale) for the scene's current pose, and `sim.chain_models` from it
+/// where the upload has one; nothing without `sim.models`.
 pub fn repose(scene: &Scene, up: &mut Upload) {
     let Some(words) = up.resources.get_mut(MODELS) else {
         return;
@@ -122,4 +123,8 @@ pub fn repose(scene: &Scene, up: &mut Upload) {
         m.scale = g.world.x_axis.truncate().length();
     }
     *words = words_of(&models);
+    // The hair meshes' chains take the same records with their own ranges.
+    if up.resources.contains_key(super::chains::CHAIN_MODELS) {
+        super::chains::repose(scene, up);
+    }
 }
