@@ -166,7 +166,6 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
     let a = payload(1u, i);
     let centre = !is_empty(g);
     let cons = !is_empty(a);
-    let scene = textureLoad(output, vec2<u32>(x, y));
     var out = vec4<f32>(0.0);
     // NDC depth of the nearest sample the colour came from.
     var depth = 1.0;
@@ -223,6 +222,8 @@ fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let alpha = out.w;
+    // Read only where hair is blended: most of the screen returns above.
+    let scene = textureLoad(output, vec2<u32>(x, y));
     textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), alpha + scene.w * (1.0 - alpha)));
     if alpha >= params.depth_alpha {
         hair_depth[i] = bitcast<u32>(min(bitcast<f32>(hair_depth[i]), depth));

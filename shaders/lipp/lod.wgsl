@@ -143,10 +143,9 @@ fn choose(b: u32) -> vec3<u32> {
     }
     let delta = select(0.0, unit(pcg(seed)), params.random_delta != 0u);
     // Lipp Eq. 1.
+    // A culled bundle keeps its N_LOD for β (lipp.lod_scan draws none).
     var strands = n;
-    if culled {
-        strands = 0u;
-    } else if params.strand_lod != 0u && n > 0u {
+    if params.strand_lod != 0u && n > 0u {
         strands = clamp(u32(ceil(l * (f32(n) + delta))), 1u, n);
     }
     // Lipp Eq. 4-5.

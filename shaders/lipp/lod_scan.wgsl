@@ -4,7 +4,7 @@
 // contiguous run of bundles; the lanes' sums are scanned in workgroup memory
 // (Hillis and Steele), then each lane writes its run.
 
-#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM}
+#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_NOT_DRAWN}
 
 struct ScanParams {
     // Scene quantity: bundles packed.
@@ -25,6 +25,12 @@ const SCAN_GROUP: u32 = 256u;
 
 var<workgroup> sums: array<u32, SCAN_GROUP>;
 var<workgroup> full_sums: array<u32, SCAN_GROUP>;
+var<workgroup> kept_sums: array<u32, SCAN_GROUP>;
+
+// scan.rs: a culled or occluded bundle draws none of the strands it keeps.
+fn drawn(b: u32) -> u32 {
+    return select(lod_choices[b * LOD_WORDS], 0u, (lod_choices[b * LOD_WORDS + 3u] & LOD_NOT_DRAWN) != 0u);
+}
 
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) lane: u32) {
@@ -34,26 +40,32 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
     let end = min(begin + per, count);
     var sum = 0u;
     var full = 0u;
+    var kept = 0u;
     for (var b = begin; b < end; b++) {
-        sum += lod_choices[b * LOD_WORDS];
+        sum += drawn(b);
         if (lod_choices[b * LOD_WORDS + 3u] & LOD_OTHER_GROOM) == 0u {
             full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
+            kept += lod_choices[b * LOD_WORDS];
         }
     }
     sums[lane] = sum;
     full_sums[lane] = full;
+    kept_sums[lane] = kept;
     workgroupBarrier();
     // Inclusive scans of the lanes' sums.
     for (var d = 1u; d < SCAN_GROUP; d <<= 1u) {
         var v = sums[lane];
         var f = full_sums[lane];
+        var k = kept_sums[lane];
         if lane >= d {
             v += sums[lane - d];
             f += full_sums[lane - d];
+            k += kept_sums[lane - d];
         }
         workgroupBarrier();
         sums[lane] = v;
         full_sums[lane] = f;
+        kept_sums[lane] = k;
         workgroupBarrier();
     }
     var first = 0u;
@@ -62,7 +74,7 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
     }
     for (var b = begin; b < end; b++) {
         let o = b * LOD_WORDS;
-        let n = lod_choices[o];
+        let n = drawn(b);
         bundle_lod[o] = n;
         bundle_lod[o + 1u] = lod_choices[o + 1u];
         bundle_lod[o + 2u] = first;
@@ -75,7 +87,8 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         raster_args[1] = 1u;
         raster_args[2] = 1u;
         raster_args[3] = total;
-        // β of Lipp Eq. 8 is word 3 / word 4.
+        // β of Lipp Eq. 8 is word 5 / word 4 (lipp::ARGS_KEPT, ARGS_ALL).
         raster_args[4] = full_sums[SCAN_GROUP - 1u];
+        raster_args[5] = kept_sums[SCAN_GROUP - 1u];
     }
 }

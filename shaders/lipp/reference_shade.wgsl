@@ -42,7 +42,7 @@ fn shade_slot(slot: u32, s: Shading, delta: f32) {
 fn reference_shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     var delta = 0.0;
     if params.lod_depth_correction != 0u {
-        delta = depth_correction(raster_args[3], raster_args[4]);
+        delta = depth_correction(raster_args[5], raster_args[4]);
     }
     let s = shading_of(params);
     let first = wg.x * SLOTS_PER_GROUP;

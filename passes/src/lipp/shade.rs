@@ -38,7 +38,7 @@ pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
-use super::{add, dot, frame, normalize, pcg, scale, sub, transform, unit};
+use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -77,6 +77,10 @@ pub struct ShadeParams {
     pub dom_layer_thickness: f32,
     /// The groom shaded (its material), in the graph's per-model block.
     pub model_index: u32,
+    /// Ours: the conservative layer is shaded only where `lipp.filter` can
+    /// read it (the centre layer empty, or the conservative hit nearer);
+    /// elsewhere it is written black. MSAA's sample layers are all shaded.
+    pub filter_layers_only: bool,
 }
 
 impl Default for ShadeParams {
@@ -93,6 +97,7 @@ impl Default for ShadeParams {
             dom_layers: 4,
             dom_layer_thickness: 0.02,
             model_index: 0,
+            filter_layers_only: true,
         }
     }
 }
@@ -130,6 +135,8 @@ crate::gpu_block! {
         /// `lipp.reference_shade` only: point slots to shade (the mesh
         /// strands × [`super::reference::SLOTS`]); 0 here.
         slots: u32,
+        filter_layers_only: u32,
+        padding: u32,
     }
 }
 
@@ -150,6 +157,8 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         model_index: p.model_index,
         probe_specular: flag(p.probe_specular),
         slots,
+        filter_layers_only: flag(p.filter_layers_only),
+        padding: 0,
     }
 }
 
@@ -255,12 +264,12 @@ pub struct Dom<'a> {
     pub delta: f32,
 }
 
-/// Lipp Eq. 8: Δ = −log β, β = drawn / all strands.
-pub fn depth_correction(drawn: u32, all: u32) -> f32 {
-    if drawn == 0 || all == 0 {
+/// Lipp Eq. 8: Δ = −log β, β = the strands the LOD kept / all strands.
+pub fn depth_correction(kept: u32, all: u32) -> f32 {
+    if kept == 0 || all == 0 {
         return 0.0;
     }
-    -(drawn.min(all) as f32 / all as f32).ln()
+    -(kept.min(all) as f32 / all as f32).ln()
 }
 
 impl Dom<'_> {
@@ -397,6 +406,15 @@ pub fn load_sh(w: &Words<'_>) -> [[f32; 3]; 9] {
     })
 }
 
+/// Whether `lipp.filter` can read layer `layer` of a pixel whose centre
+/// sample is `centre` and this layer's is `p` (`filter_layers_only`): the
+/// conservative sample only where the centre layer is empty or it is nearer
+/// (the filter's flyaway test asks it to be `front_threshold` > 0 nearer;
+/// payloads order by depth).
+pub fn filter_reads(p: &ShadeParams, layers: u32, layer: u32, centre: u64, sample: u64) -> bool {
+    !p.filter_layers_only || layers > 2 || layer == 0 || centre == EMPTY || sample < centre
+}
+
 impl CpuKernel for ShadeKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
@@ -407,7 +425,7 @@ impl CpuKernel for ShadeKernel {
         let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
         let args = ctx.words("raster_args");
         let delta = if self.0.lod_depth_correction {
-            depth_correction(args.load(3), args.load(4))
+            depth_correction(args.load(ARGS_KEPT), args.load(ARGS_ALL))
         } else {
             0.0
         };
@@ -416,10 +434,12 @@ impl CpuKernel for ShadeKernel {
         let layers = super::gbuffer_layers(&g, &out, pixels);
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
+            let centre =
+                super::payload::from_words(g.load(2 * i as usize), g.load(2 * i as usize + 1));
             for layer in 0..layers {
                 let slot = (layer * pixels + i) as usize;
                 let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
-                let c = if p == EMPTY {
+                let c = if p == EMPTY || !filter_reads(&self.0, layers, layer, centre, p) {
                     [0.0; 4]
                 } else {
                     let c = shade_sample(&inp, &unpack(p), x, y);

@@ -6,7 +6,8 @@
 //! [`footprint`]), the LOD value L (Eq. 2), the strand count N_LOD (Eq. 1,
 //! with a per-bundle random δ), and the control-point count C (Eq. 4-5,
 //! snapped to 2^k + 1). Bundles whose footprint lies outside the viewport are
-//! frustum-culled (N_LOD = 0). The decisions go to `lod_choices`;
+//! frustum-culled (flag `LOD_CULLED`: they keep N_LOD for β of Eq. 8 and
+//! draw nothing). The decisions go to `lod_choices`;
 //! `lipp.lod_scan` ([`scan`]) turns them into first strands and the
 //! rasterizer's indirect dispatch.
 //!
@@ -31,6 +32,7 @@
 //! `density_compensation`).
 
 pub mod footprint;
+pub mod occlusion;
 pub mod scan;
 
 use super::dom::{LightFrame, light_frames};
@@ -274,9 +276,8 @@ pub fn choose(
     } else {
         0.0
     };
-    let strands = if culled {
-        0
-    } else if p.strand_lod {
+    // A culled bundle keeps its N_LOD for β (lipp.lod_scan draws none).
+    let strands = if p.strand_lod {
         lod_strands(l, b.strands, delta)
     } else {
         b.strands
@@ -477,9 +478,9 @@ mod tests {
         );
         assert_eq!(bound, camera);
         assert!(camera.strands * 5 < expect as u32);
-        // No light with a map: nothing to draw.
+        // No light with a map: culled (the scan draws none of its strands).
         let dark = decide_lit(&p, 1.0, 0, 0.02, &[]);
-        assert_eq!((dark.strands, dark.flags), (0, LOD_CULLED));
+        assert_eq!(dark.flags, LOD_CULLED);
     }
 
     #[test]

@@ -6,14 +6,17 @@
 //! over all drawn strands (a workgroup per strand), so each bundle needs its
 //! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
 //! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
-//! drawn, Σ N), whose last two words give `lipp.shade` the fraction β of
-//! Eq. 8 (Σ N over the bundles the decision was for: not another groom's).
+//! drawn, Σ N, Σ N_LOD). A culled or occluded bundle draws nothing (its
+//! `bundle_lod` count is 0) but its N_LOD counts in β = Σ N_LOD / Σ N of
+//! Eq. 8, over the bundles the decision was for (not another groom's): β is
+//! the fraction of strands the LOD removed, which culling must not change.
 //! One workgroup of 256 threads, each owning a contiguous run of bundles,
 //! scans their sums in workgroup memory (shaders/lipp/lod_scan.wgsl); the
 //! CPU kernel computes the same values sequentially.
 
 use super::super::{
-    BUNDLE_WORDS, BundleLod, BundleRecord, LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
+    ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_NOT_DRAWN,
+    LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
@@ -68,11 +71,15 @@ impl CpuKernel for ScanKernel {
             .min(bundles.len() / BUNDLE_WORDS)
             .min(choices.len() / LOD_WORDS)
             .min(out.len() / LOD_WORDS);
-        let (mut total, mut full) = (0u32, 0u32);
+        let (mut total, mut full, mut kept) = (0u32, 0u32, 0u32);
         for b in 0..count {
             let mut lod = BundleLod::load(&choices, b);
             if lod.flags & LOD_OTHER_GROOM == 0 {
                 full = full.wrapping_add(BundleRecord::load(&bundles, b).strands);
+                kept = kept.wrapping_add(lod.strands);
+            }
+            if lod.flags & LOD_NOT_DRAWN != 0 {
+                lod.strands = 0;
             }
             lod.first_strand = total;
             total = total.wrapping_add(lod.strands);
@@ -82,22 +89,31 @@ impl CpuKernel for ScanKernel {
         args.store(0, total.min(MAX_GROUPS_X));
         args.store(1, 1);
         args.store(2, 1);
-        args.store(3, total);
-        // β of Lipp Eq. 8 is word 3 / word 4.
-        args.store(4, full);
+        args.store(ARGS_DRAWN, total);
+        // β of Lipp Eq. 8 is word 5 / word 4.
+        args.store(ARGS_ALL, full);
+        args.store(ARGS_KEPT, kept);
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::super::{LOD_CULLED, LOD_OCCLUDED};
     use super::*;
     use crate::kernel::harness::Harness;
     use strandgraph_graph::Quantities;
 
-    /// Bundles drawing 10, 0 (culled), 0 (another groom's) and 5 strands of 20.
+    /// Bundles keeping 10, 7 (frustum-culled), 0 (another groom's), 5 and
+    /// 3 (occluded) strands of 20.
     #[test]
-    fn first_strands_are_the_running_sum_and_beta_counts_only_this_groom() {
-        let counts = [(10, 0), (0, 1), (0, LOD_OTHER_GROOM), (5, 0)];
+    fn first_strands_are_the_running_sum_and_beta_counts_kept_strands_of_this_groom() {
+        let counts = [
+            (10, 0),
+            (7, LOD_CULLED),
+            (0, LOD_OTHER_GROOM),
+            (5, 0),
+            (3, LOD_OCCLUDED),
+        ];
         let mut bundles = Vec::new();
         let mut choices = Vec::new();
         for (n, flags) in counts {
@@ -109,18 +125,25 @@ mod tests {
             choices.extend([n, 9, 123, flags]);
         }
         let mut h = Harness::new(Quantities {
-            bundles: 4,
+            bundles: counts.len() as u64,
             ..Default::default()
         });
         h.buffer("hairmesh.bundles", bundles)
             .buffer("lod_choices", choices)
-            .buffer("bundle_lod", vec![0; 16])
+            .buffer("bundle_lod", vec![0; 4 * counts.len()])
             .buffer("raster_args", vec![0; 8]);
         h.run(&ScanKernel, 1, SCAN_GROUP);
         let lod = h.read("bundle_lod");
         let firsts: Vec<u32> = lod.chunks(4).map(|w| w[2]).collect();
-        assert_eq!(firsts, [0, 10, 10, 10]);
+        assert_eq!(firsts, [0, 10, 10, 10, 15]);
+        let drawn: Vec<u32> = lod.chunks(4).map(|w| w[0]).collect();
+        assert_eq!(
+            drawn,
+            [10, 0, 0, 5, 0],
+            "culled and occluded bundles draw nothing"
+        );
         assert!(lod.chunks(4).all(|w| w[1] == 9), "C copied");
-        assert_eq!(&h.read("raster_args")[..5], &[15, 1, 1, 15, 60]);
+        // Drawn 15; β = (10 + 7 + 5 + 3) / (4 · 20).
+        assert_eq!(&h.read("raster_args")[..6], &[15, 1, 1, 15, 80, 25]);
     }
 }

@@ -4,6 +4,7 @@
 //! point's material is its strand's groom (the point record's model), where
 //! `lipp.shade` is run once per groom.
 
+use super::super::{ARGS_ALL, ARGS_KEPT};
 use super::{PointRecord, SLOTS};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
@@ -62,7 +63,7 @@ impl CpuKernel for ShadeKernel {
         let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
         let args = ctx.words("raster_args");
         let delta = if self.0.lod_depth_correction {
-            depth_correction(args.load(3), args.load(4))
+            depth_correction(args.load(ARGS_KEPT), args.load(ARGS_ALL))
         } else {
             0.0
         };
