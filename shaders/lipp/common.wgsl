@@ -16,9 +16,6 @@ const MAX_CONTROL_POINTS: u32 = 129u;
 const MAX_GROUPS_X: u32 = 65535u;
 const LOD_CULLED: u32 = 1u;
 const LOD_OTHER_GROOM: u32 = 2u;
-const LOD_OCCLUDED: u32 = 4u;
-// lipp::LOD_NOT_DRAWN: culled or occluded, drawing none of its N_LOD.
-const LOD_NOT_DRAWN: u32 = 5u;
 // payload::DEPTH_MAX, the sub-pixel snap grid.
 const DEPTH_MAX: f32 = 16777215.0;
 // payload::INV_DEPTH_MAX: 1 / DEPTH_MAX rounded once to f32 (0x33800001).
@@ -30,18 +27,6 @@ const F32_MAX: f32 = 3.40282347e38;
 const F32_MIN: f32 = -3.40282347e38;
 // payload::EMPTY as the two words WGSL sees.
 const EMPTY_WORD: u32 = 0xFFFFFFFFu;
-
-// lod::occlusion::BOX_BITS_SHIFT.
-const BOX_BITS_SHIFT: u32 = 16u;
-
-// lod::occlusion::segment_hidden: whether the segment between control
-// points at wa <= wb of a bundle of n layers lies in one Hermite piece
-// whose box lipp.occlusion found hidden (bits of its flags).
-fn segment_hidden(flags: u32, n: u32, wa: f32, wb: f32) -> bool {
-    let j = min(u32(floor(wa * f32(n - 1u))), n - 2u);
-    let k = min(u32(floor(wb * f32(n - 1u))), n - 2u);
-    return j == k && ((flags >> BOX_BITS_SHIFT) >> j & 1u) != 0u;
-}
 
 // lipp::unit: 24 bits of a hash in [0, 1).
 fn unit(h: u32) -> f32 {

@@ -4,7 +4,7 @@
 // contiguous run of bundles; the lanes' sums are scanned in workgroup memory
 // (Hillis and Steele), then each lane writes its run.
 
-#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_NOT_DRAWN}
+#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED}
 
 struct ScanParams {
     // Scene quantity: bundles packed.
@@ -27,9 +27,9 @@ var<workgroup> sums: array<u32, SCAN_GROUP>;
 var<workgroup> full_sums: array<u32, SCAN_GROUP>;
 var<workgroup> kept_sums: array<u32, SCAN_GROUP>;
 
-// scan.rs: a culled or occluded bundle draws none of the strands it keeps.
+// scan.rs: a frustum-culled bundle draws none of the strands it keeps.
 fn drawn(b: u32) -> u32 {
-    return select(lod_choices[b * LOD_WORDS], 0u, (lod_choices[b * LOD_WORDS + 3u] & LOD_NOT_DRAWN) != 0u);
+    return select(lod_choices[b * LOD_WORDS], 0u, (lod_choices[b * LOD_WORDS + 3u] & LOD_CULLED) != 0u);
 }
 
 @compute @workgroup_size(256)

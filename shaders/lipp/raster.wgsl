@@ -15,7 +15,7 @@
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen, near_clip, clip_at, clip_at3}
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, segment_hidden, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
@@ -262,16 +262,9 @@ fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, p
         let bits_b = strip_bits(strip, 1u, st.uv, per_sample);
         let bits_c = strip_bits(strip, 2u, st.uv, per_sample);
         let bits_d = strip_bits(strip, 3u, st.uv, per_sample);
-        // lipp.occlusion's hidden boxes of the strand's bundle.
-        let flags = bundle_lod[st.bundle_index * LOD_WORDS + 3u];
         for (var m = 0u; m < strip_segments(strip); m++) {
-            let a = strip_point(strip, m);
-            let b = strip_point(strip, m + 1u);
-            if segment_hidden(flags, st.bundle.layers, a.w, b.w) {
-                continue;
-            }
             let bits = pick_bits(bits_a, bits_b, bits_c, bits_d, m);
-            draw(a, strip_tangent(strip, m), b, strip_tangent(strip, m + 1u), bits, per_sample);
+            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), bits, per_sample);
         }
         // smLayer is rewritten by the next strand.
         workgroupBarrier();

@@ -33,12 +33,6 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
     return shade_point(shading_of(params), pos, sm.tangent, strand, sm.ao, params.model_index, delta);
 }
 
-// shade::filter_reads: payloads as (low, high) words, compared as u64.
-fn filter_reads(layers: u32, layer: u32, centre: vec2<u32>, p: vec2<u32>) -> bool {
-    let nearer = p.y < centre.y || (p.y == centre.y && p.x < centre.x);
-    return params.filter_layers_only == 0u || layers > 2u || layer == 0u || is_empty(centre) || nearer;
-}
-
 @compute @workgroup_size(64)
 fn shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixels = params.width * params.height;
@@ -50,11 +44,10 @@ fn shade(@builtin(global_invocation_id) gid: vec3<u32>) {
     let y = i / params.width;
     // lipp::gbuffer_layers.
     let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
-    let centre = gbuffer[i];
     for (var layer = 0u; layer < layers; layer++) {
         let p = gbuffer[layer * pixels + i];
         var c = vec4<f32>(0.0);
-        if !is_empty(p) && filter_reads(layers, layer, centre, p) {
+        if !is_empty(p) {
             c = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
         }
         shaded[layers * i + layer] = c;

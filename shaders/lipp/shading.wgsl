@@ -49,9 +49,6 @@ struct ShadeParams {
     probe_specular: u32,
     // lipp.reference_shade: the point slots to shade (0 in lipp.shade).
     slots: u32,
-    // lipp.shade: the conservative layer only where lipp.filter reads it.
-    filter_layers_only: u32,
-    padding: u32,
 }
 
 // shade::ShadeParams as the shading reads it (booleans as 0/1).

@@ -278,26 +278,6 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // Bundles and their pieces behind the head's Hi-Z skipped
-    // (passes/src/lipp/lod/occlusion.rs).
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F+L, no occlusion culling",
-        graph: LIPP,
-        overrides: &["occlusion.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    // The conservative layer shaded everywhere, not only where the filter
-    // reads it (passes/src/lipp/shade.rs).
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F+L, every layer shaded",
-        graph: LIPP,
-        overrides: &["shade.filter_layers_only=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 2",

@@ -127,12 +127,10 @@ impl PassParams for FilterParams {
                 format!("{} is not in (0, 1) pixels", self.centre_diameter),
             ));
         }
-        // lipp.shade's filter_layers_only relies on a flyaway being nearer.
         for (name, v) in [
             ("s_parallel", self.s_parallel),
             ("s_perp", self.s_perp),
             ("sigma_c", self.sigma_c),
-            ("front_threshold", self.front_threshold),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Invalid::new(name, format!("{v} must be positive")));

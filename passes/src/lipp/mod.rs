@@ -131,15 +131,14 @@ impl Corner {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct BundleLod {
     /// N_LOD (Eq. 1); 0 for another groom's bundle. In `lod_choices` a
-    /// culled or occluded bundle keeps its N_LOD (β of Eq. 8 counts it);
+    /// frustum-culled bundle keeps its N_LOD (β of Eq. 8 counts it);
     /// `lipp.lod_scan` draws none of its strands (`bundle_lod` holds 0).
     pub strands: u32,
     /// C, control points per strand (Eq. 4-5).
     pub control_points: u32,
     /// First drawn strand of this bundle in the dispatch's numbering.
     pub first_strand: u32,
-    /// Bit 0: frustum-culled; bit 1: another groom's (not drawn this time);
-    /// bit 2: behind the opaque depth (`lipp.occlusion`).
+    /// Bit 0: frustum-culled; bit 1: another groom's (not drawn this time).
     pub flags: u32,
 }
 
@@ -147,15 +146,11 @@ pub struct BundleLod {
 pub const LOD_CULLED: u32 = 1;
 /// A bundle of another groom than the one a per-model LOD pass decides for.
 pub const LOD_OTHER_GROOM: u32 = 2;
-/// Behind the opaque meshes' depth (`lipp.occlusion`, ours).
-pub const LOD_OCCLUDED: u32 = 4;
-/// Flags of a bundle that draws no strand although the LOD kept some.
-pub const LOD_NOT_DRAWN: u32 = LOD_CULLED | LOD_OCCLUDED;
 
 /// `raster_args` words: the indirect dispatch (0-2), the strands drawn (3),
 /// Σ N of the groom (4) and Σ N_LOD of the groom (5): β of Lipp Eq. 8 is
-/// word 5 / word 4, the strands the LOD keeps whether or not culling then
-/// draws them, so culling a bundle changes no shading.
+/// word 5 / word 4, the strands the LOD keeps whether or not the frustum
+/// cull then draws them: a bundle out of view thins no visible strand.
 pub const ARGS_DRAWN: usize = 3;
 pub const ARGS_ALL: usize = 4;
 pub const ARGS_KEPT: usize = 5;

@@ -39,7 +39,6 @@
 //! (`scenes/graphs/lipp_msaa.ron`); samples beyond its layers are dropped.
 
 use super::assemble::{Assembly, Strands, assemble};
-use super::lod::occlusion::segment_hidden;
 use super::payload::{Sample, pack};
 use super::strand::{ControlPoint, strand_uv};
 use super::walk::Dda;
@@ -387,10 +386,6 @@ impl CpuKernel for RasterKernel {
             target.uv = strand_uv(k);
             let layers = &strands.layers;
             let (active, lanes) = assemble(layers, &rec, &lod, k, &opts, &mut |a, ta, b, tb| {
-                // lipp.occlusion: every sample of it is behind the opaque depth.
-                if segment_hidden(lod.flags, rec.layers(), a.w, b.w) {
-                    return;
-                }
                 if let Some((pa, pb)) = target.project(a, ta, b, tb) {
                     target.segment(&pa, &pb);
                 }

@@ -77,10 +77,6 @@ pub struct ShadeParams {
     pub dom_layer_thickness: f32,
     /// The groom shaded (its material), in the graph's per-model block.
     pub model_index: u32,
-    /// Ours: the conservative layer is shaded only where `lipp.filter` can
-    /// read it (the centre layer empty, or the conservative hit nearer);
-    /// elsewhere it is written black. MSAA's sample layers are all shaded.
-    pub filter_layers_only: bool,
 }
 
 impl Default for ShadeParams {
@@ -97,7 +93,6 @@ impl Default for ShadeParams {
             dom_layers: 4,
             dom_layer_thickness: 0.02,
             model_index: 0,
-            filter_layers_only: true,
         }
     }
 }
@@ -135,8 +130,6 @@ crate::gpu_block! {
         /// `lipp.reference_shade` only: point slots to shade (the mesh
         /// strands × [`super::reference::SLOTS`]); 0 here.
         slots: u32,
-        filter_layers_only: u32,
-        padding: u32,
     }
 }
 
@@ -157,8 +150,6 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         model_index: p.model_index,
         probe_specular: flag(p.probe_specular),
         slots,
-        filter_layers_only: flag(p.filter_layers_only),
-        padding: 0,
     }
 }
 
@@ -406,15 +397,6 @@ pub fn load_sh(w: &Words<'_>) -> [[f32; 3]; 9] {
     })
 }
 
-/// Whether `lipp.filter` can read layer `layer` of a pixel whose centre
-/// sample is `centre` and this layer's is `p` (`filter_layers_only`): the
-/// conservative sample only where the centre layer is empty or it is nearer
-/// (the filter's flyaway test asks it to be `front_threshold` > 0 nearer;
-/// payloads order by depth).
-pub fn filter_reads(p: &ShadeParams, layers: u32, layer: u32, centre: u64, sample: u64) -> bool {
-    !p.filter_layers_only || layers > 2 || layer == 0 || centre == EMPTY || sample < centre
-}
-
 impl CpuKernel for ShadeKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
@@ -434,12 +416,10 @@ impl CpuKernel for ShadeKernel {
         let layers = super::gbuffer_layers(&g, &out, pixels);
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
-            let centre =
-                super::payload::from_words(g.load(2 * i as usize), g.load(2 * i as usize + 1));
             for layer in 0..layers {
                 let slot = (layer * pixels + i) as usize;
                 let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
-                let c = if p == EMPTY || !filter_reads(&self.0, layers, layer, centre, p) {
+                let c = if p == EMPTY {
                     [0.0; 4]
                 } else {
                     let c = shade_sample(&inp, &unpack(p), x, y);

@@ -32,7 +32,6 @@
 //! `density_compensation`).
 
 pub mod footprint;
-pub mod occlusion;
 pub mod scan;
 
 use super::dom::{LightFrame, light_frames};

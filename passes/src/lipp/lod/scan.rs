@@ -6,7 +6,7 @@
 //! over all drawn strands (a workgroup per strand), so each bundle needs its
 //! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
 //! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
-//! drawn, Σ N, Σ N_LOD). A culled or occluded bundle draws nothing (its
+//! drawn, Σ N, Σ N_LOD). A frustum-culled bundle draws nothing (its
 //! `bundle_lod` count is 0) but its N_LOD counts in β = Σ N_LOD / Σ N of
 //! Eq. 8, over the bundles the decision was for (not another groom's): β is
 //! the fraction of strands the LOD removed, which culling must not change.
@@ -15,7 +15,7 @@
 //! CPU kernel computes the same values sequentially.
 
 use super::super::{
-    ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_NOT_DRAWN,
+    ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED,
     LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
 };
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
@@ -78,7 +78,7 @@ impl CpuKernel for ScanKernel {
                 full = full.wrapping_add(BundleRecord::load(&bundles, b).strands);
                 kept = kept.wrapping_add(lod.strands);
             }
-            if lod.flags & LOD_NOT_DRAWN != 0 {
+            if lod.flags & LOD_CULLED != 0 {
                 lod.strands = 0;
             }
             lod.first_strand = total;
@@ -98,13 +98,12 @@ impl CpuKernel for ScanKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::super::super::{LOD_CULLED, LOD_OCCLUDED};
     use super::*;
     use crate::kernel::harness::Harness;
     use strandgraph_graph::Quantities;
 
     /// Bundles keeping 10, 7 (frustum-culled), 0 (another groom's), 5 and
-    /// 3 (occluded) strands of 20.
+    /// 3 (frustum-culled) strands of 20.
     #[test]
     fn first_strands_are_the_running_sum_and_beta_counts_kept_strands_of_this_groom() {
         let counts = [
@@ -112,7 +111,7 @@ mod tests {
             (7, LOD_CULLED),
             (0, LOD_OTHER_GROOM),
             (5, 0),
-            (3, LOD_OCCLUDED),
+            (3, LOD_CULLED),
         ];
         let mut bundles = Vec::new();
         let mut choices = Vec::new();
@@ -140,7 +139,7 @@ mod tests {
         assert_eq!(
             drawn,
             [10, 0, 0, 5, 0],
-            "culled and occluded bundles draw nothing"
+            "culled bundles draw nothing"
         );
         assert!(lod.chunks(4).all(|w| w[1] == 9), "C copied");
         // Drawn 15; β = (10 + 7 + 5 + 3) / (4 · 20).
