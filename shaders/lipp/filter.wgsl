@@ -41,6 +41,12 @@ struct FilterParams {
 // NDC depth (f32 bits) the next groom's rasterizer is tested against.
 @group(0) @binding(5) var<storage, read_write> hair_depth: array<u32>;
 @group(0) @binding(6) var<storage, read> models: array<ModelData>;
+// lipp.shade's tiles with hair and their count (lipp::tiles).
+@group(0) @binding(7) var<storage, read> filter_tiles: array<u32>;
+@group(0) @binding(8) var<storage, read> filter_args: array<u32>;
+
+// lipp::tiles::TILE, this pass's workgroup size.
+const TILE: u32 = 64u;
 
 fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
@@ -154,9 +160,20 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
+// A workgroup per listed tile, striding past 65,535 of them.
 @compute @workgroup_size(64)
-fn filter_pixels(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+fn filter_pixels(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let count = min(filter_args[3], arrayLength(&filter_tiles));
+    for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
+        filter_pixel(filter_tiles[t] * TILE + lane);
+    }
+}
+
+fn filter_pixel(i: u32) {
     if i >= params.width * params.height {
         return;
     }

@@ -2,7 +2,8 @@
 // invocation per pixel. Port of passes/src/lipp/shade.rs; the shading of a
 // point is shading.wgsl's (shared with the ground truth's
 // reference_shade.wgsl). Writes rgba32f into `shaded` (pixel i: vec4 2i
-// centre layer, 2i+1 conservative layer).
+// centre layer, 2i+1 conservative layer) where a sample is, and lists the
+// workgroup's 64 pixels for lipp.filter if any is (lipp::tiles).
 
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
@@ -19,6 +20,14 @@
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
 @group(0) @binding(6) var<storage, read> raster_args: array<u32>;
 @group(0) @binding(9) var<storage, read_write> shaded: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> filter_tiles: array<u32>;
+// (workgroups, 1, 1, tiles listed): lipp.filter's indirect dispatch.
+@group(0) @binding(12) var<storage, read_write> filter_args: array<atomic<u32>>;
+
+// lipp::MAX_GROUPS_X.
+const MAX_GROUPS_X: u32 = 65535u;
+
+var<workgroup> tile_has_hair: atomic<u32>;
 
 const SHADE_GROUP: u32 = 64u;
 
@@ -34,22 +43,38 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
 }
 
 @compute @workgroup_size(64)
-fn shade(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn shade(
+    @builtin(global_invocation_id) gid: vec3<u32>,
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    if lane == 0u {
+        atomicStore(&tile_has_hair, 0u);
+    }
+    workgroupBarrier();
     let pixels = params.width * params.height;
     let i = gid.x;
-    if i >= pixels {
-        return;
-    }
-    let x = i % params.width;
-    let y = i / params.width;
-    // lipp::gbuffer_layers.
-    let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
-    for (var layer = 0u; layer < layers; layer++) {
-        let p = gbuffer[layer * pixels + i];
-        var c = vec4<f32>(0.0);
-        if !is_empty(p) {
-            c = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
+    if i < pixels {
+        let x = i % params.width;
+        let y = i / params.width;
+        // lipp::gbuffer_layers.
+        let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
+        for (var layer = 0u; layer < layers; layer++) {
+            let p = gbuffer[layer * pixels + i];
+            // The filter reads no colour of an empty sample.
+            if !is_empty(p) {
+                atomicStore(&tile_has_hair, 1u);
+                shaded[layers * i + layer] = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
+            }
         }
-        shaded[layers * i + layer] = c;
+    }
+    workgroupBarrier();
+    // tiles::list.
+    if lane == 0u && (atomicLoad(&tile_has_hair) != 0u || params.hair_tiles == 0u) {
+        let k = atomicAdd(&filter_args[3], 1u);
+        filter_tiles[k] = wg.x;
+        atomicMax(&filter_args[0], min(k + 1u, MAX_GROUPS_X));
+        atomicStore(&filter_args[1], 1u);
+        atomicStore(&filter_args[2], 1u);
     }
 }

@@ -49,6 +49,9 @@ struct ShadeParams {
     probe_specular: u32,
     // lipp.reference_shade: the point slots to shade (0 in lipp.shade).
     slots: u32,
+    // lipp.shade: list only the tiles with hair (lipp::tiles).
+    hair_tiles: u32,
+    padding: u32,
 }
 
 // shade::ShadeParams as the shading reads it (booleans as 0/1).

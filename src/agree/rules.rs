@@ -128,6 +128,14 @@ static EXCEPTIONS: &[Exception] = &[
         why: "as kulikov.sort: a segment takes its slot in a tile's list with an atomicAdd, so the order within a list is arrival order; the resolve keeps, per sample, the nearest fragment whatever the order",
     },
     Exception {
+        kind: "lipp.shade",
+        binding: "filter_tiles",
+        on: On::Every,
+        rule: Rule::Multiset,
+        outliers: 0.0,
+        why: "a tile with hair takes its slot in the list with an atomicAdd, so the order is arrival order; lipp.filter filters each listed tile on its own",
+    },
+    Exception {
         kind: "reference.fill_strands",
         binding: "reference_segments",
         on: On::Every,

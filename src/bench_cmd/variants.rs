@@ -278,6 +278,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // lipp.filter over every tile of the screen rather than the tiles with
+    // hair lipp.shade lists (passes/src/lipp/tiles.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, filter over every tile",
+        graph: LIPP,
+        overrides: &["shade.hair_tiles=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 2",

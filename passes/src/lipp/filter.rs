@@ -50,6 +50,7 @@
 
 use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::shade::world_position;
+use super::tiles::{self, TILE};
 use super::{add, frame, normalize, scale, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
@@ -57,9 +58,8 @@ use crate::kernel::{Ctx, Words};
 use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::layout::{FrameData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
-use strandgraph_graph::schema::Quantity;
 
-pub const FILTER_GROUP: u32 = 64;
+pub const FILTER_GROUP: u32 = super::tiles::TILE;
 pub const MAX_RADIUS: u32 = 8;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
@@ -175,11 +175,14 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         Binding::write("output"),
         Binding::write("hair_depth"),
         Binding::read("models"),
+        Binding::read("filter_tiles"),
+        Binding::read("filter_args"),
     ]),
     workgroup_size: FILTER_GROUP,
-    dispatch: Dispatch::PerElement {
-        quantity: Quantity::Pixels,
-        per_group: FILTER_GROUP,
+    // A workgroup per tile lipp.shade listed (super::tiles).
+    dispatch: Dispatch::Indirect {
+        binding: "filter_args",
+        word: 0,
     },
     shader: Shader::compute("lipp/filter.wgsl", "filter_pixels"),
     kernel: |p| Box::new(FilterKernel(*p)),
@@ -483,16 +486,23 @@ impl CpuKernel for FilterKernel {
                 .thickness,
         };
         let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
-        for i in group * FILTER_GROUP..((group + 1) * FILTER_GROUP).min(w * h) {
-            let Some(hair) = filter_pixel(&self.0, &v, i % w, i / w) else {
-                continue;
-            };
-            let i = i as usize;
-            store_rgba16f(&out, i, hair.over(load_rgba16f(&out, i)));
-            // Lipp §3.5: the depth later grooms are tested against.
-            if hair.alpha >= self.0.depth_alpha {
-                depth.store_f32(i, depth.load_f32(i).min(hair.depth));
+        let (tiles, args) = (ctx.words("filter_tiles"), ctx.words("filter_args"));
+        let count = tiles::listed(&args, &tiles);
+        let mut t = group;
+        while t < count {
+            let first = tiles.load(t as usize) * TILE;
+            for i in first..(first + TILE).min(w * h) {
+                let Some(hair) = filter_pixel(&self.0, &v, i % w, i / w) else {
+                    continue;
+                };
+                let i = i as usize;
+                store_rgba16f(&out, i, hair.over(load_rgba16f(&out, i)));
+                // Lipp §3.5: the depth later grooms are tested against.
+                if hair.alpha >= self.0.depth_alpha {
+                    depth.store_f32(i, depth.load_f32(i).min(hair.depth));
+                }
             }
+            t += ctx.workgroups.max(1);
         }
     }
 }

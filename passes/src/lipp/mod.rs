@@ -19,6 +19,7 @@ pub mod raster;
 pub mod reference;
 pub mod shade;
 pub mod strand;
+pub mod tiles;
 pub mod upload;
 pub mod walk;
 

@@ -1,5 +1,7 @@
 //! `lipp.shade`: Lipp §3.4, deferred shading of both G-buffer layers, one
-//! invocation per pixel.
+//! invocation per pixel. Empty samples are not written (nothing reads
+//! them); the tiles with a sample are listed for `lipp.filter`
+//! ([`super::tiles`], `hair_tiles`).
 //!
 //! Position is reconstructed from the 24-bit depth at the pixel centre ("we
 //! use the common approach in deferred engines and reconstruct it from the
@@ -38,6 +40,7 @@ pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
+use super::tiles;
 use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
@@ -47,7 +50,7 @@ use crate::params::{Invalid, PassParams, in_range};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
 
-pub const SHADE_GROUP: u32 = 64;
+pub const SHADE_GROUP: u32 = tiles::TILE;
 const PI: f32 = std::f32::consts::PI;
 
 crate::string_enum! {
@@ -77,6 +80,9 @@ pub struct ShadeParams {
     pub dom_layer_thickness: f32,
     /// The groom shaded (its material), in the graph's per-model block.
     pub model_index: u32,
+    /// Ours: list only the tiles with hair for `lipp.filter` ([`super::tiles`]);
+    /// off, every tile.
+    pub hair_tiles: bool,
 }
 
 impl Default for ShadeParams {
@@ -93,6 +99,7 @@ impl Default for ShadeParams {
             dom_layers: 4,
             dom_layer_thickness: 0.02,
             model_index: 0,
+            hair_tiles: true,
         }
     }
 }
@@ -130,6 +137,9 @@ crate::gpu_block! {
         /// `lipp.reference_shade` only: point slots to shade (the mesh
         /// strands × [`super::reference::SLOTS`]); 0 here.
         slots: u32,
+        /// `lipp.shade` only: list only the tiles with hair.
+        hair_tiles: u32,
+        padding: u32,
     }
 }
 
@@ -150,6 +160,8 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         model_index: p.model_index,
         probe_specular: flag(p.probe_specular),
         slots,
+        hair_tiles: flag(p.hair_tiles),
+        padding: 0,
     }
 }
 
@@ -168,6 +180,8 @@ pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
         Binding::read("dom_layers"),
         Binding::write("shaded"),
         Binding::read("env.prefiltered"),
+        Binding::write("filter_tiles"),
+        Binding::atomic("filter_args"),
     ]),
     workgroup_size: SHADE_GROUP,
     dispatch: Dispatch::PerElement {
@@ -414,19 +428,23 @@ impl CpuKernel for ShadeKernel {
         let inp = Inputs::load(ctx, &f, &model, &lights, &self.0, delta);
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let layers = super::gbuffer_layers(&g, &out, pixels);
+        let mut hair = false;
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
             for layer in 0..layers {
                 let slot = (layer * pixels + i) as usize;
                 let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
-                let c = if p == EMPTY {
-                    [0.0; 4]
-                } else {
-                    let c = shade_sample(&inp, &unpack(p), x, y);
-                    [c[0], c[1], c[2], 1.0]
-                };
-                out.store_vec4((layers * i + layer) as usize, c);
+                // The filter reads no colour of an empty sample.
+                if p == EMPTY {
+                    continue;
+                }
+                hair = true;
+                let c = shade_sample(&inp, &unpack(p), x, y);
+                out.store_vec4((layers * i + layer) as usize, [c[0], c[1], c[2], 1.0]);
             }
+        }
+        if hair || !self.0.hair_tiles {
+            tiles::list(&ctx.words("filter_args"), &ctx.words("filter_tiles"), group);
         }
     }
 }

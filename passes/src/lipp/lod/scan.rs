@@ -136,11 +136,7 @@ mod tests {
         let firsts: Vec<u32> = lod.chunks(4).map(|w| w[2]).collect();
         assert_eq!(firsts, [0, 10, 10, 10, 15]);
         let drawn: Vec<u32> = lod.chunks(4).map(|w| w[0]).collect();
-        assert_eq!(
-            drawn,
-            [10, 0, 0, 5, 0],
-            "culled bundles draw nothing"
-        );
+        assert_eq!(drawn, [10, 0, 0, 5, 0], "culled bundles draw nothing");
         assert!(lod.chunks(4).all(|w| w[1] == 9), "C copied");
         // Drawn 15; β = (10 + 7 + 5 + 3) / (4 · 20).
         assert_eq!(&h.read("raster_args")[..6], &[15, 1, 1, 15, 80, 25]);
