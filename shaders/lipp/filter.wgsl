@@ -5,7 +5,7 @@
 
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
-#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, EMPTY_WORD}
+#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -84,27 +84,17 @@ fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
     return n.xy;
 }
 
-// filter::Partial: one lane's share of a window.
-struct Partial {
-    sum: vec3<f32>,
-    wsum: f32,
-    hc: f32,
-    hcons: f32,
-}
-
-// filter::WINDOW_LANES: lanes sharing a pixel's window, a row each in turn.
-const WINDOW_LANES: u32 = 8u;
-
-var<workgroup> partials: array<Partial, 64>;
-
-// filter::window_rows: the window's rows -r + k, -r + k + 8, ... of pixel
-// (x, y) around a reference sample.
-fn window_rows(x: u32, y: u32, d_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool, k: u32) -> Partial {
+// filter::reconstruct: (filtered colour, alpha).
+fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
-    var part = Partial(vec3<f32>(0.0), 0.0, 0.0, 0.0);
-    for (var dy = -r + i32(k); dy <= r; dy += i32(WINDOW_LANES)) {
+    var sum = vec3<f32>(0.0);
+    var wsum = 0.0;
+    var hc = 0.0;
+    var hcons = 0.0;
+    let d_ref = lin(z_ref);
+    for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let qx = i32(x) + dx;
             let qy = i32(y) + dy;
@@ -122,9 +112,9 @@ fn window_rows(x: u32, y: u32, d_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
             let aq = payload(1u, q);
             if dperp <= params.strip_width {
                 if !is_empty(gq) {
-                    part.hc += 1.0;
+                    hc += 1.0;
                 } else if !is_empty(aq) {
-                    part.hcons += 1.0;
+                    hcons += 1.0;
                 }
             }
             if is_empty(gq) {
@@ -142,40 +132,17 @@ fn window_rows(x: u32, y: u32, d_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
                 wc = exp(-dot(d, d) / (params.sigma_c * params.sigma_c));
             }
             let w = ws * wc;
-            part.sum += cq.xyz * w;
-            part.wsum += w;
+            sum += cq.xyz * w;
+            wsum += w;
         }
     }
-    return part;
-}
-
-// filter::reconstruct: (filtered colour, alpha), by the 8 lanes of pixel
-// (x, y) together. Every lane of the workgroup calls it (it holds
-// barriers); a lane whose pixel needs no reconstruction passes `busy`
-// false and gets zero.
-fn reconstruct(lane: u32, busy: bool, x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
-    let d_ref = lin(z_ref);
-    var part = Partial(vec3<f32>(0.0), 0.0, 0.0, 0.0);
-    if busy {
-        part = window_rows(x, y, d_ref, tp, cp, promoted, lane % WINDOW_LANES);
-    }
-    partials[lane] = part;
-    workgroupBarrier();
-    // The lanes' shares summed in lane order, as filter::reconstruct does.
-    let base = lane - lane % WINDOW_LANES;
-    var t = Partial(vec3<f32>(0.0), 0.0, 0.0, 0.0);
-    for (var k = 0u; k < WINDOW_LANES; k++) {
-        let o = partials[base + k];
-        t = Partial(t.sum + o.sum, t.wsum + o.wsum, t.hc + o.hc, t.hcons + o.hcons);
-    }
-    workgroupBarrier();
     var c = cp.xyz;
-    if t.wsum > 0.0 {
-        c = t.sum / t.wsum;
+    if wsum > 0.0 {
+        c = sum / wsum;
     }
     var alpha = 1.0;
-    if params.opacity_reconstruction != 0u && t.hc + t.hcons > 0.0 {
-        alpha = t.hc / (t.hc + t.hcons);
+    if params.opacity_reconstruction != 0u && hc + hcons > 0.0 {
+        alpha = hc / (hc + hcons);
         if params.true_width != 0u {
             let width = models[params.model_index].thickness * frame.pixels_per_unit / d_ref;
             alpha = true_width_alpha(alpha, params.centre_diameter, width);
@@ -193,8 +160,7 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
-// A workgroup per listed tile, striding past 65,535 of them; the tile's
-// 64 pixels in 8 batches of 8, each pixel's window shared by 8 lanes.
+// A workgroup per listed tile, striding past 65,535 of them.
 @compute @workgroup_size(64)
 fn filter_pixels(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -203,82 +169,27 @@ fn filter_pixels(
 ) {
     let count = min(filter_args[3], arrayLength(&filter_tiles));
     for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
-        let tile = filter_tiles[t];
-        for (var b = 0u; b < TILE / WINDOW_LANES; b++) {
-            filter_pixel(tile * TILE + b * WINDOW_LANES + lane / WINDOW_LANES, lane);
-        }
+        filter_pixel(filter_tiles[t] * TILE + lane);
     }
 }
 
-// filter::filter_pixel for pixel i, with the other lanes of its group.
-fn filter_pixel(i: u32, lane: u32) {
-    let valid = i < params.width * params.height;
-    let writer = valid && lane % WINDOW_LANES == 0u;
+fn filter_pixel(i: u32) {
+    if i >= params.width * params.height {
+        return;
+    }
     let x = i % params.width;
     let y = i / params.width;
-    var g = vec2<u32>(EMPTY_WORD);
-    var a = vec2<u32>(EMPTY_WORD);
-    if valid {
-        g = payload(0u, i);
-        a = payload(1u, i);
-    }
+    let g = payload(0u, i);
+    let a = payload(1u, i);
     let centre = !is_empty(g);
     let cons = !is_empty(a);
-    if params.msaa > 1u || params.enabled == 0u {
-        if writer {
-            resolve_unfiltered(i, x, y, g, centre);
-        }
-        return;
-    }
-    let connect = cons && params.reconnect != 0u;
-    // The reconstruction around the centre hit, or a promoted
-    // conservative-only pixel's (§3.3.2).
-    var first = Sample(1.0, vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
-    var first_colour = vec4<f32>(0.0);
-    if centre {
-        first = unpack_payload(g);
-        first_colour = color(0u, i);
-    } else if connect {
-        first = unpack_payload(a);
-        first_colour = color(1u, i);
-    }
-    let busy = centre || connect;
-    let out_first = reconstruct(lane, busy, x, y, first.depth, screen_tangent(x, y, first), first_colour, !centre);
-    // A flyaway in front of the centre hit.
-    var front = false;
-    var sa = Sample(1.0, vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
-    var flyaway_colour = vec4<f32>(0.0);
-    if centre && connect {
-        sa = unpack_payload(a);
-        front = lin(sa.depth) <= lin(first.depth) - params.front_threshold;
-        flyaway_colour = color(1u, i);
-    }
-    let f = reconstruct(lane, front, x, y, sa.depth, screen_tangent(x, y, sa), flyaway_colour, true);
-    if !writer || !busy {
-        return;
-    }
-    var out = out_first;
-    var depth = first.depth;
-    if front {
-        if params.true_width == 0u {
-            out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
-        } else {
-            // Both strands with their own opacity: the flyaway over the centre.
-            let al = f.w + out.w * (1.0 - f.w);
-            out = vec4<f32>((f.xyz * f.w + out.xyz * out.w * (1.0 - f.w)) / al, al);
-        }
-        depth = sa.depth;
-    }
-    blend(i, x, y, out, depth);
-}
-
-// The MSAA reference resolve (Lipp Fig. 5, "MSAA 8") and, with the filter
-// off, the centre layer as it is (SWR 1).
-fn resolve_unfiltered(i: u32, x: u32, y: u32, g: vec2<u32>, centre: bool) {
+    var out = vec4<f32>(0.0);
+    // NDC depth of the nearest sample the colour came from.
+    var depth = 1.0;
     if params.msaa > 1u {
+        // MSAA reference resolve (Lipp Fig. 5, "MSAA 8").
         var sum = vec3<f32>(0.0);
         var hits = 0u;
-        var depth = 1.0;
         for (var s = 0u; s < min(params.msaa, layer_count()); s++) {
             let q = payload(s, i);
             if !is_empty(q) {
@@ -287,17 +198,48 @@ fn resolve_unfiltered(i: u32, x: u32, y: u32, g: vec2<u32>, centre: bool) {
                 depth = min(depth, unpack_payload(q).depth);
             }
         }
-        if hits > 0u {
-            blend(i, x, y, vec4<f32>(sum / f32(hits), f32(hits) / f32(params.msaa)), depth);
+        if hits == 0u {
+            return;
         }
+        out = vec4<f32>(sum / f32(hits), f32(hits) / f32(params.msaa));
+    } else if params.enabled == 0u {
+        if !centre {
+            return;
+        }
+        out = vec4<f32>(color(0u, i).xyz, 1.0);
+        depth = unpack_payload(g).depth;
     } else if centre {
-        blend(i, x, y, vec4<f32>(color(0u, i).xyz, 1.0), unpack_payload(g).depth);
+        let sg = unpack_payload(g);
+        depth = sg.depth;
+        out = reconstruct(x, y, sg.depth, screen_tangent(x, y, sg), color(0u, i), false);
+        var front = false;
+        if cons && params.reconnect != 0u {
+            let sa = unpack_payload(a);
+            front = lin(sa.depth) <= lin(sg.depth) - params.front_threshold;
+        }
+        if front {
+            // A flyaway in front of the centre hit: blended over it, opacity 1.
+            let sa = unpack_payload(a);
+            let f = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+            if params.true_width == 0u {
+                out = vec4<f32>(f.xyz * f.w + out.xyz * (1.0 - f.w), 1.0);
+            } else {
+                // Both strands with their own opacity: the flyaway over the centre.
+                let a = f.w + out.w * (1.0 - f.w);
+                out = vec4<f32>((f.xyz * f.w + out.xyz * out.w * (1.0 - f.w)) / a, a);
+            }
+            depth = sa.depth;
+        }
+    } else if cons && params.reconnect != 0u {
+        // Promoted conservative-only pixel (§3.3.2).
+        let sa = unpack_payload(a);
+        out = reconstruct(x, y, sa.depth, screen_tangent(x, y, sa), color(1u, i), true);
+        depth = sa.depth;
+    } else {
+        return;
     }
-}
-
-// filter::Hair::over, and the hair depth later grooms test (Lipp §3.5).
-fn blend(i: u32, x: u32, y: u32, out: vec4<f32>, depth: f32) {
     let alpha = out.w;
+    // Read only where hair is blended: most of the screen returns above.
     let scene = textureLoad(output, vec2<u32>(x, y));
     textureStore(output, vec2<u32>(x, y), vec4<f32>(out.xyz * alpha + scene.xyz * (1.0 - alpha), alpha + scene.w * (1.0 - alpha)));
     if alpha >= params.depth_alpha {

@@ -282,48 +282,22 @@ impl Reference {
     }
 }
 
-/// Lanes that share a pixel's window in the WGSL, each taking every eighth
-/// row (ours: the window of a pixel is the filter's whole cost, and one lane
-/// walking all of it left the H100 waiting on loads at the far view).
-pub const WINDOW_LANES: i32 = 8;
-
-/// One lane's share of a window: weighted colour, weight, strip hits.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Partial {
-    pub sum: [f32; 3],
-    pub wsum: f32,
-    pub hc: f32,
-    pub hcons: f32,
-}
-
-impl Partial {
-    fn add(&mut self, o: &Partial) {
-        for k in 0..3 {
-            self.sum[k] += o.sum[k];
-        }
-        self.wsum += o.wsum;
-        self.hc += o.hc;
-        self.hcons += o.hcons;
-    }
-}
-
-/// The window rows −r + k, −r + k + 8, … of pixel (x, y) around a
-/// reference sample at linear depth `d_ref` (lane k's share).
-fn window_rows(
+/// The filtered colour and alpha of pixel (x, y) around a reference sample.
+pub fn reconstruct(
     p: &FilterParams,
     v: &View<'_>,
     x: u32,
     y: u32,
     re: &Reference,
-    d_ref: f32,
-    k: i32,
-) -> Partial {
-    let (tp, cp) = (re.tp, re.cp);
+) -> ([f32; 3], f32) {
+    let (z_ref, tp, cp, promoted) = (re.z, re.tp, re.cp, re.promoted);
     let r = p.radius as i32;
     let sp = p.radius as f32 * p.s_parallel;
     let sq = p.radius as f32 * p.s_perp;
-    let mut part = Partial::default();
-    for dy in (-r + k..=r).step_by(WINDOW_LANES as usize) {
+    let (mut sum, mut wsum) = ([0.0f32; 3], 0.0f32);
+    let (mut hc, mut hcons) = (0.0f32, 0.0f32);
+    let d_ref = linear_depth(v.f, z_ref);
+    for dy in -r..=r {
         for dx in -r..=r {
             let (qx, qy) = (x as i32 + dx, y as i32 + dy);
             if qx < 0 || qy < 0 || qx >= v.width as i32 || qy >= v.height as i32 {
@@ -337,9 +311,9 @@ fn window_rows(
             let (gq, aq) = (v.payload(0, q), v.payload(1, q));
             if dperp <= p.strip_width {
                 if gq != EMPTY {
-                    part.hc += 1.0;
+                    hc += 1.0;
                 } else if aq != EMPTY {
-                    part.hcons += 1.0;
+                    hcons += 1.0;
                 }
             }
             if gq == EMPTY {
@@ -351,7 +325,7 @@ fn window_rows(
             }
             let cq = v.color(0, q);
             let ws = (-(dpar * dpar) / (sp * sp) - dperp * dperp / (sq * sq)).exp();
-            let wc = if re.promoted {
+            let wc = if promoted {
                 1.0
             } else {
                 let d2 = (0..3)
@@ -361,41 +335,23 @@ fn window_rows(
             };
             let w = ws * wc;
             for k in 0..3 {
-                part.sum[k] += cq[k] * w;
+                sum[k] += cq[k] * w;
             }
-            part.wsum += w;
+            wsum += w;
         }
     }
-    part
-}
-
-/// The filtered colour and alpha of pixel (x, y) around a reference sample:
-/// the lanes' shares summed in lane order, as the WGSL sums them.
-pub fn reconstruct(
-    p: &FilterParams,
-    v: &View<'_>,
-    x: u32,
-    y: u32,
-    re: &Reference,
-) -> ([f32; 3], f32) {
-    let cp = re.cp;
-    let d_ref = linear_depth(v.f, re.z);
-    let mut t = Partial::default();
-    for k in 0..WINDOW_LANES {
-        t.add(&window_rows(p, v, x, y, re, d_ref, k));
-    }
-    let c = if t.wsum > 0.0 {
-        [t.sum[0] / t.wsum, t.sum[1] / t.wsum, t.sum[2] / t.wsum]
+    let c = if wsum > 0.0 {
+        [sum[0] / wsum, sum[1] / wsum, sum[2] / wsum]
     } else {
         [cp[0], cp[1], cp[2]]
     };
-    let alpha = if !p.opacity_reconstruction || t.hc + t.hcons == 0.0 {
+    let alpha = if !p.opacity_reconstruction || hc + hcons == 0.0 {
         1.0
     } else if p.true_width {
         let width = v.thickness * v.f.pixels_per_unit / d_ref;
-        true_width_alpha(t.hc / (t.hc + t.hcons), p.centre_diameter, width)
+        true_width_alpha(hc / (hc + hcons), p.centre_diameter, width)
     } else {
-        t.hc / (t.hc + t.hcons)
+        hc / (hc + hcons)
     };
     (c, alpha)
 }
