@@ -5,7 +5,7 @@
 
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
-#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample}
+#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, INV_DEPTH_MAX}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -66,6 +66,16 @@ fn lin(z: f32) -> f32 {
     return linear_depth(frame.near, frame.far, z);
 }
 
+// filter::ndc_depth: the NDC depth at linear depth d > 0 (lin's inverse).
+fn ndc(d: f32) -> f32 {
+    return frame.far * (d - frame.near) / (d * (frame.far - frame.near));
+}
+
+// payload::unpack's depth alone.
+fn payload_depth(p: vec2<u32>) -> f32 {
+    return f32(p.y >> 8u) * INV_DEPTH_MAX;
+}
+
 // filter::screen_tangent.
 fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
     let p = world_position(frame.inv_view_proj, frame.screen, x, y, s.depth);
@@ -89,11 +99,20 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
+    // Per pixel, so that a tap divides by nothing (filter::Window).
+    let k_par = 1.0 / (sp * sp);
+    let k_perp = 1.0 / (sq * sq);
+    let k_c = select(1.0 / (params.sigma_c * params.sigma_c), 0.0, promoted);
+    let strip2 = params.strip_width * params.strip_width;
     var sum = vec3<f32>(0.0);
     var wsum = 0.0;
     var hc = 0.0;
     var hcons = 0.0;
     let d_ref = lin(z_ref);
+    // Within the threshold of the camera, every nearer depth is in the window.
+    let near = d_ref - params.depth_threshold;
+    let z_near = select(-3.40282347e38, ndc(near), near > 0.0);
+    let z_far = ndc(d_ref + params.depth_threshold);
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let qx = i32(x) + dx;
@@ -107,10 +126,10 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
             let dpar = fx * tp.x + fy * tp.y;
             let ox = fx - dpar * tp.x;
             let oy = fy - dpar * tp.y;
-            let dperp = sqrt(ox * ox + oy * oy);
+            let perp2 = ox * ox + oy * oy;
             let gq = payload(0u, q);
             let aq = payload(1u, q);
-            if dperp <= params.strip_width {
+            if perp2 <= strip2 {
                 if !is_empty(gq) {
                     hc += 1.0;
                 } else if !is_empty(aq) {
@@ -120,18 +139,13 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
             if is_empty(gq) {
                 continue;
             }
-            let zq = unpack_payload(gq).depth;
-            if abs(lin(zq) - d_ref) > params.depth_threshold {
+            let zq = payload_depth(gq);
+            if zq < z_near || zq > z_far {
                 continue;
             }
             let cq = color(0u, q);
-            let ws = exp(-(dpar * dpar) / (sp * sp) - dperp * dperp / (sq * sq));
-            var wc = 1.0;
-            if !promoted {
-                let d = cp.xyz - cq.xyz;
-                wc = exp(-dot(d, d) / (params.sigma_c * params.sigma_c));
-            }
-            let w = ws * wc;
+            let d = cp.xyz - cq.xyz;
+            let w = exp(-(dpar * dpar) * k_par - perp2 * k_perp - dot(d, d) * k_c);
             sum += cq.xyz * w;
             wsum += w;
         }

@@ -213,6 +213,12 @@ pub fn linear_depth(f: &FrameData, z: f32) -> f32 {
     f.near * f.far / (f.far - z * (f.far - f.near))
 }
 
+/// NDC depth at linear depth `d` > 0: [`linear_depth`]'s inverse,
+/// increasing in `d`, so a window of linear depths is a window of NDC depths.
+pub fn ndc_depth(f: &FrameData, d: f32) -> f32 {
+    f.far * (d - f.near) / (d * (f.far - f.near))
+}
+
 /// The screen-space direction of world tangent `t` at pixel (x, y), depth z.
 pub fn screen_tangent(f: &FrameData, x: u32, y: u32, s: &Sample) -> [f32; 2] {
     let p = world_position(f, x, y, s.depth);
@@ -294,9 +300,27 @@ pub fn reconstruct(
     let r = p.radius as i32;
     let sp = p.radius as f32 * p.s_parallel;
     let sq = p.radius as f32 * p.s_perp;
+    // Per pixel, so that a tap divides by nothing and takes one exp: the
+    // Gaussians' denominators as factors, the strip test on squares, the
+    // depth window as NDC bounds (the payload's own depth).
+    let (k_par, k_perp) = (1.0 / (sp * sp), 1.0 / (sq * sq));
+    let k_c = if promoted {
+        0.0
+    } else {
+        1.0 / (p.sigma_c * p.sigma_c)
+    };
+    let strip2 = p.strip_width * p.strip_width;
     let (mut sum, mut wsum) = ([0.0f32; 3], 0.0f32);
     let (mut hc, mut hcons) = (0.0f32, 0.0f32);
     let d_ref = linear_depth(v.f, z_ref);
+    // Within the threshold of the camera, every nearer depth is in the window.
+    let near = d_ref - p.depth_threshold;
+    let z_near = if near > 0.0 {
+        ndc_depth(v.f, near)
+    } else {
+        f32::MIN
+    };
+    let z_far = ndc_depth(v.f, d_ref + p.depth_threshold);
     for dy in -r..=r {
         for dx in -r..=r {
             let (qx, qy) = (x as i32 + dx, y as i32 + dy);
@@ -307,9 +331,9 @@ pub fn reconstruct(
             let (fx, fy) = (dx as f32, dy as f32);
             let dpar = fx * tp[0] + fy * tp[1];
             let (ox, oy) = (fx - dpar * tp[0], fy - dpar * tp[1]);
-            let dperp = (ox * ox + oy * oy).sqrt();
+            let perp2 = ox * ox + oy * oy;
             let (gq, aq) = (v.payload(0, q), v.payload(1, q));
-            if dperp <= p.strip_width {
+            if perp2 <= strip2 {
                 if gq != EMPTY {
                     hc += 1.0;
                 } else if aq != EMPTY {
@@ -320,20 +344,14 @@ pub fn reconstruct(
                 continue;
             }
             let zq = unpack(gq).depth;
-            if (linear_depth(v.f, zq) - d_ref).abs() > p.depth_threshold {
+            if zq < z_near || zq > z_far {
                 continue;
             }
             let cq = v.color(0, q);
-            let ws = (-(dpar * dpar) / (sp * sp) - dperp * dperp / (sq * sq)).exp();
-            let wc = if promoted {
-                1.0
-            } else {
-                let d2 = (0..3)
-                    .map(|k| (cp[k] - cq[k]) * (cp[k] - cq[k]))
-                    .sum::<f32>();
-                (-d2 / (p.sigma_c * p.sigma_c)).exp()
-            };
-            let w = ws * wc;
+            let dc2 = (0..3)
+                .map(|k| (cp[k] - cq[k]) * (cp[k] - cq[k]))
+                .sum::<f32>();
+            let w = (-(dpar * dpar) * k_par - perp2 * k_perp - dc2 * k_c).exp();
             for k in 0..3 {
                 sum[k] += cq[k] * w;
             }
