@@ -5,7 +5,7 @@
 
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
-#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, INV_DEPTH_MAX}
+#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, INV_DEPTH_MAX, F32_MIN}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -99,7 +99,7 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
-    // Per pixel, so that a tap divides by nothing (filter::Window).
+    // Per pixel, so that a tap divides by nothing (filter::reconstruct).
     let k_par = 1.0 / (sp * sp);
     let k_perp = 1.0 / (sq * sq);
     let k_c = select(1.0 / (params.sigma_c * params.sigma_c), 0.0, promoted);
@@ -111,7 +111,7 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
     let d_ref = lin(z_ref);
     // Within the threshold of the camera, every nearer depth is in the window.
     let near = d_ref - params.depth_threshold;
-    let z_near = select(-3.40282347e38, ndc(near), near > 0.0);
+    let z_near = select(F32_MIN, ndc(near), near > 0.0);
     let z_far = ndc(d_ref + params.depth_threshold);
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
