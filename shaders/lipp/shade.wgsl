@@ -13,7 +13,7 @@
 #define DOM_LAYERS_BINDING 8
 #define ENV_PREFILTERED_BINDING 10
 #import strandgraph::lipp_dom::frame
-#import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample}
+#import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
@@ -23,9 +23,6 @@
 @group(0) @binding(11) var<storage, read_write> filter_tiles: array<u32>;
 // (workgroups, 1, 1, tiles listed): lipp.filter's indirect dispatch.
 @group(0) @binding(12) var<storage, read_write> filter_args: array<atomic<u32>>;
-
-// lipp::MAX_GROUPS_X.
-const MAX_GROUPS_X: u32 = 65535u;
 
 var<workgroup> tile_has_hair: atomic<u32>;
 
@@ -74,7 +71,9 @@ fn shade(
         let k = atomicAdd(&filter_args[3], 1u);
         filter_tiles[k] = wg.x;
         atomicMax(&filter_args[0], min(k + 1u, MAX_GROUPS_X));
-        atomicStore(&filter_args[1], 1u);
-        atomicStore(&filter_args[2], 1u);
+        if k == 0u {
+            atomicStore(&filter_args[1], 1u);
+            atomicStore(&filter_args[2], 1u);
+        }
     }
 }

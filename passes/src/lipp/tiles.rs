@@ -25,12 +25,16 @@ pub const ARGS_TILES: usize = 3;
 
 /// Appends tile `t` to `filter_tiles` and grows the dispatch in
 /// `filter_args` to cover it (the filter strides past 65,535 workgroups).
+/// The first tile listed sets the dispatch's other two dimensions: every
+/// tile writing them would add two more atomics on the one hot address.
 pub fn list(args: &Words<'_>, tiles: &Words<'_>, t: u32) {
     let k = args.fetch_add(ARGS_TILES, 1);
     tiles.store(k as usize, t);
     args.fetch_max(0, (k + 1).min(MAX_GROUPS_X));
-    args.store(1, 1);
-    args.store(2, 1);
+    if k == 0 {
+        args.store(1, 1);
+        args.store(2, 1);
+    }
 }
 
 /// The tiles listed in `filter_args` (at most what `filter_tiles` holds).
