@@ -220,6 +220,28 @@ fn poly_range(src: Poly, axis: u32) -> vec2<f32> {
     return r;
 }
 
+// Trapezoid::quad's four corners in order (the ends a and b offset by ±
+// their half widths along the normal), as named registers: an array indexed
+// at run time lives in local memory on NVIDIA GPUs, and the raster reads
+// the corners for every pixel.
+struct Quad {
+    a_plus: vec2<f32>,
+    b_plus: vec2<f32>,
+    b_minus: vec2<f32>,
+    a_minus: vec2<f32>,
+}
+
+// The quad as a Poly, for the clipper.
+fn quad_poly(q: Quad) -> Poly {
+    var p: Poly;
+    p.pts[0] = q.a_plus;
+    p.pts[1] = q.b_plus;
+    p.pts[2] = q.b_minus;
+    p.pts[3] = q.a_minus;
+    p.n = 4u;
+    return p;
+}
+
 // raster::geometry::Trapezoid: a projected segment in raster pixels.
 struct Trapezoid {
     valid: bool,
@@ -227,7 +249,7 @@ struct Trapezoid {
     b: vec2<f32>,
     wa: f32,
     wb: f32,
-    quad: Poly,
+    quad: Quad,
 }
 
 // Trapezoid::new: snapped ends and half widths; invalid when degenerate.
@@ -247,11 +269,10 @@ fn trapezoid_new(a_in: vec2<f32>, b_in: vec2<f32>, half_a: f32, half_b: f32, wa:
         return t;
     }
     let n = vec2<f32>(-d.y / len, d.x / len);
-    t.quad.n = 4u;
-    t.quad.pts[0] = vec2<f32>(t.a.x + n.x * ha, t.a.y + n.y * ha);
-    t.quad.pts[1] = vec2<f32>(t.b.x + n.x * hb, t.b.y + n.y * hb);
-    t.quad.pts[2] = vec2<f32>(t.b.x - n.x * hb, t.b.y - n.y * hb);
-    t.quad.pts[3] = vec2<f32>(t.a.x - n.x * ha, t.a.y - n.y * ha);
+    t.quad.a_plus = vec2<f32>(t.a.x + n.x * ha, t.a.y + n.y * ha);
+    t.quad.b_plus = vec2<f32>(t.b.x + n.x * hb, t.b.y + n.y * hb);
+    t.quad.b_minus = vec2<f32>(t.b.x - n.x * hb, t.b.y - n.y * hb);
+    t.quad.a_minus = vec2<f32>(t.a.x - n.x * ha, t.a.y - n.y * ha);
     t.valid = true;
     return t;
 }
@@ -280,8 +301,50 @@ fn model_trapezoid(t: ModelTiles, lod: ModelLod, c0_in: vec4<f32>, c1_in: vec4<f
 }
 
 // Trapezoid::column: the part over pixel column x (Kulikov's TrapezoidSlice).
-fn trapezoid_column(quad: Poly, x: i32) -> Poly {
-    return poly_strip(quad, 0u, f32(x), f32(x) + 1.0);
+fn trapezoid_column(quad: Quad, x: i32) -> Poly {
+    return poly_strip(quad_poly(quad), 0u, f32(x), f32(x) + 1.0);
+}
+
+// Trapezoid::columns: the first and last pixel column the quad touches.
+fn quad_columns(q: Quad) -> vec2<i32> {
+    let lo = min(min(q.a_plus.x, q.b_plus.x), min(q.b_minus.x, q.a_minus.x));
+    let hi = max(max(q.a_plus.x, q.b_plus.x), max(q.b_minus.x, q.a_minus.x));
+    return vec2<i32>(i32(floor(lo)), i32(floor(hi)));
+}
+
+// raster::geometry::edge_span folded into range r: the y extent of edge
+// a-b cut to the column [x0, x0 + 1].
+fn edge_span(a: vec2<f32>, b: vec2<f32>, x0: f32, r: vec2<f32>) -> vec2<f32> {
+    var p = b;
+    var q = a;
+    if a.x < b.x {
+        p = a;
+        q = b;
+    }
+    let lo = max(p.x, x0);
+    let hi = min(q.x, x0 + 1.0);
+    if hi < lo {
+        return r;
+    }
+    var ya = p.y;
+    var yb = q.y;
+    if q.x > p.x {
+        let slope = (q.y - p.y) / (q.x - p.x);
+        ya = p.y + slope * (lo - p.x);
+        yb = p.y + slope * (hi - p.x);
+    }
+    return vec2<f32>(min(r.x, min(ya, yb)), max(r.y, max(ya, yb)));
+}
+
+// Trapezoid::column_span: the quad's y extent over column x, from its
+// edges; (F32_MAX, F32_MIN) where no edge reaches the column.
+fn quad_column_span(q: Quad, x: i32) -> vec2<f32> {
+    let x0 = f32(x);
+    var r = vec2<f32>(F32_MAX, F32_MIN);
+    r = edge_span(q.a_plus, q.b_plus, x0, r);
+    r = edge_span(q.b_plus, q.b_minus, x0, r);
+    r = edge_span(q.b_minus, q.a_minus, x0, r);
+    return edge_span(q.a_minus, q.a_plus, x0, r);
 }
 
 // raster::geometry::edge_area: one edge's clamped height integrated over
@@ -323,11 +386,11 @@ fn edge_area(a: vec2<f32>, b: vec2<f32>, x0: f32, y0: f32) -> f32 {
 
 // Trapezoid::pixel_coverage: the quad's exact area inside pixel (x, y) by
 // edge integration, in registers (composition's three layers per pixel).
-fn quad_pixel_coverage(quad: Poly, x: i32, y: i32) -> f32 {
+fn quad_pixel_coverage(q: Quad, x: i32, y: i32) -> f32 {
     let x0 = f32(x);
     let y0 = f32(y);
-    let s = edge_area(quad.pts[0], quad.pts[1], x0, y0) + edge_area(quad.pts[1], quad.pts[2], x0, y0)
-        + edge_area(quad.pts[2], quad.pts[3], x0, y0) + edge_area(quad.pts[3], quad.pts[0], x0, y0);
+    let s = edge_area(q.a_plus, q.b_plus, x0, y0) + edge_area(q.b_plus, q.b_minus, x0, y0)
+        + edge_area(q.b_minus, q.a_minus, x0, y0) + edge_area(q.a_minus, q.a_plus, x0, y0);
     return min(abs(s), 1.0);
 }
 

@@ -206,8 +206,8 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
         let tt = clamp(dot(c - trap.a, ab) / dot(ab, ab), 0.0, 1.0);
         var coverage = 0.0;
         if params.width_coverage != 0u {
-            let w0 = length(trap.quad.pts[0] - trap.quad.pts[3]);
-            let w1 = length(trap.quad.pts[1] - trap.quad.pts[2]);
+            let w0 = length(trap.quad.a_plus - trap.quad.a_minus);
+            let w1 = length(trap.quad.b_plus - trap.quad.b_minus);
             coverage = clamp(w0 + tt * (w1 - w0), 0.0, 1.0);
         } else {
             coverage = quad_pixel_coverage(trap.quad, u, v);

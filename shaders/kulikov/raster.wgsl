@@ -3,7 +3,8 @@
 //
 // Each lane takes one segment, rasterizes it as a trapezoid (positions and
 // half widths snapped to 1/256 pixel, coverage = exact area of trapezoid ∩
-// pixel by Sutherland-Hodgman clipping), depth-tests every covered pixel
+// pixel from its edges, or by Sutherland-Hodgman clipping with
+// analytic_coverage off), depth-tests every covered pixel
 // against the scene depth at the pixel centre, and writes a 32-bit payload
 // (depth10 << 22 | segment) into 3 ordered layers with chained atomicMin,
 // plus atomicAdd(coverage, round(coverage * 1024)).
@@ -34,7 +35,7 @@
 #define LOD_MODELS_BINDING 4
 #import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
 #import strandgraph::layout::{ModelLod, ModelTiles}
-#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, column_coverage, quad_pixel_coverage, trapezoid_depth_at, morton_code}
+#import strandgraph::kulikov::{TILE, TILE_TEXELS, EMPTY, LAYERS, COVERAGE_SCALE, round_away, model_trapezoid, load_lod, load_tiles, quantize_depth, pack_payload, linear_depth, Poly, poly_range, Trapezoid, trapezoid_column, quad_columns, quad_column_span, column_coverage, quad_pixel_coverage, trapezoid_depth_at, morton_code}
 
 struct RasterParams {
     loop_flattening: u32,
@@ -274,13 +275,26 @@ fn drain() {
     }
 }
 
-// First and last row of a column slice within the grid (empty: first > last).
-fn column_rows(col: Poly, grid_h: i32) -> vec2<i32> {
-    if col.n < 3u {
+// First and last row of a column's y extent within the grid (empty: first > last).
+fn column_rows(span: vec2<f32>, grid_h: i32) -> vec2<i32> {
+    if span.x > span.y {
         return vec2<i32>(1, 0);
     }
-    let r = poly_range(col, 1u);
-    return vec2<i32>(max(i32(floor(r.x)), 0), min(i32(floor(r.y)), grid_h - 1));
+    return vec2<i32>(max(i32(floor(span.x)), 0), min(i32(floor(span.y)), grid_h - 1));
+}
+
+// Cursor::open: column x's rows, from the trapezoid's edges with analytic
+// coverage (lane state in registers); else from its slice, kept in `col`
+// for the clipper.
+fn open_column(seg: Segment, x: i32, grid_h: i32, col: ptr<function, Poly>) -> vec2<i32> {
+    if params.analytic_coverage != 0u {
+        return column_rows(quad_column_span(seg.trap.quad, x), grid_h);
+    }
+    *col = trapezoid_column(seg.trap.quad, x);
+    if (*col).n < 3u {
+        return vec2<i32>(1, 0);
+    }
+    return column_rows(poly_range(*col, 1u), grid_h);
 }
 
 // Counting sort of the workgroup's segments by Morton code; returns the
@@ -357,7 +371,6 @@ fn morton_sort(seg_in: Segment, index: u32, first: u32) -> Segment {
     return seg;
 }
 
-// A pixel is written when its coverage quantises to at least 1/1024: slivers
 // RasterKernel's Cursor::pixel: the trapezoid's area in pixel (x, y) of the
 // open column, from its edges in registers (the talk's analytic coverage)
 // or by clipping the column slice.
@@ -368,6 +381,7 @@ fn pixel_coverage(seg: Segment, col: Poly, x: i32, y: i32) -> f32 {
     return column_coverage(col, y);
 }
 
+// A pixel is written when its coverage quantises to at least 1/1024: slivers
 // thinner than that are float noise that backends need not agree on.
 // round_away, as the CPU kernel's f32::round: WGSL's round() sends exactly
 // half a step (a common coverage on the snapped grid) to 0, and dropped those
@@ -411,9 +425,9 @@ fn raster(
     var x_end = -1;
     var grid_h = 0;
     if seg.valid {
-        let r = poly_range(seg.trap.quad, 0u);
-        x = max(i32(floor(r.x)), 0);
-        x_end = min(i32(floor(r.y)), i32(seg.tiles.grid_w * TILE) - 1);
+        let columns = quad_columns(seg.trap.quad);
+        x = max(columns.x, 0);
+        x_end = min(columns.y, i32(seg.tiles.grid_w * TILE) - 1);
         grid_h = i32(seg.tiles.grid_h * TILE);
     }
     var col: Poly;
@@ -428,8 +442,7 @@ fn raster(
             if x > x_end {
                 break;
             }
-            col = trapezoid_column(seg.trap.quad, x);
-            let rows = column_rows(col, grid_h);
+            let rows = open_column(seg, x, grid_h, &col);
             if rows.x <= rows.y {
                 y = rows.x;
                 y_end = rows.y;
@@ -458,8 +471,7 @@ fn raster(
                         if x > x_end {
                             break;
                         }
-                        col = trapezoid_column(seg.trap.quad, x);
-                        let rows = column_rows(col, grid_h);
+                        let rows = open_column(seg, x, grid_h, &col);
                         if rows.x <= rows.y {
                             y = rows.x;
                             y_end = rows.y;
@@ -483,8 +495,7 @@ fn raster(
             y = 0;
             y_end = -1;
             if has_col {
-                col = trapezoid_column(seg.trap.quad, x);
-                let rows = column_rows(col, grid_h);
+                let rows = open_column(seg, x, grid_h, &col);
                 y = rows.x;
                 y_end = rows.y;
             }

@@ -63,10 +63,16 @@ impl<'l> Cursor<'l> {
         c
     }
 
-    /// Opens column `x`: its slice of the trapezoid and its rows in the grid.
+    /// Opens column `x`: its rows in the grid, from the trapezoid's edges
+    /// with analytic coverage, else from its slice, which the clipper reads.
     fn open(&mut self, trap: &Trapezoid) {
-        self.col = trap.column(self.x);
-        (self.y, self.y_end) = column_rows(&self.col, self.grid_h);
+        let span = if self.analytic {
+            trap.column_span(self.x)
+        } else {
+            self.col = trap.column(self.x);
+            (!self.col.is_empty()).then(|| self.col.range(1))
+        };
+        (self.y, self.y_end) = column_rows(span, self.grid_h);
     }
 
     /// The pixel at (x, y) of the open column, then the next row.
@@ -84,12 +90,12 @@ impl<'l> Cursor<'l> {
     }
 }
 
-/// First and last row of a column slice within the grid (empty: first > last).
-fn column_rows(col: &Poly, grid_h: i32) -> (i32, i32) {
-    if col.is_empty() {
+/// First and last row of a column's y extent within the grid (empty:
+/// first > last).
+fn column_rows(span: Option<(f32, f32)>, grid_h: i32) -> (i32, i32) {
+    let Some((lo, hi)) = span else {
         return (1, 0);
-    }
-    let (lo, hi) = col.range(1);
+    };
     (
         (lo.floor() as i32).max(0),
         (hi.floor() as i32).min(grid_h - 1),
