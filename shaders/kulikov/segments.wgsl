@@ -22,9 +22,23 @@
 @group(0) @binding(#{MODELS_BINDING}) var<storage, read> models: array<ModelData>;
 @group(0) @binding(#{LOD_MODELS_BINDING}) var<storage, read> lod_models: array<ModelLod>;
 
-// cull::drawn_segment: the first model holding `id`, then its LOD.
+// cull::drawn_segment: the model holding `id` (Scene::segment_model's
+// binary search: models number their segments in order), then its LOD.
 fn drawn_segment(id: u32) -> DrawnSegment {
-    for (var m = 0u; m < frame.model_count; m++) {
+    // The last model whose range starts at or before `id`.
+    var m = 0u;
+    var n = frame.model_count;
+    loop {
+        if n <= 1u {
+            break;
+        }
+        let half = n / 2u;
+        if models[m + half].segment_first <= id {
+            m += half;
+        }
+        n -= half;
+    }
+    if frame.model_count > 0u {
         let md = models[m];
         if segment_in_model(md, id) {
             return drawn_in_model(md, load_lod(lod_models[m]), m, id);
