@@ -330,8 +330,8 @@ pub fn run(mut args: Args) -> Result<()> {
         // The first GPU cell of a run is measured twice and the first
         // measurement dropped: on the H100 a run's first cell measured 2 to
         // 4 times slow in about half the runs (close view 7.8 ms, then
-        // 1.79 ms), every pass alike, whatever the warm-up; the cells after
-        // it never did.
+        // 1.79 ms), every pass alike, whatever the warm-up; later cells
+        // seldom did (2 of 65 in one run).
         let mut primed = backend == Backend::Cpu || args.quick;
         // The roofline, on the first scene's screen size. A device that
         // cannot run it (no 64-bit atomics) still gets its rows timed.

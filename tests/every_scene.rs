@@ -5,7 +5,11 @@
 //! placeholder triangle buffer and draw no opaque geometry.
 //!
 //! Kulikov's self-shadowing runs as the voxel march here: the offline bake
-//! is the same for every graph and is tested on its own (bake/tests).
+//! is the same for every graph and is tested on its own (bake/tests). The
+//! references resolve one sample a pixel rather than 64: at this size every
+//! pixel of a groom holds thousands of ribbons, and the 64 samples took half
+//! of this test's ten minutes; the sampling itself is tested at full count
+//! in tests/agree.rs and measured by the bench.
 
 use std::path::{Path, PathBuf};
 use strandgraph::frame::{complete_upload, override_param};
@@ -70,6 +74,16 @@ fn render(scene: &Scene, graph: &Path) -> Result<usize, String> {
     if plan.graph.passes.iter().any(|p| p.kind == "kulikov.shade") {
         override_param(&mut plan, "shade.self_shadow=\"VoxelMarch\"")
             .map_err(|e| format!("{e:?}"))?;
+    }
+    let resolves: Vec<String> = plan
+        .graph
+        .passes
+        .iter()
+        .filter(|p| p.kind == "reference.resolve")
+        .map(|p| format!("{}.samples_per_axis=1", p.name))
+        .collect();
+    for spec in &resolves {
+        override_param(&mut plan, spec).map_err(|e| format!("{e:?}"))?;
     }
     let mut up = upload(scene, W, H);
     complete_upload(&plan, scene, &mut up).map_err(|e| format!("{e:?}"))?;

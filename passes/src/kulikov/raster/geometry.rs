@@ -165,7 +165,7 @@ impl Trapezoid {
     /// vertices are exactly these cut edges' ends. The GPU raster keeps its
     /// lane state in registers with it, where the slice's vertex array lives
     /// in local memory (measured on an H100, 1080p close view: raster
-    /// 1.57 → 0.90 ms; benches/results/kulikov-raster-registers-h100.txt).
+    /// 1.57 → 0.89 ms; benches/results/kulikov-raster-registers-h100.txt).
     pub fn column_span(&self, x: i32) -> Option<(f32, f32)> {
         let p = self.quad.points();
         let x0 = x as f32;
@@ -239,16 +239,20 @@ fn clamped_mean(ya: f32, yb: f32) -> f32 {
 mod tests {
     use super::*;
 
-    #[test]
-    fn edge_integration_matches_the_clipper() {
-        // Pseudo-random trapezoids of every orientation and width.
-        let mut s = 12345u32;
-        let mut rnd = || {
+    /// Xorshift uniform numbers in [0, 1] from `seed`.
+    fn uniform(mut s: u32) -> impl FnMut() -> f32 {
+        move || {
             s ^= s << 13;
             s ^= s >> 17;
             s ^= s << 5;
             s as f32 / u32::MAX as f32
-        };
+        }
+    }
+
+    #[test]
+    fn edge_integration_matches_the_clipper() {
+        // Pseudo-random trapezoids of every orientation and width.
+        let mut rnd = uniform(12345);
         let mut worst = 0.0f32;
         for _ in 0..400 {
             let a = [1.0 + 6.0 * rnd(), 1.0 + 6.0 * rnd()];
@@ -273,13 +277,7 @@ mod tests {
 
     #[test]
     fn column_span_matches_the_clipped_slice() {
-        let mut s = 777u32;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s as f32 / u32::MAX as f32
-        };
+        let mut rnd = uniform(777);
         let mut checked = 0;
         for _ in 0..400 {
             // Axis-aligned ends too: vertical and horizontal edges.
