@@ -7,8 +7,8 @@
 //! Kulikov's self-shadowing runs as the voxel march here: the offline bake
 //! is the same for every graph and is tested on its own (bake/tests). The
 //! references resolve one sample a pixel rather than 64: at this size every
-//! pixel of a groom holds thousands of ribbons, and the 64 samples took half
-//! of this test's ten minutes; the sampling itself is tested at full count
+//! pixel of a groom holds thousands of ribbons, and the 64 samples took
+//! 92 s of this test's 606 s; the sampling itself is tested at full count
 //! in tests/agree.rs and measured by the bench.
 
 use std::path::{Path, PathBuf};
