@@ -102,12 +102,11 @@ fn tile_reaches(m: u32, tlo: vec3<f32>, thi: vec3<f32>, light_count: u32) -> boo
     return false;
 }
 
-// The workgroup's mask, copied once per lane after it is complete: the
-// march tests it for every model of every ray.
-var<private> reached_bits: array<u32, 8>;
-
+// The workgroup's mask, complete after the barrier that follows the tile
+// test. Read from workgroup memory: a private copy indexed at run time
+// would live in local memory.
 fn is_reached(m: u32) -> bool {
-    return m >= MASKED_MODELS || (reached_bits[m / 32u] & (1u << (m % 32u))) != 0u;
+    return m >= MASKED_MODELS || (atomicLoad(&reached[m / 32u]) & (1u << (m % 32u))) != 0u;
 }
 
 struct Hit {
@@ -176,30 +175,61 @@ fn normal_at(x: i32, y: i32, p: vec3<f32>) -> vec3<f32> {
     return to_eye;
 }
 
+// skin_shadow::voxel: density units of voxel i, zero outside the grid.
+fn voxel(m: u32, i: vec3<i32>) -> f32 {
+    let res = i32(params.resolution);
+    if any(i < vec3<i32>(0)) || any(i >= vec3<i32>(res)) {
+        return 0.0;
+    }
+    return f32(density_grid[m * GRID_WORDS + u32((i.z * res + i.y) * res + i.x)]);
+}
+
+// skin_shadow::lerp.
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    return a + (b - a) * t;
+}
+
+// skin_shadow::blend: the trilinear blend of a cell's corners, x first,
+// then y, then z. `front` holds the corners at z, `back` at z + 1, each
+// as (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1).
+fn blend(front: vec4<f32>, back: vec4<f32>, t: vec3<f32>) -> f32 {
+    let z0 = lerp(lerp(front.x, front.y, t.x), lerp(front.z, front.w, t.x), t.y);
+    let z1 = lerp(lerp(back.x, back.y, t.x), lerp(back.z, back.w, t.x), t.y);
+    return lerp(z0, z1, t.z);
+}
+
 // skin_shadow::trilinear: density units at q, trilinear between voxel
-// centres, zero outside the grid.
+// centres, zero outside the grid. Inside, one base index and seven
+// constant offsets; only cells on the border test each corner.
 fn trilinear(m: u32, md: ModelData, size: vec3<f32>, q: vec3<f32>) -> f32 {
     let res = i32(params.resolution);
-    let r = f32(res);
-    var f = vec3<f32>(0.0);
-    for (var a = 0u; a < 3u; a++) {
-        f[a] = (q[a] - md.bounds_min[a]) / size[a] * r - 0.5;
-    }
+    let f = (q - md.bounds_min.xyz) / size * f32(res) - vec3<f32>(0.5);
     let i0f = floor(f);
     let t = f - i0f;
-    let i0 = vec3<i32>(i0f);
-    var sum = 0.0;
-    for (var corner = 0u; corner < 8u; corner++) {
-        let bit = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
-        let idx = i0 + vec3<i32>(bit);
-        if any(idx < vec3<i32>(0)) || any(idx >= vec3<i32>(res)) {
-            continue;
-        }
-        let w3 = select(vec3<f32>(1.0) - t, t, bit == vec3<u32>(1u));
-        let v = u32((idx.z * res + idx.y) * res + idx.x);
-        sum += w3.x * w3.y * w3.z * f32(density_grid[m * GRID_WORDS + v]);
+    let i = vec3<i32>(i0f);
+    if all(i >= vec3<i32>(0)) && all(i < vec3<i32>(res - 1)) {
+        let r = u32(res);
+        let b = m * GRID_WORDS + u32((i.z * res + i.y) * res + i.x);
+        let z = b + r * r;
+        let front = vec4<f32>(
+            f32(density_grid[b]), f32(density_grid[b + 1u]),
+            f32(density_grid[b + r]), f32(density_grid[b + r + 1u]),
+        );
+        let back = vec4<f32>(
+            f32(density_grid[z]), f32(density_grid[z + 1u]),
+            f32(density_grid[z + r]), f32(density_grid[z + r + 1u]),
+        );
+        return blend(front, back, t);
     }
-    return sum;
+    let front = vec4<f32>(
+        voxel(m, i), voxel(m, i + vec3<i32>(1, 0, 0)),
+        voxel(m, i + vec3<i32>(0, 1, 0)), voxel(m, i + vec3<i32>(1, 1, 0)),
+    );
+    let back = vec4<f32>(
+        voxel(m, i + vec3<i32>(0, 0, 1)), voxel(m, i + vec3<i32>(1, 0, 1)),
+        voxel(m, i + vec3<i32>(0, 1, 1)), voxel(m, i + vec3<i32>(1, 1, 1)),
+    );
+    return blend(front, back, t);
 }
 
 // skin_shadow::crossed: strands crossed through model m's grid, `steps`
@@ -293,9 +323,6 @@ fn march_skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         }
     }
     workgroupBarrier();
-    for (var k = 0u; k < 8u; k++) {
-        reached_bits[k] = atomicLoad(&reached[k]);
-    }
     if i >= params.width * params.height {
         return;
     }

@@ -157,35 +157,43 @@ pub fn ray_box(g: &Grid, p: Vec3, dir: Vec3) -> Option<(f32, f32)> {
     (enter < exit).then_some((enter, exit))
 }
 
+/// Density units of voxel `i`, zero outside the grid.
+fn voxel(grid: &Words<'_>, base: u32, r: i64, i: [i64; 3]) -> f32 {
+    if i.iter().any(|&i| i < 0 || i >= r) {
+        return 0.0;
+    }
+    grid.load((i64::from(base) + (i[2] * r + i[1]) * r + i[0]) as usize) as f32
+}
+
+fn lerp(a: f32, b: f32, t: f32) -> f32 {
+    a + (b - a) * t
+}
+
+/// The trilinear blend of a cell's corners, x first, then y, then z:
+/// `front` holds the corners at z, `back` at z + 1, each as (x, y),
+/// (x + 1, y), (x, y + 1), (x + 1, y + 1).
+fn blend(front: [f32; 4], back: [f32; 4], t: [f32; 3]) -> f32 {
+    let face = |c: [f32; 4]| lerp(lerp(c[0], c[1], t[0]), lerp(c[2], c[3], t[0]), t[1]);
+    lerp(face(front), face(back), t[2])
+}
+
 /// The grid's density units at `p`, trilinear between voxel centres with
 /// zero outside the grid: what a 3D texture with a linear sampler and a
 /// zero border returns. Nearest-voxel lookups print the 48³ voxels as
-/// blocks onto the skin.
+/// blocks onto the skin. (The WGSL reads a cell inside the grid from one
+/// base index; the blend is the same.)
 pub fn trilinear(grid: &Words<'_>, base: u32, g: &Grid, p: Vec3) -> f32 {
-    let r = g.resolution as i64;
+    let r = i64::from(g.resolution);
     let f = [0, 1, 2].map(|a| (p[a] - g.min[a]) / g.size[a] * r as f32 - 0.5);
     let i0 = f.map(|f| f.floor());
     let t = [0, 1, 2].map(|a| f[a] - i0[a]);
-    let i0 = i0.map(|i| i as i64);
-    let mut sum = 0.0;
-    for corner in 0..8 {
-        let idx = [0, 1, 2].map(|a| i0[a] + (corner >> a & 1));
-        if idx.iter().any(|&i| i < 0 || i >= r) {
-            continue;
-        }
-        let w: f32 = (0..3)
-            .map(|a| {
-                if corner >> a & 1 == 1 {
-                    t[a]
-                } else {
-                    1.0 - t[a]
-                }
-            })
-            .product();
-        let v = (idx[2] * r + idx[1]) * r + idx[0];
-        sum += w * grid.load((i64::from(base) + v) as usize) as f32;
-    }
-    sum
+    let [x, y, z] = i0.map(|i| i as i64);
+    let at = |dx, dy, dz| voxel(grid, base, r, [x + dx, y + dy, z + dz]);
+    blend(
+        [at(0, 0, 0), at(1, 0, 0), at(0, 1, 0), at(1, 1, 0)],
+        [at(0, 0, 1), at(1, 0, 1), at(0, 1, 1), at(1, 1, 1)],
+        t,
+    )
 }
 
 /// Strands crossed from `p` along unit `dir` up to `max_t` through one
@@ -480,6 +488,37 @@ mod tests {
                 "light {light}: nothing shadowed"
             );
         }
+    }
+
+    #[test]
+    fn trilinear_is_exact_on_linear_densities_and_fades_to_zero_outside() {
+        // 4³ voxels over the unit cube; voxel (x, y, z) holds 1 + x + 2y + 4z.
+        let g = Grid {
+            min: [0.0; 3],
+            size: [1.0; 3],
+            resolution: 4,
+        };
+        let words: Vec<std::sync::atomic::AtomicU32> = (0..64u32)
+            .map(|v| (1 + (v & 3) + 2 * (v >> 2 & 3) + 4 * (v >> 4)).into())
+            .collect();
+        let oob = std::sync::atomic::AtomicU64::new(0);
+        let grid = Words::new(&words, &oob);
+        // Voxel centres are at (i + 0.5) / 4; inside them the blend is exact.
+        let at = |x: f32, y: f32, z: f32| (x * 4.0 - 0.5, y * 4.0 - 0.5, z * 4.0 - 0.5);
+        for p in [[0.2f32, 0.3, 0.4], [0.5, 0.5, 0.5], [0.8, 0.13, 0.6]] {
+            let (x, y, z) = at(p[0], p[1], p[2]);
+            let got = trilinear(&grid, 0, &g, Vec3::from(p));
+            assert!(
+                (got - (1.0 + x + 2.0 * y + 4.0 * z)).abs() < 1e-4,
+                "{p:?}: {got}"
+            );
+        }
+        // On the grid's face the outer half-voxel blends with zero outside.
+        let face = trilinear(&grid, 0, &g, Vec3::new(0.0, 0.625, 0.625));
+        let inner = trilinear(&grid, 0, &g, Vec3::new(0.125, 0.625, 0.625));
+        assert!((face - 0.5 * inner).abs() < 1e-4, "{face} vs {inner}");
+        assert_eq!(trilinear(&grid, 0, &g, Vec3::new(2.0, 0.5, 0.5)), 0.0);
+        assert_eq!(oob.load(std::sync::atomic::Ordering::Relaxed), 0);
     }
 
     #[test]
