@@ -47,6 +47,19 @@ impl Spread {
     }
 }
 
+/// One pass of a measured cell.
+#[derive(Debug, Clone)]
+pub struct PassStats {
+    pub name: String,
+    pub kind: String,
+    /// Its time over frames.
+    pub spread: Spread,
+    /// Median begin and end from the frame's first timestamp, where the
+    /// backend gives spans (ash): with queues overlapping, these show which
+    /// passes a frame waits for.
+    pub span: Option<(f64, f64)>,
+}
+
 /// One measured cell.
 #[derive(Debug, Clone)]
 pub struct Stats {
@@ -54,8 +67,8 @@ pub struct Stats {
     pub total: Spread,
     /// The raster passes' summed time per frame.
     pub raster: Spread,
-    /// Per pass, in plan order: name, kind, spread over frames.
-    pub passes: Vec<(String, String, Spread)>,
+    /// Per pass, in plan order.
+    pub passes: Vec<PassStats>,
     /// Atomics of the raster passes, from the instrumented CPU run.
     pub raster_atomics: u64,
     /// Every frame's per-pass times (JSON only).
@@ -85,7 +98,18 @@ impl Stats {
                     .iter()
                     .filter_map(|f| f.get(i).and_then(|t| t.millis))
                     .collect();
-                (t.name.clone(), t.kind.clone(), Spread::of(&v))
+                let spans: Vec<(f64, f64)> = frames
+                    .iter()
+                    .filter_map(|f| f.get(i).and_then(|t| t.span))
+                    .collect();
+                let begins: Vec<f64> = spans.iter().map(|s| s.0).collect();
+                let ends: Vec<f64> = spans.iter().map(|s| s.1).collect();
+                PassStats {
+                    name: t.name.clone(),
+                    kind: t.kind.clone(),
+                    spread: Spread::of(&v),
+                    span: (!spans.is_empty()).then(|| (median(&begins), median(&ends))),
+                }
             })
             .collect();
         let raster_ms: Vec<f64> = frames
@@ -530,8 +554,8 @@ impl Report {
             line("frame", "", &st.total, ",,");
             let raster_extra = format!("{},{:.0},{frac}", st.raster_atomics, st.atomic_rate());
             line("raster (sum)", "", &st.raster, &raster_extra);
-            for (name, kind, sp) in &st.passes {
-                line(name, kind, sp, ",,");
+            for p in &st.passes {
+                line(&p.name, &p.kind, &p.spread, ",,");
             }
         }
         o
@@ -586,11 +610,15 @@ impl Report {
                         j["passes"] = st
                             .passes
                             .iter()
-                            .map(|(n, k, sp)| {
-                                let mut p = sp.json();
-                                p["pass"] = json!(n);
-                                p["kind"] = json!(k);
-                                p
+                            .map(|p| {
+                                let mut j = p.spread.json();
+                                j["pass"] = json!(p.name);
+                                j["kind"] = json!(p.kind);
+                                if let Some((begin, end)) = p.span {
+                                    j["begin_ms"] = json!(begin);
+                                    j["end_ms"] = json!(end);
+                                }
+                                j
                             })
                             .collect();
                         j["per_frame_ms"] = json!(st.per_frame);
