@@ -3,9 +3,9 @@
 // passes/src/kulikov/motion.rs, which documents the packing.
 //
 // Bindings (group 0): 0 = HistoryParams, then the pass's bindings() in
-// order. store_history: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions,
-// 4 = prev_frame.
-// motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions, 4 = vertex_motion.
+// order. store_history: 1 = frame, 2 = prev_frame.
+// motion: 1 = frame, 2 = clip_positions, 3 = prev_clip_positions (read,
+// then overwritten for the next frame), 4 = vertex_motion.
 #import strandgraph::layout::FrameData
 #import strandgraph::kulikov::round_away
 
@@ -24,10 +24,9 @@ const NOT_TRANSFORMED: u32 = 0u;
 @group(0) @binding(0) var<uniform> params: HistoryParams;
 @group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> clip_positions: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read_write> store_history_prev_clip_positions: array<u32>;
-@group(0) @binding(3) var<storage, read> motion_prev_clip_positions: array<u32>;
+@group(0) @binding(2) var<storage, read_write> prev_frame: FrameData;
+@group(0) @binding(3) var<storage, read_write> prev_clip_positions: array<u32>;
 @group(0) @binding(4) var<storage, read_write> vertex_motion: array<vec2<f32>>;
-@group(0) @binding(4) var<storage, read_write> prev_frame: FrameData;
 
 fn compress(ndc: f32) -> u32 {
     return u32(round_away((clamp(ndc, -1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX));
@@ -37,21 +36,21 @@ fn decompress(code: u32) -> f32 {
     return f32(code) / UNORM_MAX * 2.0 - 1.0;
 }
 
+// motion::pack.
+fn pack(c: vec4<f32>) -> u32 {
+    if c.w > frame.near {
+        return (compress(c.x / c.w) + 1u) | ((compress(c.y / c.w) + 1u) << 16u);
+    }
+    return NOT_TRANSFORMED;
+}
+
 @compute @workgroup_size(256)
-fn store_history(@builtin(global_invocation_id) id: vec3<u32>) {
-    let v = id.x;
-    if v == 0u {
+fn store_history(@builtin(local_invocation_index) lane: u32) {
+    // Binding 0 is every pass's parameter block; this entry needs none.
+    _ = params.vertices;
+    if lane == 0u {
         prev_frame = frame;
     }
-    if v >= params.vertices {
-        return;
-    }
-    let c = clip_positions[v];
-    var packed = NOT_TRANSFORMED;
-    if c.w > frame.near {
-        packed = (compress(c.x / c.w) + 1u) | ((compress(c.y / c.w) + 1u) << 16u);
-    }
-    store_history_prev_clip_positions[v] = packed;
 }
 
 @compute @workgroup_size(256)
@@ -61,7 +60,7 @@ fn motion(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let c = clip_positions[v];
-    let prev = motion_prev_clip_positions[v];
+    let prev = prev_clip_positions[v];
     var m = vec2<f32>(0.0);
     if prev != NOT_TRANSFORMED && c.w > frame.near {
         let p = vec2<f32>(decompress((prev & 0xFFFFu) - 1u), decompress((prev >> 16u) - 1u));
@@ -69,4 +68,5 @@ fn motion(@builtin(global_invocation_id) id: vec3<u32>) {
         m = vec2<f32>((n.x - p.x) * 0.5 * frame.screen.x, (p.y - n.y) * 0.5 * frame.screen.y);
     }
     vertex_motion[v] = m;
+    prev_clip_positions[v] = pack(c);
 }

@@ -4,16 +4,17 @@
 //! positions in the next frame; assume no movement if vertex wasn't
 //! transformed last frame (LOD change); clamped UNORM16 for x and y."
 //!
-//! - `kulikov.motion` reads last frame's compressed NDC (the History buffer
-//!   `prev_clip_positions`: the graph compiler makes this frame's writer wait
-//!   for it) and this frame's `clip_positions`, and writes each vertex's
-//!   screen motion in pixels (now − previous, y down) to `vertex_motion`.
-//! - `kulikov.store_history` compresses this frame's NDC into
-//!   `prev_clip_positions` for the next frame, and keeps this frame's camera
-//!   (`frame`) as `prev_frame` for `kulikov.pixel_motion`'s reprojection.
+//! - `kulikov.motion` reads each vertex's last-frame word from the History
+//!   buffer `prev_clip_positions` and this frame's `clip_positions`, writes
+//!   its screen motion in pixels (now − previous, y down) to
+//!   `vertex_motion`, and overwrites the word with this frame's compressed
+//!   NDC for the next frame. Each invocation reads and writes only its own
+//!   vertex, so the history is updated in place by the pass that reads it.
+//! - `kulikov.store_history` keeps this frame's camera (`frame`) as
+//!   `prev_frame` for next frame's `kulikov.pixel_motion`, after this
+//!   frame's has read it: one workgroup copying 256 bytes, at the frame's end.
 //!
-//! The two kinds share one file because they share one packed format:
-//! `store_history` writes what `motion` reads next frame, and the encoder
+//! The two kinds share one file because they keep one history: the encoder
 //! and decoder ([`pack`], [`motion`]) are tested against each other here.
 //!
 //! A vertex was transformed this frame when its clip w is in front of the
@@ -91,16 +92,11 @@ fn history_gpu(_: &NoParams, q: &Quantities) -> HistoryGpu {
 
 pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
     kind: "kulikov.store_history",
-    summary: "compress this frame's post-transform NDC (clamped UNORM16 x, y) for next frame's motion vectors",
+    summary: "keep this frame's camera as prev_frame for next frame's per-pixel motion",
     source: "Kulikov 2025, 'Motion vectors'",
-    bindings: Some(&[
-        Binding::read("frame"),
-        Binding::read("clip_positions"),
-        Binding::write("prev_clip_positions"),
-        Binding::write("prev_frame"),
-    ]),
+    bindings: Some(&[Binding::read("frame"), Binding::write("prev_frame")]),
     workgroup_size: GROUP,
-    dispatch: PER_VERTEX,
+    dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("kulikov/motion.wgsl", "store_history"),
     kernel: |_| Box::new(StoreKernel),
     gpu: history_gpu,
@@ -109,12 +105,12 @@ pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
 
 pub static MOTION: PassKind<NoParams, HistoryGpu> = PassKind {
     kind: "kulikov.motion",
-    summary: "per-vertex screen motion from last frame's compressed NDC (none where either frame skipped the vertex)",
+    summary: "per-vertex screen motion from last frame's compressed NDC (none where either frame skipped the vertex); then this frame's NDC, clamped UNORM16 x, y, over it for the next",
     source: "Kulikov 2025, 'Motion vectors'",
     bindings: Some(&[
         Binding::read("frame"),
         Binding::read("clip_positions"),
-        Binding::read("prev_clip_positions"),
+        Binding::write("prev_clip_positions"),
         Binding::write("vertex_motion"),
     ]),
     workgroup_size: GROUP,
@@ -135,20 +131,10 @@ fn vertices(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<usize> {
 struct StoreKernel;
 
 impl CpuKernel for StoreKernel {
-    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let frame: FrameData = read(&ctx.words("frame"), 0);
-        let (clip, out) = (
-            ctx.words("clip_positions"),
-            ctx.words("prev_clip_positions"),
-        );
-        for v in vertices(group, ctx) {
-            out.store(v, pack(clip.load_vec4(v), frame.near));
-        }
-        if group == 0 {
-            let (now, prev) = (ctx.words("frame"), ctx.words("prev_frame"));
-            for k in 0..std::mem::size_of::<FrameData>() / 4 {
-                prev.store(k, now.load(k));
-            }
+    fn run_workgroup(&self, _group: u32, ctx: &Ctx<'_>) {
+        let (now, prev) = (ctx.words("frame"), ctx.words("prev_frame"));
+        for k in 0..std::mem::size_of::<FrameData>() / 4 {
+            prev.store(k, now.load(k));
         }
     }
 }
@@ -164,15 +150,11 @@ impl CpuKernel for MotionKernel {
             ctx.words("vertex_motion"),
         );
         for v in vertices(group, ctx) {
-            let m = motion(
-                prev.load(v),
-                clip.load_vec4(v),
-                f.near,
-                f.screen[0],
-                f.screen[1],
-            );
+            let c = clip.load_vec4(v);
+            let m = motion(prev.load(v), c, f.near, f.screen[0], f.screen[1]);
             out.store(2 * v, m[0].to_bits());
             out.store(2 * v + 1, m[1].to_bits());
+            prev.store(v, pack(c, f.near));
         }
     }
 }
