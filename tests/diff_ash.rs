@@ -122,7 +122,7 @@ fn showcase_visibility_matches_cpu_and_wgpu_on_ash() {
     let read_wgpu = |name: &str| wgpu.read(&p.plan, name).unwrap().unwrap();
 
     // Integer bookkeeping before the raster: exact.
-    for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
+    for name in ["lod_models", "lod_args", "atlas_tiles", "raster_args"] {
         assert_eq!(
             read_cpu(name),
             read_ash(&plain, name),

@@ -101,7 +101,7 @@ fn compare_visibility(variant: &str, overrides: &[&str]) {
     frames.print_timings();
 
     // Everything before the raster is integer bookkeeping: exact.
-    for name in ["lod_models", "skin_args", "atlas_tiles", "raster_args"] {
+    for name in ["lod_models", "lod_args", "atlas_tiles", "raster_args"] {
         assert_eq!(frames.cpu(name), frames.gpu(name), "{name} differs");
     }
     report_clip_positions(&frames);

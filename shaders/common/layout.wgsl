@@ -87,7 +87,8 @@ struct ModelLod {
     strand_prefix: u32,
     depth_near: f32,
     depth_far: f32,
-    _pad: u32,
+    // Drawn segments of all earlier models (kulikov::cull::nth_drawn).
+    segment_prefix: u32,
 }
 
 // `atlas_tiles`: one model's part of the atlas (kulikov::tile_alloc::ModelTiles, 8 words).

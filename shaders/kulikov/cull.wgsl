@@ -10,7 +10,7 @@
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
 #define LOD_MODELS_BINDING 3
-#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::kulikov_segments::{frame, models, lod_models, nth_drawn}
 #import strandgraph::layout::ModelData
 #import strandgraph::clip::{transform, clip_to_screen, near_clip}
 #import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
@@ -33,6 +33,9 @@ struct CullParams {
 // Per model: min x, min y, !max x, !max y (all atomicMin).
 @group(0) @binding(7) var<storage, read_write> screen_bounds: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read_write> sort_bins: array<atomic<u32>>;
+// lod::drawn_dispatch at word 4: the dispatch over drawn segments, whose
+// count is word 7.
+@group(0) @binding(9) var<storage, read> lod_args: array<u32>;
 
 const GROUP: u32 = 256u;
 const NONE: u32 = 0xFFFFFFFFu;
@@ -117,22 +120,32 @@ fn test(seg: DrawnSegment, c0_in: vec4<f32>, c1_in: vec4<f32>) -> Verdict {
     return out;
 }
 
+// One invocation per drawn segment (cull::nth_drawn), striding when the
+// dispatch was capped; the round count is workgroup-uniform, so every lane
+// reaches the subgroup operations.
 @compute @workgroup_size(256)
 fn cull(
     @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) index: u32,
     @builtin(subgroup_invocation_id) lane: u32,
 ) {
-    let id = wg.x * GROUP + index;
+    let stride = groups.x * GROUP;
+    let drawn = lod_args[7];
+    for (var first = wg.x * GROUP; first < drawn; first += stride) {
+        cull_one(first + index, lane);
+    }
+}
+
+fn cull_one(d: u32, lane: u32) {
+    let seg = nth_drawn(d);
+    let id = models[seg.model].segment_first + seg.local;
     var v = Verdict(false, vec4<u32>(0u), 0u);
     var model = 0u;
     // No early return: every lane reaches the subgroup operations below.
-    if id < params.segments {
-        let seg = drawn_segment(id);
-        if seg.valid {
-            v = test(seg, clip_positions[seg.va], clip_positions[seg.vb]);
-            model = seg.model;
-        }
+    if seg.valid && id < params.segments {
+        v = test(seg, clip_positions[seg.va], clip_positions[seg.vb]);
+        model = seg.model;
     }
     let word = id / 32u;
     let bit = 1u << (id % 32u);

@@ -24,10 +24,13 @@ struct LodParams {
 @group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> models: array<ModelData>;
 @group(0) @binding(3) var<storage, read_write> lod_models: array<ModelLod>;
-@group(0) @binding(4) var<storage, read_write> skin_args: array<u32>;
+@group(0) @binding(4) var<storage, read_write> lod_args: array<u32>;
 
 // Skinning workgroup size (lod::SKIN_GROUP).
 const SKIN_GROUP: u32 = 64u;
+// lod::DRAWN_GROUP and contract::MAX_COVER_GROUPS.
+const DRAWN_GROUP: u32 = 256u;
+const MAX_GROUPS: u32 = 65535u;
 
 // lod::screen_extent: (clamped screen area, near, far).
 fn screen_extent(m: ModelData) -> vec3<f32> {
@@ -130,8 +133,18 @@ fn lod() {
         lod_models[mi].strand_prefix = prefix;
         prefix += strands;
     }
-    skin_args[0] = (prefix + SKIN_GROUP - 1u) / SKIN_GROUP;
-    skin_args[1] = 1u;
-    skin_args[2] = 1u;
-    skin_args[3] = prefix;
+    // lod::drawn_dispatch: the cull's and the sort's dispatch over drawn segments.
+    var drawn = 0u;
+    for (var mi = 0u; mi < count; mi++) {
+        lod_models[mi].segment_prefix = drawn;
+        drawn += lod_models[mi].strands * lod_models[mi].segments_per_strand;
+    }
+    lod_args[4] = min((drawn + DRAWN_GROUP - 1u) / DRAWN_GROUP, MAX_GROUPS);
+    lod_args[5] = 1u;
+    lod_args[6] = 1u;
+    lod_args[7] = drawn;
+    lod_args[0] = (prefix + SKIN_GROUP - 1u) / SKIN_GROUP;
+    lod_args[1] = 1u;
+    lod_args[2] = 1u;
+    lod_args[3] = prefix;
 }

@@ -47,6 +47,36 @@ fn drawn_segment(id: u32) -> DrawnSegment {
     return DrawnSegment(false, 0u, 0u, 0u, 0u);
 }
 
+// cull::nth_drawn: drawn segment `d` of the LOD's compact numbering (models
+// in order, each model's kept strands, each strand's drawn segments);
+// invalid past the last. Its global id is the model's segment_first + local.
+fn nth_drawn(d: u32) -> DrawnSegment {
+    // The last model whose drawn segments start at or before `d`.
+    var m = 0u;
+    var n = frame.model_count;
+    loop {
+        if n <= 1u {
+            break;
+        }
+        let half = n / 2u;
+        if lod_models[m + half].segment_prefix <= d {
+            m += half;
+        }
+        n -= half;
+    }
+    if frame.model_count > 0u {
+        let lod = load_lod(lod_models[m]);
+        let local = d - lod.segment_prefix;
+        if d >= lod.segment_prefix && local < lod.strands * lod.segments_per_strand {
+            let md = models[m];
+            let strand = local / lod.segments_per_strand;
+            let k = local % lod.segments_per_strand;
+            return drawn_in_model(md, lod, m, md.segment_first + strand * (md.points_per_strand - 1u) + k);
+        }
+    }
+    return DrawnSegment(false, 0u, 0u, 0u, 0u);
+}
+
 // kulikov::world_of_clip.
 fn world_of_clip(c: vec4<f32>) -> vec3<f32> {
     let p = transform(frame.inv_view_proj, c);

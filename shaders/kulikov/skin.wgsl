@@ -13,7 +13,7 @@ struct SkinParams {
 }
 
 @group(0) @binding(0) var<uniform> params: SkinParams;
-@group(0) @binding(1) var<storage, read> skin_args: array<u32>;
+@group(0) @binding(1) var<storage, read> lod_args: array<u32>;
 @group(0) @binding(2) var<storage, read> frame: FrameData;
 @group(0) @binding(3) var<storage, read> models: array<ModelData>;
 @group(0) @binding(4) var<storage, read> lod_models: array<ModelLod>;
@@ -153,7 +153,7 @@ fn apply(mo: RootMotion, p_bind: vec3<f32>) -> vec3<f32> {
 @compute @workgroup_size(64)
 fn skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     _ = params.reserved;
-    let total = skin_args[3];
+    let total = lod_args[3];
     let g = wg.x * SKIN_GROUP + lane;
     if g >= total {
         return;

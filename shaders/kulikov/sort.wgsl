@@ -6,9 +6,9 @@
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
 #define LOD_MODELS_BINDING 3
-#import strandgraph::kulikov_segments::{frame, models, lod_models, drawn_segment}
+#import strandgraph::kulikov_segments::{frame, models, lod_models, nth_drawn}
 #import strandgraph::clip::{clip_to_screen, near_clip}
-#import strandgraph::kulikov::screen_bin
+#import strandgraph::kulikov::{screen_bin, DrawnSegment}
 #import strandgraph::scan::{scan_run, scan_lanes, scan_total, SCAN_LANES}
 #import strandgraph::subgroup::elected
 
@@ -62,27 +62,26 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
 }
 
 // --- scatter: frame, models, lod_models, clip_positions, segment_visibility,
-// sort_offsets, sorted_segments ---
+// sort_offsets, sorted_segments, lod_args ---
 @group(0) @binding(4) var<storage, read> clip_positions: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> segment_visibility: array<u32>;
 @group(0) @binding(6) var<storage, read_write> sort_offsets: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> sorted_segments: array<u32>;
+// lod::drawn_dispatch at word 4: the dispatch over drawn segments, whose
+// count is word 7.
+@group(0) @binding(8) var<storage, read> lod_args: array<u32>;
 
 const GROUP: u32 = 256u;
 const NONE: u32 = 0xFFFFFFFFu;
 
-// ScatterKernel::bucket: the bucket segment `id` goes to, NONE when it is
-// not drawn.
-fn bucket(id: u32) -> u32 {
-    if id >= params.segments || (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
+// ScatterKernel::bucket: the bucket drawn segment `seg` (global `id`) goes
+// to, NONE when it is not visible.
+fn bucket(seg: DrawnSegment, id: u32) -> u32 {
+    if !seg.valid || id >= params.segments || (segment_visibility[id / 32u] & (1u << (id % 32u))) == 0u {
         return NONE;
     }
     if params.enabled == 0u {
         return params.bins;
-    }
-    let seg = drawn_segment(id);
-    if !seg.valid {
-        return NONE;
     }
     let w = frame.screen.x;
     let h = frame.screen.y;
@@ -91,14 +90,26 @@ fn bucket(id: u32) -> u32 {
     return screen_bin(w, h, clip_to_screen(part.a, w, h), clip_to_screen(part.b, w, h));
 }
 
+// One invocation per drawn segment (cull::nth_drawn), striding when the
+// dispatch was capped; the round count is workgroup-uniform.
 @compute @workgroup_size(256)
 fn scatter(
     @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) index: u32,
     @builtin(subgroup_invocation_id) lane: u32,
 ) {
-    let id = wg.x * GROUP + index;
-    let key = bucket(id);
+    let stride = groups.x * GROUP;
+    let drawn = lod_args[7];
+    for (var first = wg.x * GROUP; first < drawn; first += stride) {
+        scatter_one(first + index, lane);
+    }
+}
+
+fn scatter_one(d: u32, lane: u32) {
+    let seg = nth_drawn(d);
+    let id = models[seg.model].segment_first + seg.local;
+    let key = bucket(seg, id);
     if params.aggregate == 0u {
         if key != NONE {
             sorted_segments[atomicAdd(&sort_offsets[key], 1u)] = id;

@@ -15,7 +15,6 @@ use crate::kernel::{CounterValues, Ctx, Words};
 use crate::layout::ModelData;
 use crate::params::PassParams;
 use std::collections::BTreeMap;
-use strandgraph_graph::schema::Quantity;
 
 pub const GROUP: u32 = 256;
 
@@ -67,11 +66,13 @@ pub static CULL: PassKind<CullParams, CullGpu> = PassKind {
         Binding::atomic("segment_visibility"),
         Binding::atomic("screen_bounds"),
         Binding::atomic("sort_bins"),
+        Binding::read("lod_args"),
     ]),
     workgroup_size: GROUP,
-    dispatch: Dispatch::PerElement {
-        quantity: Quantity::Segments,
-        per_group: GROUP,
+    // Over the drawn segments only ([`nth_drawn`]).
+    dispatch: Dispatch::Indirect {
+        binding: "lod_args",
+        word: 4,
     },
     shader: Shader::compute("kulikov/cull.wgsl", "cull"),
     kernel: |p| Box::new(CullKernel(*p)),
@@ -90,6 +91,8 @@ struct CullKernel(CullParams);
 /// A drawn segment: its model, both vertices' global indices, its local index.
 #[derive(Debug, Clone, Copy)]
 pub struct DrawnSegment {
+    /// Its global id (full numbering).
+    pub id: u32,
     pub model: usize,
     pub local: u32,
     pub v0: u32,
@@ -99,6 +102,49 @@ pub struct DrawnSegment {
 /// Maps a global segment id to its drawn vertices, or `None` when LOD dropped it.
 pub fn drawn_segment(scene: &Scene, lods: &[ModelLod], id: u32) -> Option<DrawnSegment> {
     let (m, local) = scene.segment_model(id)?;
+    drawn_in_model(scene, lods, m, local)
+}
+
+/// Drawn segment `d` of the LOD's compact numbering (models in order, each
+/// model's kept strands, each strand's drawn segments), `None` past the
+/// last. The passes that visit drawn segments only (cull, sort) launch
+/// `lod_args`' second dispatch and map each invocation through this, as
+/// `segments.wgsl`'s `nth_drawn` does; their outputs stay in the full
+/// numbering. Kulikov: LOD "reduces the amount of rendered strands", so at
+/// a distance most of the full numbering is not drawn.
+pub fn nth_drawn(scene: &Scene, lods: &[ModelLod], d: u32) -> Option<DrawnSegment> {
+    // The last model whose drawn segments start at or before `d`.
+    let m = lods
+        .partition_point(|l| l.segment_prefix <= d)
+        .checked_sub(1)?;
+    let lod = lods.get(m).filter(|_| m < scene.models.len())?;
+    let local = d - lod.segment_prefix;
+    if local >= lod.drawn() {
+        return None;
+    }
+    let per = scene.models[m].points_per_strand - 1;
+    let (strand, k) = (
+        local / lod.segments_per_strand,
+        local % lod.segments_per_strand,
+    );
+    drawn_in_model(scene, lods, m, strand * per + k)
+}
+
+/// The first drawn-segment index of each [`GROUP`]-wide block workgroup
+/// `group` visits in the dispatch `lod_args` holds at word 4 (one block,
+/// or more where the dispatch was capped: the WGSL's stride loop).
+pub fn drawn_blocks(ctx: &Ctx<'_>, group: u32) -> impl Iterator<Item = u32> {
+    let args = ctx.words("lod_args");
+    let (groups, drawn) = (u64::from(args.load(4).max(1)), u64::from(args.load(7)));
+    let stride = groups * u64::from(GROUP);
+    (0..)
+        .map(move |round| round * stride + u64::from(group * GROUP))
+        .take_while(move |&first| first < drawn)
+        .map(|first| first as u32)
+}
+
+/// Segment `local` of model `m` (full numbering), if the LOD draws it.
+fn drawn_in_model(scene: &Scene, lods: &[ModelLod], m: usize, local: u32) -> Option<DrawnSegment> {
     let md = &scene.models[m];
     let per = md.points_per_strand - 1;
     let (strand, k) = (local / per, local % per);
@@ -109,6 +155,7 @@ pub fn drawn_segment(scene: &Scene, lods: &[ModelLod], id: u32) -> Option<DrawnS
     let (a, b) = lod.segment_vertices(md.points_per_strand, k);
     let base = md.vertex_first + strand * md.points_per_strand;
     Some(DrawnSegment {
+        id: md.segment_first + local,
         model: m,
         local,
         v0: base + a,
@@ -225,19 +272,21 @@ impl CpuKernel for CullKernel {
         let total = ctx.quantities.segments;
         let width = ctx.subgroup_width.max(1);
         let mut local = CounterValues::default();
-        for sub in 0..GROUP.div_ceil(width) {
-            let lanes = (sub * width..((sub + 1) * width).min(GROUP)).map(|l| group * GROUP + l);
+        for (first, sub) in drawn_blocks(ctx, group)
+            .flat_map(|first| (0..GROUP.div_ceil(width)).map(move |sub| (first, sub)))
+        {
+            let lanes = sub * width..((sub + 1) * width).min(GROUP);
             let visible: Vec<Visible> = lanes
-                .filter(|&id| u64::from(id) < total)
-                .filter_map(|id| {
-                    let seg = drawn_segment(&scene, &lods, id)?;
+                .filter_map(|l| nth_drawn(&scene, &lods, first + l))
+                .filter(|seg| u64::from(seg.id) < total)
+                .filter_map(|seg| {
                     let (c0, c1) = (
                         clip.load_vec4(seg.v0 as usize),
                         clip.load_vec4(seg.v1 as usize),
                     );
                     let (b, bin) = self.test(&scene, &hiz, &seg, c0, c1)?;
                     Some(Visible {
-                        id,
+                        id: seg.id,
                         model: seg.model,
                         bounds: b,
                         bin,
@@ -307,6 +356,64 @@ impl CullKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layout::FrameData;
+    use bytemuck::Zeroable;
+
+    #[test]
+    fn the_drawn_numbering_visits_every_drawn_segment_once_in_order() {
+        let model = |segment_first, strand_count, points, vertex_first| ModelData {
+            segment_first,
+            strand_count,
+            points_per_strand: points,
+            vertex_first,
+            ..ModelData::zeroed()
+        };
+        // 4 strands of 9 points, an empty model, 3 of 2 points, 5 of 6 points.
+        let scene = Scene {
+            frame: FrameData::zeroed(),
+            models: vec![
+                model(0, 4, 9, 0),
+                model(32, 0, 4, 36),
+                model(32, 3, 2, 36),
+                model(35, 5, 6, 42),
+            ],
+        };
+        // Keep 3 strands at every other vertex, none, all, 2 at every vertex.
+        let mut lods: Vec<ModelLod> = [(3, 2), (0, 1), (3, 1), (2, 1)]
+            .into_iter()
+            .zip(&scene.models)
+            .map(|((strands, step), m)| ModelLod {
+                strands,
+                vertex_step: step,
+                segments_per_strand: super::super::drawn_segments(m.points_per_strand, step),
+                ..ModelLod::default()
+            })
+            .collect();
+        let mut prefix = 0;
+        for l in &mut lods {
+            l.segment_prefix = prefix;
+            prefix += l.drawn();
+        }
+        let all: Vec<u32> = (0..60)
+            .filter_map(|id| drawn_segment(&scene, &lods, id))
+            .map(|s| s.id)
+            .collect();
+        assert_eq!(prefix as usize, all.len());
+        let visited: Vec<DrawnSegment> = (0..prefix + 5)
+            .map_while(|d| nth_drawn(&scene, &lods, d))
+            .collect();
+        assert_eq!(visited.iter().map(|s| s.id).collect::<Vec<_>>(), all);
+        // The same vertices as the full numbering's lookup.
+        for s in &visited {
+            let f = drawn_segment(&scene, &lods, s.id).unwrap();
+            assert_eq!(
+                (s.model, s.local, s.v0, s.v1),
+                (f.model, f.local, f.v0, f.v1)
+            );
+        }
+        assert!(nth_drawn(&scene, &lods, prefix).is_none());
+        assert!(nth_drawn(&scene, &[], 0).is_none());
+    }
 
     #[test]
     fn fedora_box_culls_except_inside_the_sphere() {

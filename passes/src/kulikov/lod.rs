@@ -13,7 +13,7 @@
 
 use super::payload::MAX_SEGMENTS_PER_MODEL;
 use super::{ModelLod, Scene, drawn_segments, transform};
-use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
+use crate::contract::{Binding, CpuKernel, Dispatch, MAX_COVER_GROUPS, Shader, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::layout::{MODEL_LOD_ENABLED, ModelData};
@@ -88,7 +88,7 @@ pub static LOD: PassKind<LodParams, LodGpu> = PassKind {
         Binding::read("frame"),
         Binding::read("models"),
         Binding::write("lod_models"),
-        Binding::write("skin_args"),
+        Binding::write("lod_args"),
     ]),
     workgroup_size: 1,
     dispatch: Dispatch::Fixed(1),
@@ -118,13 +118,28 @@ impl CpuKernel for LodKernel {
         for (m, l) in lods.iter().enumerate() {
             l.store(&out, m);
         }
-        let total: u32 = lods.iter().map(|l| l.strands).sum();
-        let args = ctx.words("skin_args");
-        args.store(0, total.div_ceil(SKIN_GROUP));
-        args.store(1, 1);
-        args.store(2, 1);
-        args.store(3, total);
+        let args = ctx.words("lod_args");
+        let strands: u32 = lods.iter().map(|l| l.strands).sum();
+        let drawn: u32 = lods.iter().map(ModelLod::drawn).sum();
+        let skin = [strands.div_ceil(SKIN_GROUP), 1, 1, strands];
+        for (k, w) in skin.into_iter().chain(drawn_dispatch(drawn)).enumerate() {
+            args.store(k, w);
+        }
     }
+}
+
+/// Workgroup size of the passes over drawn segments (`kulikov.cull`,
+/// `kulikov.sort`).
+pub const DRAWN_GROUP: u32 = super::cull::GROUP;
+
+/// The indirect dispatch over `drawn` segments: `[groups, 1, 1, drawn]`,
+/// [`DRAWN_GROUP`] a workgroup, at most [`MAX_COVER_GROUPS`] workgroups
+/// (the kernels stride over the rest; the 4th word is the count they read).
+/// `lod_args` holds two dispatches: kept strands (skinning) at word 0, this
+/// at word 4.
+pub fn drawn_dispatch(drawn: u32) -> [u32; 4] {
+    let groups = u64::from(drawn.div_ceil(DRAWN_GROUP)).min(MAX_COVER_GROUPS) as u32;
+    [groups, 1, 1, drawn]
 }
 
 /// Screen-space bounds (pixels, clamped) and view-depth range of a model.
@@ -217,6 +232,7 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
                 strand_prefix: 0,
                 depth_near: near,
                 depth_far: far,
+                segment_prefix: 0,
             }
         })
         .collect();
@@ -240,6 +256,11 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
         }
         l.strand_prefix = prefix;
         prefix += l.strands;
+    }
+    let mut drawn = 0;
+    for l in &mut lods {
+        l.segment_prefix = drawn;
+        drawn += l.drawn();
     }
     lods
 }

@@ -41,6 +41,9 @@ pub struct ModelLod {
     /// Linear view depth range of the model's bounds, for payload depth.
     pub depth_near: f32,
     pub depth_far: f32,
+    /// Drawn segments of all earlier models (for the dispatches over drawn
+    /// segments: [`Scene::nth_drawn`]).
+    pub segment_prefix: u32,
 }
 
 impl ModelLod {
@@ -56,6 +59,7 @@ impl ModelLod {
             strand_prefix: w.load(b + 4),
             depth_near: w.load_f32(b + 5),
             depth_far: w.load_f32(b + 6),
+            segment_prefix: w.load(b + 7),
         }
     }
 
@@ -68,7 +72,12 @@ impl ModelLod {
         w.store(b + 4, self.strand_prefix);
         w.store_f32(b + 5, self.depth_near);
         w.store_f32(b + 6, self.depth_far);
-        w.store(b + 7, 0);
+        w.store(b + 7, self.segment_prefix);
+    }
+
+    /// Segments this model draws.
+    pub fn drawn(&self) -> u32 {
+        self.strands * self.segments_per_strand
     }
 
     /// The two vertex indices (within the strand) of drawn segment `k`.

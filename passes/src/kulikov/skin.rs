@@ -29,7 +29,7 @@ pub static SKIN: PassKind<NoParams, SkinGpu> = PassKind {
     summary: "skin roots to triangles (hairRootSkinningInfo_t) and cache post-transform positions",
     source: "Kulikov 2025, 'Skinning'",
     bindings: Some(&[
-        Binding::read("skin_args"),
+        Binding::read("lod_args"),
         Binding::read("frame"),
         Binding::read("models"),
         Binding::read("lod_models"),
@@ -41,7 +41,7 @@ pub static SKIN: PassKind<NoParams, SkinGpu> = PassKind {
     ]),
     workgroup_size: SKIN_GROUP,
     dispatch: Dispatch::Indirect {
-        binding: "skin_args",
+        binding: "lod_args",
         word: 0,
     },
     shader: Shader::compute("kulikov/skin.wgsl", "skin"),
@@ -113,7 +113,7 @@ impl CpuKernel for SkinKernel {
             ctx.words("mesh.triangles"),
             ctx.words("clip_positions"),
         );
-        let total = ctx.words("skin_args").load(3);
+        let total = ctx.words("lod_args").load(3);
         let lods = scene.lods(ctx);
         for lane in 0..SKIN_GROUP {
             let g = group * SKIN_GROUP + lane;

@@ -7,7 +7,7 @@
 //! indirect dispatch. With sorting off, segments keep arrival order (random,
 //! since strands are shuffled for LOD): the talk's "unsorted" baseline.
 
-use super::cull::{GROUP as CULL_GROUP, drawn_segment, screen_bin};
+use super::cull::{DrawnSegment, GROUP as CULL_GROUP, drawn_blocks, nth_drawn, screen_bin};
 use super::{Scene, clip_to_screen};
 use crate::common::clip::near_clip;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -92,11 +92,13 @@ pub static SORT: PassKind<SortParams, SortGpu> = PassKind {
         Binding::read("segment_visibility"),
         Binding::atomic("sort_offsets"),
         Binding::write("sorted_segments"),
+        Binding::read("lod_args"),
     ]),
     workgroup_size: CULL_GROUP,
-    dispatch: Dispatch::PerElement {
-        quantity: Quantity::Segments,
-        per_group: CULL_GROUP,
+    // Over the drawn segments only (cull::nth_drawn).
+    dispatch: Dispatch::Indirect {
+        binding: "lod_args",
+        word: 4,
     },
     shader: Shader::compute("kulikov/sort.wgsl", "scatter"),
     kernel: |p| Box::new(ScatterKernel(*p)),
@@ -131,16 +133,10 @@ impl CpuKernel for ScanKernel {
 struct ScatterKernel(SortParams);
 
 impl ScatterKernel {
-    /// The bucket segment `id` goes to (the WGSL's `bucket`), `None` when
-    /// it is not drawn.
-    fn bucket(
-        &self,
-        scene: &Scene,
-        lods: &[super::ModelLod],
-        ctx: &Ctx<'_>,
-        id: u32,
-    ) -> Option<u32> {
-        let bits = ctx.words("segment_visibility");
+    /// The bucket drawn segment `seg` goes to (the WGSL's `bucket`),
+    /// `None` when it is not visible.
+    fn bucket(&self, scene: &Scene, ctx: &Ctx<'_>, seg: &DrawnSegment) -> Option<u32> {
+        let (bits, id) = (ctx.words("segment_visibility"), seg.id);
         if u64::from(id) >= ctx.quantities.segments
             || bits.load((id / 32) as usize) & (1 << (id % 32)) == 0
         {
@@ -149,7 +145,6 @@ impl ScatterKernel {
         if !self.0.enabled {
             return Some(ctx.quantities.count(Quantity::Tiles(super::TILE)) as u32);
         }
-        let seg = drawn_segment(scene, lods, id)?;
         let clip = ctx.words("clip_positions");
         let (c0, c1) = (
             clip.load_vec4(seg.v0 as usize),
@@ -177,11 +172,13 @@ impl CpuKernel for ScatterKernel {
         } else {
             1
         };
-        for sub in 0..CULL_GROUP.div_ceil(width) {
-            let ids =
-                (sub * width..((sub + 1) * width).min(CULL_GROUP)).map(|l| group * CULL_GROUP + l);
-            let keyed: Vec<(u32, u32)> = ids
-                .filter_map(|id| Some((self.bucket(&scene, &lods, ctx, id)?, id)))
+        for (first, sub) in drawn_blocks(ctx, group)
+            .flat_map(|first| (0..CULL_GROUP.div_ceil(width)).map(move |sub| (first, sub)))
+        {
+            let lanes = sub * width..((sub + 1) * width).min(CULL_GROUP);
+            let keyed: Vec<(u32, u32)> = lanes
+                .filter_map(|l| nth_drawn(&scene, &lods, first + l))
+                .filter_map(|seg| Some((self.bucket(&scene, ctx, &seg)?, seg.id)))
                 .collect();
             // Buckets in ascending order (the subgroupMin loop), one atomic
             // each; the lanes of a bucket in lane order.

@@ -280,6 +280,7 @@ mod tests {
                 strand_prefix: 0,
                 depth_near: 0.5,
                 depth_far: 10.0,
+                segment_prefix: 0,
             },
             tiles: ModelTiles {
                 first_tile: 0,

@@ -73,6 +73,7 @@ fn harness_clip(clip: &[[f32; 4]], thickness: &[f32], order: &[u32]) -> Harness 
         strand_prefix: 0,
         depth_near: NEAR,
         depth_far: FAR,
+        segment_prefix: 0,
     };
     let mut lods = vec![0u32; ModelLod::WORDS];
     lods[0] = lod.strands;
