@@ -61,6 +61,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &sim::follow::FOLLOW,
     &kulikov::lod::LOD,
     &kulikov::skin::SKIN,
+    &kulikov::skin::SKIN_MOTION,
     &kulikov::density::DENSITY,
     &kulikov::depth_downsample::DEPTH_DOWNSAMPLE,
     &kulikov::cull::CULL,
@@ -75,7 +76,6 @@ pub static PASSES: &[&dyn PassDef] = &[
     &kulikov::pixel_motion::PIXEL_MOTION,
     &kulikov::skin_shadow::SKIN_SHADOW,
     &kulikov::motion::STORE_HISTORY,
-    &kulikov::motion::MOTION,
     // Lipp et al., deferred software rasterization of hair meshes.
     &lipp::lod::LOD,
     &lipp::lod::scan::LOD_SCAN,

@@ -5,7 +5,7 @@
 
 #import strandgraph::layout::{FrameData, ModelData, ModelLod, TriangleData}
 #import strandgraph::clip::transform
-#import strandgraph::kulikov::load_lod
+#import strandgraph::kulikov::{load_lod, round_away}
 
 // The pass has no parameters; the block keeps binding 0 the same for every pass.
 struct SkinParams {
@@ -25,6 +25,11 @@ struct SkinParams {
 @group(0) @binding(7) var<storage, read> groom_skinning: array<vec4<u32>>;
 @group(0) @binding(8) var<storage, read> mesh_triangles: array<TriangleData>;
 @group(0) @binding(9) var<storage, read_write> clip_positions: array<vec4<f32>>;
+// kulikov.skin_motion only (motion.rs): last frame's LOD, the vertex
+// history (read, then this frame's NDC over it) and the motion.
+@group(0) @binding(10) var<storage, read> prev_lod_models: array<ModelLod>;
+@group(0) @binding(11) var<storage, read_write> prev_clip_positions: array<u32>;
+@group(0) @binding(12) var<storage, read_write> vertex_motion: array<vec2<f32>>;
 
 const SKIN_GROUP: u32 = 64u;
 
@@ -150,29 +155,73 @@ fn apply(mo: RootMotion, p_bind: vec3<f32>) -> vec3<f32> {
     return mo.root_now + sum;
 }
 
-@compute @workgroup_size(64)
-fn skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    _ = params.reserved;
-    let total = lod_args[3];
-    let g = wg.x * SKIN_GROUP + lane;
-    if g >= total {
-        return;
+// motion.rs: UNORM16 NDC codes, stored plus one; 0 is "not transformed"
+// (also a History buffer's first contents).
+const UNORM_MAX: f32 = 65534.0;
+const NOT_TRANSFORMED: u32 = 0u;
+
+fn compress(ndc: f32) -> u32 {
+    return u32(round_away((clamp(ndc, -1.0, 1.0) * 0.5 + 0.5) * UNORM_MAX));
+}
+
+fn decompress(code: u32) -> f32 {
+    return f32(code) / UNORM_MAX * 2.0 - 1.0;
+}
+
+// motion::pack.
+fn pack(c: vec4<f32>) -> u32 {
+    if c.w > frame.near {
+        return (compress(c.x / c.w) + 1u) | ((compress(c.y / c.w) + 1u) << 16u);
     }
-    var found = false;
+    return NOT_TRANSFORMED;
+}
+
+// motion::motion: screen motion in pixels (y down), zero where either
+// frame did not transform the vertex.
+fn screen_motion(prev: u32, c: vec4<f32>) -> vec2<f32> {
+    if prev == NOT_TRANSFORMED || !(c.w > frame.near) {
+        return vec2<f32>(0.0);
+    }
+    let p = vec2<f32>(decompress((prev & 0xFFFFu) - 1u), decompress((prev >> 16u) - 1u));
+    let n = vec2<f32>(c.x / c.w, c.y / c.w);
+    return vec2<f32>((n.x - p.x) * 0.5 * frame.screen.x, (p.y - n.y) * 0.5 * frame.screen.y);
+}
+
+// motion::drawn_at: whether a strand of `count` points draws vertex `v` at
+// a vertex step.
+fn drawn_at(v: u32, step: u32, count: u32) -> bool {
+    return v % max(step, 1u) == 0u || v + 1u == count;
+}
+
+// A kept strand after skinning: its model, index among the model's kept
+// strands, first vertex, point count and vertex step.
+struct Skinned {
+    found: bool,
+    model: u32,
+    kept: u32,
+    first: u32,
+    count: u32,
+    step: u32,
+}
+
+// Kept strand g (global kept index): its drawn vertices to clip space.
+fn skin_strand(g: u32) -> Skinned {
+    var out = Skinned(false, 0u, 0u, 0u, 0u, 1u);
     var mi = 0u;
     for (; mi < frame.model_count; mi++) {
         let l = lod_models[mi];
         if g >= l.strand_prefix && g < l.strand_prefix + l.strands {
-            found = true;
+            out.found = true;
             break;
         }
     }
-    if !found {
-        return;
+    if !out.found {
+        return out;
     }
     let model = models[mi];
     let lod = load_lod(lod_models[mi]);
-    let strand = model.strand_first + g - lod.strand_prefix;
+    let kept = g - lod.strand_prefix;
+    let strand = model.strand_first + kept;
     let fc = groom_strands[strand];
     let first = fc.x;
     let count = fc.y;
@@ -193,5 +242,54 @@ fn skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) l
             break;
         }
         v = min(v + lod.vertex_step, count - 1u);
+    }
+    out.model = mi;
+    out.kept = kept;
+    out.first = first;
+    out.count = count;
+    out.step = lod.vertex_step;
+    return out;
+}
+
+@compute @workgroup_size(64)
+fn skin(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    _ = params.reserved;
+    let g = wg.x * SKIN_GROUP + lane;
+    if g < lod_args[3] {
+        skin_strand(g);
+    }
+}
+
+// kulikov.skin_motion: skinning, then each drawn vertex's motion against
+// last frame's history and this frame's NDC over it (motion.rs). Last frame
+// transformed the vertex when its LOD kept the strand (kept strands are a
+// prefix) and drew that vertex: no cleared cache is needed to tell.
+@compute @workgroup_size(64)
+fn skin_motion(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    _ = params.reserved;
+    let g = wg.x * SKIN_GROUP + lane;
+    if g >= lod_args[3] {
+        return;
+    }
+    let s = skin_strand(g);
+    if !s.found {
+        return;
+    }
+    let prev = prev_lod_models[s.model];
+    let had = s.kept < prev.strands;
+    var v = 0u;
+    loop {
+        let i = s.first + v;
+        let c = clip_positions[i];
+        var last = NOT_TRANSFORMED;
+        if had && drawn_at(v, prev.vertex_step, s.count) {
+            last = prev_clip_positions[i];
+        }
+        vertex_motion[i] = screen_motion(last, c);
+        prev_clip_positions[i] = pack(c);
+        if v + 1u >= s.count {
+            break;
+        }
+        v = min(v + s.step, s.count - 1u);
     }
 }

@@ -104,7 +104,7 @@ static EXCEPTIONS: &[Exception] = &[
         why: "f32 lighting packed to halves: exp and pow differ in their last f32 bits on a GPU, which moves a value on a half's rounding boundary by one half-ULP",
     },
     Exception {
-        kind: "kulikov.motion",
+        kind: "kulikov.skin_motion",
         binding: "prev_clip_positions",
         on: On::Every,
         rule: Rule::Unorm16 { steps: 1 },

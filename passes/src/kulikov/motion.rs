@@ -1,33 +1,34 @@
-//! `kulikov.motion` and `kulikov.store_history`: motion vectors from the
-//! post-transform cache (Kulikov, "Motion vectors"):
+//! Motion vectors from the post-transform cache (Kulikov, "Motion vectors"):
 //! "Compress post-transform NDC from current frame; use as last frame
 //! positions in the next frame; assume no movement if vertex wasn't
 //! transformed last frame (LOD change); clamped UNORM16 for x and y."
 //!
-//! - `kulikov.motion` reads each vertex's last-frame word from the History
-//!   buffer `prev_clip_positions` and this frame's `clip_positions`, writes
-//!   its screen motion in pixels (now − previous, y down) to
-//!   `vertex_motion`, and overwrites the word with this frame's compressed
-//!   NDC for the next frame. Each invocation reads and writes only its own
-//!   vertex, so the history is updated in place by the pass that reads it.
-//! - `kulikov.store_history` keeps this frame's camera (`frame`) as
-//!   `prev_frame` for next frame's `kulikov.pixel_motion`, after this
-//!   frame's has read it: one workgroup copying 256 bytes, at the frame's end.
+//! - `kulikov.skin_motion` (skin.rs) skins each drawn vertex, takes its
+//!   screen motion in pixels (now − previous, y down) against the word in
+//!   the History buffer `prev_clip_positions`, and stores this frame's
+//!   compressed NDC over that word: the history is updated in place, in the
+//!   pass that makes the positions, and only for drawn vertices.
+//! - `kulikov.store_history` keeps this frame's camera (`frame`) and LOD
+//!   (`lod_models`) as `prev_frame` and `prev_lod_models`, after this
+//!   frame's readers: one workgroup at the frame's end.
 //!
-//! The two kinds share one file because they keep one history: the encoder
-//! and decoder ([`pack`], [`motion`]) are tested against each other here.
+//! "Wasn't transformed last frame" is read from last frame's LOD: kept
+//! strands are a prefix of each model's list, so a vertex was transformed
+//! when its strand's index among the kept ones is below last frame's kept
+//! count and last frame's vertex step drew it ([`drawn_at`]). A vertex the
+//! LOD dropped keeps a stale word that nothing reads; no pass clears the
+//! post-transform cache or walks the vertices the LOD skips.
 //!
-//! A vertex was transformed this frame when its clip w is in front of the
-//! near plane: the graph clears `clip_positions` before skinning, so a
-//! vertex the LOD skipped reads w = 0.
+//! This file holds the packed format both ends share: the encoder and
+//! decoder ([`pack`], [`motion`]) are tested against each other here.
 
+use super::ModelLod;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::layout::{FrameData, read};
 use crate::params::NoParams;
 use strandgraph_graph::Quantities;
-use strandgraph_graph::schema::Quantity;
 
 const GROUP: u32 = 256;
 /// Largest UNORM16 code used for NDC. Codes are stored plus one, so that
@@ -68,10 +69,11 @@ pub fn motion(prev: u32, c: [f32; 4], near: f32, width: f32, height: f32) -> [f3
     [(nx - px) * 0.5 * width, (py - ny) * 0.5 * height]
 }
 
-const PER_VERTEX: Dispatch = Dispatch::PerElement {
-    quantity: Quantity::Vertices,
-    per_group: GROUP,
-};
+/// Whether a strand of `count` points draws vertex `v` at a vertex step
+/// (every `step`-th vertex and the tip: `ModelLod::segment_vertices`).
+pub fn drawn_at(v: u32, step: u32, count: u32) -> bool {
+    v % step.max(1) == 0 || v + 1 == count
+}
 
 crate::gpu_block! {
     /// `HistoryParams`: vertex count, three pad words.
@@ -83,50 +85,26 @@ crate::gpu_block! {
     }
 }
 
-fn history_gpu(_: &NoParams, q: &Quantities) -> HistoryGpu {
-    HistoryGpu {
-        vertices: count(q.vertices),
-        ..HistoryGpu::default()
-    }
-}
-
 pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
     kind: "kulikov.store_history",
-    summary: "keep this frame's camera as prev_frame for next frame's per-pixel motion",
+    summary: "keep this frame's camera and LOD for next frame's motion vectors",
     source: "Kulikov 2025, 'Motion vectors'",
-    bindings: Some(&[Binding::read("frame"), Binding::write("prev_frame")]),
+    bindings: Some(&[
+        Binding::read("frame"),
+        Binding::read("lod_models"),
+        Binding::write("prev_frame"),
+        Binding::write("prev_lod_models"),
+    ]),
     workgroup_size: GROUP,
     dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("kulikov/motion.wgsl", "store_history"),
     kernel: |_| Box::new(StoreKernel),
-    gpu: history_gpu,
+    gpu: |_, q: &Quantities| HistoryGpu {
+        vertices: count(q.vertices),
+        ..HistoryGpu::default()
+    },
     raster: None,
 };
-
-pub static MOTION: PassKind<NoParams, HistoryGpu> = PassKind {
-    kind: "kulikov.motion",
-    summary: "per-vertex screen motion from last frame's compressed NDC (none where either frame skipped the vertex); then this frame's NDC, clamped UNORM16 x, y, over it for the next",
-    source: "Kulikov 2025, 'Motion vectors'",
-    bindings: Some(&[
-        Binding::read("frame"),
-        Binding::read("clip_positions"),
-        Binding::write("prev_clip_positions"),
-        Binding::write("vertex_motion"),
-    ]),
-    workgroup_size: GROUP,
-    dispatch: PER_VERTEX,
-    shader: Shader::compute("kulikov/motion.wgsl", "motion"),
-    kernel: |_| Box::new(MotionKernel),
-    gpu: history_gpu,
-    raster: None,
-};
-
-/// The vertices of workgroup `group` (clamped to the vertex count).
-fn vertices(group: u32, ctx: &Ctx<'_>) -> std::ops::Range<usize> {
-    let n = ctx.quantities.vertices as usize;
-    let start = (group * GROUP) as usize;
-    start.min(n)..(start + GROUP as usize).min(n)
-}
 
 struct StoreKernel;
 
@@ -136,25 +114,10 @@ impl CpuKernel for StoreKernel {
         for k in 0..std::mem::size_of::<FrameData>() / 4 {
             prev.store(k, now.load(k));
         }
-    }
-}
-
-struct MotionKernel;
-
-impl CpuKernel for MotionKernel {
-    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let f: FrameData = read(&ctx.words("frame"), 0);
-        let (clip, prev, out) = (
-            ctx.words("clip_positions"),
-            ctx.words("prev_clip_positions"),
-            ctx.words("vertex_motion"),
-        );
-        for v in vertices(group, ctx) {
-            let c = clip.load_vec4(v);
-            let m = motion(prev.load(v), c, f.near, f.screen[0], f.screen[1]);
-            out.store(2 * v, m[0].to_bits());
-            out.store(2 * v + 1, m[1].to_bits());
-            prev.store(v, pack(c, f.near));
+        let frame: FrameData = read(&now, 0);
+        let (lods, prev_lods) = (ctx.words("lod_models"), ctx.words("prev_lod_models"));
+        for k in 0..frame.model_count as usize * ModelLod::WORDS {
+            prev_lods.store(k, lods.load(k));
         }
     }
 }
@@ -188,6 +151,31 @@ mod tests {
         // Same position both frames: (quantisation-level) zero motion.
         let m = motion(pack(c, 0.02), c, 0.02, 1920.0, 1080.0);
         assert!(m[0].abs() < 0.02 && m[1].abs() < 0.02, "{m:?}");
+    }
+
+    #[test]
+    fn a_vertex_step_draws_every_step_th_vertex_and_the_tip() {
+        let drawn = |step, count| {
+            (0..count)
+                .filter(|&v| drawn_at(v, step, count))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(drawn(1, 4), [0, 1, 2, 3]);
+        assert_eq!(drawn(2, 6), [0, 2, 4, 5]);
+        assert_eq!(drawn(2, 5), [0, 2, 4]);
+        // The same vertices ModelLod::segment_vertices draws.
+        let lod = ModelLod {
+            vertex_step: 2,
+            ..ModelLod::default()
+        };
+        let mut ends: Vec<u32> = (0..super::super::drawn_segments(6, 2))
+            .flat_map(|k| {
+                let (a, b) = lod.segment_vertices(6, k);
+                [a, b]
+            })
+            .collect();
+        ends.dedup();
+        assert_eq!(ends, drawn(2, 6));
     }
 
     #[test]

@@ -8,7 +8,8 @@
 //! `p = root_now + R (p_bind - root_bind)`, `R = frame_now · frame_bindᵀ`.
 
 use super::lod::SKIN_GROUP;
-use super::{Scene, transform};
+use super::motion::{NOT_TRANSFORMED, drawn_at, motion, pack};
+use super::{ModelLod, Scene, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -45,12 +46,86 @@ pub static SKIN: PassKind<NoParams, SkinGpu> = PassKind {
         word: 0,
     },
     shader: Shader::compute("kulikov/skin.wgsl", "skin"),
-    kernel: |_| Box::new(SkinKernel),
+    kernel: |_| Box::new(SkinKernel { motion: false }),
     gpu: |_, _| SkinGpu::default(),
     raster: None,
 };
 
-struct SkinKernel;
+/// `kulikov.skin` that also keeps the motion vectors (motion.rs): each
+/// drawn vertex's motion against last frame's history, then this frame's
+/// NDC over it. Ours: the talk's motion pass reads the post-transform cache
+/// back; here the pass that writes it does the work while the vertex is at
+/// hand, over drawn vertices only, and no pass clears the cache first.
+pub static SKIN_MOTION: PassKind<NoParams, SkinGpu> = PassKind {
+    kind: "kulikov.skin_motion",
+    summary: "kulikov.skin, plus per-vertex motion vectors against last frame's compressed NDC (UNORM16), which it then overwrites",
+    source: "Kulikov 2025, 'Skinning', 'Motion vectors'",
+    bindings: Some(&[
+        Binding::read("lod_args"),
+        Binding::read("frame"),
+        Binding::read("models"),
+        Binding::read("lod_models"),
+        Binding::read("groom.vertices"),
+        Binding::read("groom.strands"),
+        Binding::read("groom.skinning"),
+        Binding::read("mesh.triangles"),
+        Binding::write("clip_positions"),
+        Binding::read("prev_lod_models"),
+        Binding::write("prev_clip_positions"),
+        Binding::write("vertex_motion"),
+    ]),
+    workgroup_size: SKIN_GROUP,
+    dispatch: Dispatch::Indirect {
+        binding: "lod_args",
+        word: 0,
+    },
+    shader: Shader::compute("kulikov/skin.wgsl", "skin_motion"),
+    kernel: |_| Box::new(SkinKernel { motion: true }),
+    gpu: |_, _| SkinGpu::default(),
+    raster: None,
+};
+
+struct SkinKernel {
+    /// `kulikov.skin_motion`.
+    motion: bool,
+}
+
+/// One kept strand's view of the vertex history (`kulikov.skin_motion`).
+struct History<'a> {
+    /// Whether last frame's LOD kept this strand, and its vertex step.
+    kept_last_frame: bool,
+    step_last_frame: u32,
+    words: Words<'a>,
+    motion: Words<'a>,
+}
+
+impl<'a> History<'a> {
+    fn open(ctx: &Ctx<'a>, model: usize, kept: u32) -> Self {
+        let prev = ModelLod::load(&ctx.words("prev_lod_models"), model);
+        Self {
+            kept_last_frame: kept < prev.strands,
+            step_last_frame: prev.vertex_step,
+            words: ctx.words("prev_clip_positions"),
+            motion: ctx.words("vertex_motion"),
+        }
+    }
+
+    /// Drawn vertex `v` of a strand of `count` points, global index `i`,
+    /// now at clip `c`: its motion against last frame's word (none where
+    /// last frame did not draw it), then this frame's word over it.
+    fn update(&self, scene: &Scene, i: usize, v: u32, count: u32, c: [f32; 4]) {
+        let f = &scene.frame;
+        let last = if self.kept_last_frame && drawn_at(v, self.step_last_frame, count) {
+            self.words.load(i)
+        } else {
+            NOT_TRANSFORMED
+        };
+        let m = motion(last, c, f.near, f.screen[0], f.screen[1]);
+        self.motion.store(2 * i, m[0].to_bits());
+        self.motion.store(2 * i + 1, m[1].to_bits());
+        self.words.store(i, pack(c, f.near));
+    }
+}
 
 fn vec3(v: [f32; 4]) -> Vec3 {
     Vec3::new(v[0], v[1], v[2])
@@ -137,14 +212,17 @@ impl CpuKernel for SkinKernel {
             } else {
                 None
             };
+            let kept = g - lod.strand_prefix;
+            let history = self.motion.then(|| History::open(ctx, m, kept));
             let mut v = 0;
             loop {
                 let p = world.transform_point3(local(v));
                 let p = motion.as_ref().map_or(p, |mo| mo.apply(p));
-                out.store_vec4(
-                    (first + v) as usize,
-                    transform(&scene.frame.view_proj, [p.x, p.y, p.z, 1.0]),
-                );
+                let c = transform(&scene.frame.view_proj, [p.x, p.y, p.z, 1.0]);
+                out.store_vec4((first + v) as usize, c);
+                if let Some(h) = &history {
+                    h.update(&scene, (first + v) as usize, v, count, c);
+                }
                 if v + 1 >= count {
                     break;
                 }
