@@ -72,7 +72,7 @@ pub fn motion(prev: u32, c: [f32; 4], near: f32, width: f32, height: f32) -> [f3
 /// Whether a strand of `count` points draws vertex `v` at a vertex step
 /// (every `step`-th vertex and the tip: `ModelLod::segment_vertices`).
 pub fn drawn_at(v: u32, step: u32, count: u32) -> bool {
-    v % step.max(1) == 0 || v + 1 == count
+    v.is_multiple_of(step.max(1)) || v + 1 == count
 }
 
 crate::gpu_block! {
