@@ -22,10 +22,11 @@
 @group(0) @binding(#{MODELS_BINDING}) var<storage, read> models: array<ModelData>;
 @group(0) @binding(#{LOD_MODELS_BINDING}) var<storage, read> lod_models: array<ModelLod>;
 
-// cull::drawn_segment: the model holding `id` (Scene::segment_model's
-// binary search: models number their segments in order), then its LOD.
-fn drawn_segment(id: u32) -> DrawnSegment {
-    // The last model whose range starts at or before `id`.
+// The last model whose first segment is at or before `key` (binary
+// search: models number their segments in order). `drawn`: first segments
+// of the LOD's compact numbering (ModelLod::segment_prefix), else of the
+// full numbering (ModelData::segment_first). Callers pass a constant.
+fn last_model_at_or_before(key: u32, drawn: bool) -> u32 {
     var m = 0u;
     var n = frame.model_count;
     loop {
@@ -33,11 +34,22 @@ fn drawn_segment(id: u32) -> DrawnSegment {
             break;
         }
         let half = n / 2u;
-        if models[m + half].segment_first <= id {
+        var start = models[m + half].segment_first;
+        if drawn {
+            start = lod_models[m + half].segment_prefix;
+        }
+        if start <= key {
             m += half;
         }
         n -= half;
     }
+    return m;
+}
+
+// cull::drawn_segment: the model holding `id` (Scene::segment_model's
+// binary search), then its LOD.
+fn drawn_segment(id: u32) -> DrawnSegment {
+    let m = last_model_at_or_before(id, false);
     if frame.model_count > 0u {
         let md = models[m];
         if segment_in_model(md, id) {
@@ -51,19 +63,7 @@ fn drawn_segment(id: u32) -> DrawnSegment {
 // in order, each model's kept strands, each strand's drawn segments);
 // invalid past the last. Its global id is the model's segment_first + local.
 fn nth_drawn(d: u32) -> DrawnSegment {
-    // The last model whose drawn segments start at or before `d`.
-    var m = 0u;
-    var n = frame.model_count;
-    loop {
-        if n <= 1u {
-            break;
-        }
-        let half = n / 2u;
-        if lod_models[m + half].segment_prefix <= d {
-            m += half;
-        }
-        n -= half;
-    }
+    let m = last_model_at_or_before(d, true);
     if frame.model_count > 0u {
         let lod = load_lod(lod_models[m]);
         let local = d - lod.segment_prefix;

@@ -1,5 +1,7 @@
-// kulikov.skin: strand roots follow their triangle; every drawn vertex goes
-// to clip space (before the division by w) into `clip_positions`.
+// kulikov.skin (`skin`): strand roots follow their triangle; every drawn
+// vertex goes to clip space (before the division by w) into
+// `clip_positions`. kulikov.skin_motion (`skin_motion`): the same, then each
+// drawn vertex's motion and vertex history (motion.rs).
 // Port of passes/src/kulikov/skin.rs, with glam's operation order:
 // p = root_now + sum_i now[i] * dot(p - root_bind, bind[i]).
 
