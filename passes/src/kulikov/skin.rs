@@ -25,26 +25,37 @@ crate::gpu_block! {
     }
 }
 
+/// The bindings of both skinning kinds, then `$extra`.
+macro_rules! skin_bindings {
+    ($($extra:expr),* $(,)?) => {
+        &[
+            Binding::read("lod_args"),
+            Binding::read("frame"),
+            Binding::read("models"),
+            Binding::read("lod_models"),
+            Binding::read("groom.vertices"),
+            Binding::read("groom.strands"),
+            Binding::read("groom.skinning"),
+            Binding::read("mesh.triangles"),
+            Binding::write("clip_positions"),
+            $($extra),*
+        ]
+    };
+}
+
+/// A lane per kept strand: the LOD's first indirect dispatch.
+const PER_KEPT_STRAND: Dispatch = Dispatch::Indirect {
+    binding: "lod_args",
+    word: 0,
+};
+
 pub static SKIN: PassKind<NoParams, SkinGpu> = PassKind {
     kind: "kulikov.skin",
     summary: "skin roots to triangles (hairRootSkinningInfo_t) and cache post-transform positions",
     source: "Kulikov 2025, 'Skinning'",
-    bindings: Some(&[
-        Binding::read("lod_args"),
-        Binding::read("frame"),
-        Binding::read("models"),
-        Binding::read("lod_models"),
-        Binding::read("groom.vertices"),
-        Binding::read("groom.strands"),
-        Binding::read("groom.skinning"),
-        Binding::read("mesh.triangles"),
-        Binding::write("clip_positions"),
-    ]),
+    bindings: Some(skin_bindings!()),
     workgroup_size: SKIN_GROUP,
-    dispatch: Dispatch::Indirect {
-        binding: "lod_args",
-        word: 0,
-    },
+    dispatch: PER_KEPT_STRAND,
     shader: Shader::compute("kulikov/skin.wgsl", "skin"),
     kernel: |_| Box::new(SkinKernel { motion: false }),
     gpu: |_, _| SkinGpu::default(),
@@ -60,25 +71,13 @@ pub static SKIN_MOTION: PassKind<NoParams, SkinGpu> = PassKind {
     kind: "kulikov.skin_motion",
     summary: "kulikov.skin, plus per-vertex motion vectors against last frame's compressed NDC (UNORM16), which it then overwrites",
     source: "Kulikov 2025, 'Skinning', 'Motion vectors'",
-    bindings: Some(&[
-        Binding::read("lod_args"),
-        Binding::read("frame"),
-        Binding::read("models"),
-        Binding::read("lod_models"),
-        Binding::read("groom.vertices"),
-        Binding::read("groom.strands"),
-        Binding::read("groom.skinning"),
-        Binding::read("mesh.triangles"),
-        Binding::write("clip_positions"),
+    bindings: Some(skin_bindings!(
         Binding::read("prev_lod_models"),
         Binding::write("prev_clip_positions"),
         Binding::write("vertex_motion"),
-    ]),
+    )),
     workgroup_size: SKIN_GROUP,
-    dispatch: Dispatch::Indirect {
-        binding: "lod_args",
-        word: 0,
-    },
+    dispatch: PER_KEPT_STRAND,
     shader: Shader::compute("kulikov/skin.wgsl", "skin_motion"),
     kernel: |_| Box::new(SkinKernel { motion: true }),
     gpu: |_, _| SkinGpu::default(),
