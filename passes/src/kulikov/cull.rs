@@ -135,11 +135,15 @@ pub fn nth_drawn(scene: &Scene, lods: &[ModelLod], d: u32) -> Option<DrawnSegmen
 /// or more where the dispatch was capped: the WGSL's stride loop).
 pub fn drawn_blocks(ctx: &Ctx<'_>, group: u32) -> impl Iterator<Item = u32> {
     let args = ctx.words("lod_args");
-    let (groups, drawn) = (u64::from(args.load(4).max(1)), u64::from(args.load(7)));
-    let stride = groups * u64::from(GROUP);
+    blocks(args.load(4), args.load(7), group)
+}
+
+/// [`drawn_blocks`] of a dispatch of `groups` workgroups over `drawn` segments.
+fn blocks(groups: u32, drawn: u32, group: u32) -> impl Iterator<Item = u32> {
+    let stride = u64::from(groups.max(1)) * u64::from(GROUP);
     (0..)
         .map(move |round| round * stride + u64::from(group * GROUP))
-        .take_while(move |&first| first < drawn)
+        .take_while(move |&first| first < u64::from(drawn))
         .map(|first| first as u32)
 }
 
@@ -358,6 +362,32 @@ mod tests {
     use super::*;
     use crate::layout::FrameData;
     use bytemuck::Zeroable;
+
+    #[test]
+    fn a_capped_dispatch_strides_over_every_drawn_segment_once() {
+        for (drawn, groups) in [(0, 0), (1, 1), (1000, 4), (5000, 3), (70_000, 1)] {
+            let [capped, ..] = super::super::lod::drawn_dispatch(drawn);
+            let groups = if groups == 0 {
+                capped
+            } else {
+                groups.min(capped)
+            };
+            let mut seen: Vec<u32> = (0..groups)
+                .flat_map(|g| blocks(groups, drawn, g))
+                .flat_map(|first| first..(first + GROUP).min(drawn))
+                .collect();
+            seen.sort_unstable();
+            assert_eq!(
+                seen,
+                (0..drawn).collect::<Vec<_>>(),
+                "{drawn} over {groups}"
+            );
+        }
+        // Past 65,535 workgroups the dispatch is capped and lanes stride.
+        let [groups, _, _, n] = super::super::lod::drawn_dispatch(20_000_000);
+        assert_eq!((groups, n), (65_535, 20_000_000));
+        assert_eq!(blocks(groups, n, 0).count(), 2);
+    }
 
     #[test]
     fn the_drawn_numbering_visits_every_drawn_segment_once_in_order() {
