@@ -122,7 +122,9 @@ fn lod() {
             lod_models[mi].strands = u32(floor(f64(lod_models[mi].strands) * factor));
         }
     }
+    // Kept strands and drawn segments (lod::drawn_dispatch) of the earlier models.
     var prefix = 0u;
+    var drawn = 0u;
     for (var mi = 0u; mi < count; mi++) {
         let strands = lod_models[mi].strands;
         if params.thickness_compensation != 0u && strands > 0u {
@@ -132,13 +134,10 @@ fn lod() {
         }
         lod_models[mi].strand_prefix = prefix;
         prefix += strands;
-    }
-    // lod::drawn_dispatch: the cull's and the sort's dispatch over drawn segments.
-    var drawn = 0u;
-    for (var mi = 0u; mi < count; mi++) {
         lod_models[mi].segment_prefix = drawn;
-        drawn += lod_models[mi].strands * lod_models[mi].segments_per_strand;
+        drawn += strands * lod_models[mi].segments_per_strand;
     }
+    // The cull's and the sort's dispatch over drawn segments.
     lod_args[4] = min((drawn + DRAWN_GROUP - 1u) / DRAWN_GROUP, MAX_GROUPS);
     lod_args[5] = 1u;
     lod_args[6] = 1u;

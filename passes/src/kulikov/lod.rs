@@ -246,7 +246,8 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
             l.strands = (f64::from(l.strands) * factor).floor() as u32;
         }
     }
-    let mut prefix = 0;
+    // Kept strands and drawn segments of the earlier models.
+    let (mut prefix, mut drawn) = (0, 0);
     for (l, m) in lods.iter_mut().zip(&scene.models) {
         if p.thickness_compensation && l.strands > 0 {
             // Coverage is additive in this pipeline: keep strands × thickness constant.
@@ -256,9 +257,6 @@ pub fn choose(p: &LodParams, scene: &Scene) -> Vec<ModelLod> {
         }
         l.strand_prefix = prefix;
         prefix += l.strands;
-    }
-    let mut drawn = 0;
-    for l in &mut lods {
         l.segment_prefix = drawn;
         drawn += l.drawn();
     }
