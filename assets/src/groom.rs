@@ -71,6 +71,14 @@ impl Groom {
             .all(|s| self.strand_range(s).len() == n)
             .then_some(n)
     }
+    /// The most points of any strand (0 for a groom without strands).
+    pub fn max_points_per_strand(&self) -> u32 {
+        self.strand_offsets
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .max()
+            .unwrap_or(0)
+    }
     pub fn roots(&self) -> Vec<Vec3> {
         (0..self.strand_count())
             .map(|s| self.positions[self.strand_offsets[s] as usize])

@@ -30,6 +30,11 @@ struct LodParams {
     light_view: u32,
     map_resolution: u32,
     camera_bound: u32,
+    // Ours: C at most lod::groom_cap of the groom's points per strand.
+    groom_resolution: u32,
+    _pad1: u32,
+    _pad2: u32,
+    _pad3: u32,
 }
 
 const ALL_MODELS: u32 = 0xffffffffu;
@@ -75,6 +80,15 @@ fn light_map(lf: LightFrame, res: f32, first_layer: u32, layers: u32) -> Footpri
         }
     }
     return fp;
+}
+
+// lod::groom_cap: 2 (points - 1) + 1 snapped like Eq. 5, C_max for an
+// unknown groom (fewer than 2 points).
+fn groom_cap(points: u32, c_max: u32) -> u32 {
+    if points < 2u {
+        return c_max;
+    }
+    return snap_control_points(2u * (points - 1u) + 1u, c_max);
 }
 
 // lod::snap_control_points (Lipp Eq. 5).
@@ -151,7 +165,11 @@ fn choose(b: u32) -> vec3<u32> {
     // Lipp Eq. 4-5.
     let l_res = select(1.0, l, params.resolution_lod != 0u);
     let c_raw = max(u32(floor(sqrt(l_res) * f32(params.max_control_points))), layers);
-    let c = snap_control_points(c_raw, params.max_control_points);
+    var c_max = params.max_control_points;
+    if params.groom_resolution != 0u {
+        c_max = groom_cap(hairmesh_bundles[o + 10u], c_max);
+    }
+    let c = snap_control_points(c_raw, c_max);
     return vec3<u32>(strands, c, select(0u, LOD_CULLED, culled));
 }
 

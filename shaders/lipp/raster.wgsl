@@ -90,20 +90,9 @@ fn strip_bits(strip: Strip, m: u32, uv: vec2<f32>, per_sample: bool) -> vec2<u32
     return segment_bits(strip_tangent(strip, m), strip_tangent(strip, m + 1u), uv, per_sample);
 }
 
-// Target::write: payload::pack of the sample at t, from the segment's
-// shared bits.
-fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: vec2<u32>, per_sample: bool) {
-    if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
-        return;
-    }
-    let z = a.z + (b.z - a.z) * t;
-    if !(z >= 0.0 && z < 1.0) || z >= textureLoad(scene_depth, vec2<i32>(x, y), 0).x {
-        return;
-    }
-    let pixel = u32(y) * params.width + u32(x);
-    if params.model_index > 0u && z >= bitcast<f32>(hair_depth[pixel]) {
-        return;
-    }
+// Target::put: payload::pack of a depth-tested sample at t, from the
+// segment's shared bits.
+fn put(a: End, b: End, t: f32, z: f32, pixel: u32, layer: u32, seg_bits: vec2<u32>, per_sample: bool) {
     var p = seg_bits;
     if per_sample {
         p |= tangent_bits(safe_normalize(lerp_vec(a.tangent, b.tangent, t)));
@@ -114,11 +103,47 @@ fn write_sample(a: End, b: End, t: f32, x: i32, y: i32, layer: u32, seg_bits: ve
     atomicMin(&gbuffer[slot], (u64(p.y) << 32u) | u64(p.x));
 }
 
+// Target::write_pixel: the sample at tc into layer `layer` (if `centre`)
+// and the conservative layer's at tm (if `cons`) into pixel (x, y), with
+// one read of the depth both are tested against.
+fn write_pixel(a: End, b: End, x: i32, y: i32, centre: bool, tc: f32, layer: u32, cons: bool, tm: f32, seg_bits: vec2<u32>, per_sample: bool) {
+    if x < 0 || y < 0 || x >= i32(params.width) || y >= i32(params.height) {
+        return;
+    }
+    let pixel = u32(y) * params.width + u32(x);
+    var limit = textureLoad(scene_depth, vec2<i32>(x, y), 0).x;
+    if params.model_index > 0u {
+        limit = min(limit, bitcast<f32>(hair_depth[pixel]));
+    }
+    let zc = a.z + (b.z - a.z) * tc;
+    if centre && zc >= 0.0 && zc < 1.0 && zc < limit {
+        put(a, b, tc, zc, pixel, layer, seg_bits, per_sample);
+    }
+    let zm = a.z + (b.z - a.z) * tm;
+    if cons && zm >= 0.0 && zm < 1.0 && zm < limit {
+        put(a, b, tm, zm, pixel, 1u, seg_bits, per_sample);
+    }
+}
+
+// raster::column_rows: the union of the centre and conservative rows
+// (lo, hi) of a column (each empty when lo > hi).
+fn column_rows(centre: vec2<i32>, cons: vec2<i32>) -> vec2<i32> {
+    if centre.x > centre.y {
+        return cons;
+    }
+    if cons.x > cons.y {
+        return centre;
+    }
+    return vec2<i32>(min(centre.x, cons.x), max(centre.y, cons.y));
+}
+
 fn pixel_of(x_major: bool, m: i32, n: i32) -> vec2<i32> {
     return select(vec2<i32>(n, m), vec2<i32>(m, n), x_major);
 }
 
-// Target::segment: a DDA over the major axis, one column at a time.
+// Target::segment: a DDA over the major axis, one column at a time. A
+// column's centre rows and conservative rows are visited in one loop
+// (Target::column_rows), each pixel once.
 fn draw_segment(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     let x_major = abs(b.x - a.x) >= abs(b.y - a.y);
     let ma = select(a.y, a.x, x_major);
@@ -136,32 +161,37 @@ fn draw_segment(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     let half = params.centre_diameter * 0.5;
     let len = sqrt(dm * dm + dn * dn);
     let cosa = select(1.0, abs(dm) / len, len > 0.0);
+    let cons_on = params.conservative_layer != 0u;
     for (var col = lo; col <= hi; col += 1.0) {
         let ci = i32(col);
         let t = column_params(ma, dm, col);
-        let t0 = t.x;
-        let t1 = t.y;
         let centre = col + 0.5;
+        var c_lo = 1;
+        var c_hi = 0;
+        var tc = 0.0;
+        var nc = 0.0;
         if dm != 0.0 && centre >= min(ma, mb) && centre < max(ma, mb) {
-            let t = (centre - ma) / dm;
-            let n = na + dn * t;
-            let r = i32(floor(n - 0.5));
-            for (var row = r; row <= r + 1; row++) {
-                if abs((n - (f32(row) + 0.5)) * cosa) <= half {
-                    let p = pixel_of(x_major, ci, row);
-                    write_sample(a, b, t, p.x, p.y, 0u, bits, per_sample);
-                }
-            }
+            tc = (centre - ma) / dm;
+            nc = na + dn * tc;
+            c_lo = i32(floor(nc - 0.5));
+            c_hi = c_lo + 1;
         }
-        if params.conservative_layer != 0u {
-            let n0 = na + dn * t0;
-            let n1 = na + dn * t1;
-            let r0 = i32(floor(min(n0, n1)));
-            let r1 = i32(floor(max(n0, n1)));
-            let tm = 0.5 * (t0 + t1);
-            for (var row = r0; row <= r1; row++) {
+        var r0 = 1;
+        var r1 = 0;
+        if cons_on {
+            let n0 = na + dn * t.x;
+            let n1 = na + dn * t.y;
+            r0 = i32(floor(min(n0, n1)));
+            r1 = i32(floor(max(n0, n1)));
+        }
+        let tm = 0.5 * (t.x + t.y);
+        let rows = column_rows(vec2<i32>(c_lo, c_hi), vec2<i32>(r0, r1));
+        for (var row = rows.x; row <= rows.y; row++) {
+            let cen = row >= c_lo && row <= c_hi && abs((nc - (f32(row) + 0.5)) * cosa) <= half;
+            let con = row >= r0 && row <= r1;
+            if cen || con {
                 let p = pixel_of(x_major, ci, row);
-                write_sample(a, b, tm, p.x, p.y, 1u, bits, per_sample);
+                write_pixel(a, b, p.x, p.y, cen, tc, 0u, con, tm, bits, per_sample);
             }
         }
     }
@@ -218,7 +248,7 @@ fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
                 let ex = a.x + dx * t - px;
                 let ey = a.y + dy * t - py;
                 if ex * ex + ey * ey <= half * half {
-                    write_sample(a, b, t, p.x, p.y, s, bits, per_sample);
+                    write_pixel(a, b, p.x, p.y, true, t, s, false, 0.0, bits, per_sample);
                 }
             }
         }

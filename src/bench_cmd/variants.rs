@@ -260,6 +260,19 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // C_max points however fine the groom (passes/src/lipp/lod/mod.rs,
+    // `groom_resolution`), in the camera's view and the maps'.
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, no groom-resolution cap",
+        graph: LIPP,
+        overrides: &[
+            "lod.groom_resolution=false",
+            "shadow_lod.groom_resolution=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
     // (passes/src/lipp/lod/mod.rs).
     Variant {

@@ -66,6 +66,9 @@ pub struct BundleRecord {
     /// Fig. 1 sets it per style: λ = {4.0, 5.5, 2.0, 2.8, 3.0}); 0 when the
     /// groom's LOD is off (`lod.enabled: false`): full detail.
     pub lod_lambda: f32,
+    /// The most points of any strand of the groom the hair mesh stands for
+    /// (0: unknown), for `lipp.lod`'s `groom_resolution` cap.
+    pub groom_points: u32,
 }
 
 impl BundleRecord {
@@ -82,6 +85,7 @@ impl BundleRecord {
             noise: w.load_f32(o + 7),
             seed: w.load(o + 8),
             lod_lambda: w.load_f32(o + 9),
+            groom_points: w.load(o + 10),
         }
     }
 
@@ -97,6 +101,7 @@ impl BundleRecord {
         o[7] = self.noise.to_bits();
         o[8] = self.seed;
         o[9] = self.lod_lambda.to_bits();
+        o[10] = self.groom_points;
         o
     }
 

@@ -240,24 +240,36 @@ impl Target<'_> {
         Some((end(part.a, part.ta), end(part.b, part.tb)))
     }
 
-    /// Writes the sample at parameter `t` of segment (a, b) into pixel (x, y)
-    /// of layer `layer` (0 centre, 1 conservative), depth-tested.
-    fn write(&mut self, a: &End, b: &End, t: f32, x: i32, y: i32, layer: usize) {
+    /// Writes into pixel (x, y) the sample at parameter `tc` of segment
+    /// (a, b) to layer `layer` (if `centre`) and the conservative layer's
+    /// sample at `tm` (if `cons`), both tested against one read of the
+    /// scene's depth (and, after the first groom, `hair_depth`).
+    fn write_pixel(
+        &mut self,
+        (a, b): (&End, &End),
+        (x, y): (i32, i32),
+        centre: Option<(f32, usize)>,
+        cons: Option<f32>,
+    ) {
         if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 {
             return;
         }
-        let z = a.z + (b.z - a.z) * t;
         let pixel = (y as u32 * self.width + x as u32) as usize;
-        if !(0.0..1.0).contains(&z) || z >= self.depth.load_f32(pixel) {
-            return;
+        let mut limit = self.depth.load_f32(pixel);
+        if let Some(h) = &self.hair_depth {
+            limit = limit.min(h.load_f32(pixel));
         }
-        if self
-            .hair_depth
-            .as_ref()
-            .is_some_and(|h| z >= h.load_f32(pixel))
-        {
-            return;
+        let samples = centre.into_iter().chain(cons.map(|tm| (tm, 1)));
+        for (t, layer) in samples {
+            let z = a.z + (b.z - a.z) * t;
+            if (0.0..1.0).contains(&z) && z < limit {
+                self.put(a, b, t, z, pixel, layer);
+            }
         }
+    }
+
+    /// payload::pack of a depth-tested sample at `t`, `atomicMin` into its layer.
+    fn put(&mut self, a: &End, b: &End, t: f32, z: f32, pixel: usize, layer: usize) {
         let sample = Sample {
             depth: z,
             tangent: self
@@ -293,7 +305,7 @@ impl Target<'_> {
                 };
                 let (ex, ey) = (a.x + dx * t - px, a.y + dy * t - py);
                 if ex * ex + ey * ey <= half * half {
-                    self.write(a, b, t, x, y, s);
+                    self.write_pixel((a, b), (x, y), Some((t, s)), None);
                 }
             }
         }
@@ -320,25 +332,46 @@ impl Target<'_> {
         let cos = if len > 0.0 { dm.abs() / len } else { 1.0 };
         dda.columns(dda.limit(self.width, self.height), |col, t0, t1| {
             // Centre layer: the column centre within the segment (half-open,
-            // so shared ends are drawn once), rows whose centre is near the line.
+            // so shared ends are drawn once), rows r and r + 1 around the line,
+            // kept where the pixel centre is near it.
             let centre = col + 0.5;
+            let (mut c_rows, mut tc, mut nc) = ((1, 0), 0.0, 0.0);
             if dm != 0.0 && centre >= ma.min(mb) && centre < ma.max(mb) {
-                let t = (centre - ma) / dm;
-                let n = na + dn * t;
-                let r = (n - 0.5).floor() as i32;
-                for row in [r, r + 1] {
-                    if ((n - (row as f32 + 0.5)) * cos).abs() <= half {
-                        let (x, y) = dda.pixel(col as i32, row);
-                        self.write(a, b, t, x, y, 0);
-                    }
-                }
+                tc = (centre - ma) / dm;
+                nc = na + dn * tc;
+                let r = (nc - 0.5).floor() as i32;
+                c_rows = (r, r + 1);
             }
             // Conservative layer: every row the segment touches in the column.
-            if self.params.conservative_layer {
-                let tm = 0.5 * (t0 + t1);
-                dda.column_pixels(col, t0, t1, |x, y| self.write(a, b, tm, x, y, 1));
+            let (r0, r1) = dda.rows(t0, t1);
+            let cons_rows = if self.params.conservative_layer {
+                (r0 as i32, r1 as i32)
+            } else {
+                (1, 0)
+            };
+            let tm = 0.5 * (t0 + t1);
+            let inside = |(lo, hi): (i32, i32), row: i32| lo <= row && row <= hi;
+            let (lo, hi) = column_rows(c_rows, cons_rows);
+            for row in lo..=hi {
+                let cen = inside(c_rows, row) && ((nc - (row as f32 + 0.5)) * cos).abs() <= half;
+                let con = inside(cons_rows, row);
+                if cen || con {
+                    let pixel = dda.pixel(col as i32, row);
+                    self.write_pixel((a, b), pixel, cen.then_some((tc, 0)), con.then_some(tm));
+                }
             }
         });
+    }
+}
+
+/// The rows a column visits: the union of the centre layer's and the
+/// conservative layer's row ranges (each `(lo, hi)`, empty when lo > hi),
+/// so that a pixel in both is read and tested once.
+fn column_rows(centre: (i32, i32), cons: (i32, i32)) -> (i32, i32) {
+    match (centre.0 <= centre.1, cons.0 <= cons.1) {
+        (false, _) => cons,
+        (true, false) => centre,
+        (true, true) => (centre.0.min(cons.0), centre.1.max(cons.1)),
     }
 }
 

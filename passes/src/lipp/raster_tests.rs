@@ -49,6 +49,8 @@ pub(crate) fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
             noise: 0.002,
             seed: 7 + b,
             lod_lambda: 1.0,
+            // Unknown: the LOD's C_max, so the strands keep every point.
+            groom_points: 0,
         };
         bundles.extend(rec.words());
         for i in 0..4 {
@@ -225,4 +227,16 @@ fn msaa_reference_mode_fills_one_layer_per_sample() {
     let (lo, hi) = (*hits.iter().min().unwrap(), *hits.iter().max().unwrap());
     assert!(lo > 100 && hi < 2 * lo, "{hits:?}");
     assert_eq!(super::sample_positions(8).len(), 8);
+}
+
+#[test]
+fn a_columns_rows_are_the_union_of_both_layers_rows() {
+    use super::column_rows;
+    let empty = (1, 0);
+    assert_eq!(column_rows((3, 4), (2, 5)), (2, 5));
+    assert_eq!(column_rows((3, 4), (4, 4)), (3, 4));
+    assert_eq!(column_rows(empty, (2, 3)), (2, 3), "no centre sample");
+    assert_eq!(column_rows((7, 8), empty), (7, 8), "no conservative layer");
+    let (lo, hi) = column_rows(empty, empty);
+    assert!(lo > hi, "nothing to visit");
 }

@@ -39,6 +39,7 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
         let Some(mesh) = &g.hair_mesh else { continue };
         let world = g.world;
         let normal = Mat3::from_mat4(world);
+        let groom_points = g.groom.max_points_per_strand();
         for (b, bd) in mesh.bundles.iter().enumerate() {
             let src = mesh.bundle_layers(b);
             let kept = kept_layers(src.len() as u32);
@@ -57,6 +58,7 @@ pub fn pack(scene: &Scene, up: &mut Upload) {
                 } else {
                     0.0
                 },
+                groom_points,
             };
             for &k in &kept {
                 let l = &src[k as usize];
