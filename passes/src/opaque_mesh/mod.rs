@@ -110,9 +110,18 @@ impl<'a> View<'a> {
     /// column order, as the WGSL `transform` does, so every backend snaps
     /// the same positions.
     fn setup(&self, tri: &TriangleData) -> Option<Setup> {
-        let clip = corners(tri)
-            .map(|p| Vec4::from(transform(&self.frame.view_proj, [p.x, p.y, p.z, 1.0])));
-        Setup::from_clip(clip, self.frame.near, self.width, self.height)
+        let clip = |p: Vec3| Vec4::from(transform(&self.frame.view_proj, [p.x, p.y, p.z, 1.0]));
+        // An array literal, not `corners(tri).map(..)`: with rustc 1.95 the
+        // `map` form here compiled (in one build of this crate) to an
+        // aligned SSE store into an 8-byte-aligned stack slot, a SIGSEGV in
+        // the visibility kernel's tests.
+        let [a, b, c] = corners(tri);
+        Setup::from_clip(
+            [clip(a), clip(b), clip(c)],
+            self.frame.near,
+            self.width,
+            self.height,
+        )
     }
 
     /// Row-major texel index.
