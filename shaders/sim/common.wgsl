@@ -4,6 +4,9 @@
 #define_import_path strandgraph::sim
 
 // passes/src/sim/mod.rs: SimModel, 128 bytes.
+// sim::SIM_SIMULATE: the scene marks the groom `simulate: true`.
+const SIM_SIMULATE: u32 = 1u;
+
 struct SimModel {
     inv_world: mat4x4<f32>,
     rest_down: vec4<f32>,

@@ -4,7 +4,7 @@
 // glam's operation order.
 
 #import strandgraph::layout::{FrameData, ModelData}
-#import strandgraph::sim::{SimModel, dot3, normalize3, point}
+#import strandgraph::sim::{SimModel, SIM_SIMULATE, dot3, normalize3, point}
 
 struct PbdParams {
     // 0 Flagged, 1 All, 2 None.
@@ -45,7 +45,6 @@ struct SimVertex {
 const GROUP: u32 = 64u;
 const SDF_RES: u32 = 40u;
 const FIELD_WORDS: u32 = 64000u;
-const SIM_SIMULATE: u32 = 1u;
 const SIM_COLLIDER: u32 = 2u;
 const GRID_RES: u32 = 32u;
 const GRID_WORDS: u32 = 131072u;

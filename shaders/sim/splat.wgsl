@@ -3,13 +3,14 @@
 // passes/src/sim/grid.rs (the method and its citation are there).
 
 #import strandgraph::layout::FrameData
-#import strandgraph::sim::{SimModel, point}
+#import strandgraph::sim::{SimModel, SIM_SIMULATE, point}
 
 struct SplatParams {
     strands: u32,
     enabled: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // grid::SplatParams::models: 0 Flagged, 1 All, 2 None.
+    models: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: SplatParams;
@@ -47,6 +48,16 @@ fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
         m++;
     }
     let sim = sim_models[m];
+    // Simulated::includes: the other grooms' strands are not read at all.
+    var simulated = false;
+    switch params.models {
+        case 0u: { simulated = (sim.flags & SIM_SIMULATE) != 0u; }
+        case 1u: { simulated = true; }
+        default: { simulated = false; }
+    }
+    if !simulated {
+        return;
+    }
     let range = groom_strands[g];
     // A strand the solver has never written is skipped at its root.
     if range.y == 0u || sim_state[2u * range.x].w == 0.0 {

@@ -36,7 +36,7 @@ pub const VARIANTS: &[Variant] = &[
         // Kulikov: "2 milliseconds for simulation plus rendering".
         name: "simulating every groom",
         graph: KULIKOV,
-        overrides: &["simulate.models=\"All\""],
+        overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
     },
@@ -246,7 +246,7 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 1+F+L, simulating every groom",
         graph: LIPP,
-        overrides: &["simulate.models=\"All\""],
+        overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

@@ -25,6 +25,7 @@
 //! outside adds nothing and feels no friction.
 
 use super::chains::CORNERS;
+use super::pbd::Simulated;
 use super::{SimModel, model_of};
 use crate::contract::flag;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
@@ -112,11 +113,21 @@ pub struct SplatParams {
     /// Off, the grid stays empty and costs nothing: what a graph sets with
     /// the solver's `hair_friction: 0`, the grid's only reader.
     pub enabled: bool,
+    /// The grooms whose strands are splatted: set it as the solver's
+    /// `models` (its default too). The others' strands are skipped before
+    /// any of their state is read; at the distance views, where no groom is
+    /// simulated, that took the pass from 0.022 to a few µs on the H100,
+    /// on the frame's critical path. (Strands the solver has never written
+    /// are skipped at their root as well, whatever this says.)
+    pub models: Simulated,
 }
 
 impl Default for SplatParams {
     fn default() -> Self {
-        Self { enabled: true }
+        Self {
+            enabled: true,
+            models: Simulated::Flagged,
+        }
     }
 }
 
@@ -127,8 +138,9 @@ crate::gpu_block! {
     pub struct SplatGpu {
         strands: u32,
         enabled: u32,
-        _pad1: u32,
-        _pad2: u32,
+        /// 0 Flagged, 1 All, 2 None (`Simulated`).
+        models: u32,
+        _pad: u32,
     }
 }
 
@@ -147,6 +159,7 @@ pub static SPLAT: PassKind<SplatParams, SplatGpu> = PassKind {
     gpu: |p, q| SplatGpu {
         strands: count(q.strands),
         enabled: flag(p.enabled),
+        models: p.models as u32,
         ..SplatGpu::default()
     },
     raster: None,
@@ -168,6 +181,7 @@ pub static SPLAT_CHAINS: PassKind<SplatParams, SplatGpu> = PassKind {
     gpu: |p, q| SplatGpu {
         strands: CORNERS * count(q.bundles),
         enabled: flag(p.enabled),
+        models: p.models as u32,
         ..SplatGpu::default()
     },
     raster: None,
@@ -201,6 +215,9 @@ impl CpuKernel for SplatKernel {
             let Some((m, sim)) = model_of(&sims, frame.model_count, g) else {
                 continue;
             };
+            if !self.0.models.includes(sim.flags) {
+                continue;
+            }
             let (first, n) = (
                 strands.load(2 * g) as usize,
                 strands.load(2 * g + 1) as usize,

@@ -47,6 +47,17 @@ crate::string_enum! {
     pub enum Simulated { Flagged, All, None }
 }
 
+impl Simulated {
+    /// Whether a groom with `SimModel::flags` `flags` is simulated.
+    pub fn includes(self, flags: u32) -> bool {
+        match self {
+            Simulated::Flagged => flags & SIM_SIMULATE != 0,
+            Simulated::All => true,
+            Simulated::None => false,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PbdParams {
@@ -395,13 +406,8 @@ impl CpuKernel for PbdKernel {
                 continue;
             };
             let model: ModelData = read(&models, m);
-            let simulated = match self.0.models {
-                Simulated::Flagged => sim.flags & SIM_SIMULATE != 0,
-                Simulated::All => true,
-                Simulated::None => false,
-            };
             // The others keep their rest pose in `groom.vertices`.
-            if !simulated {
+            if !self.0.models.includes(sim.flags) {
                 continue;
             }
             let (first, count) = (

@@ -148,6 +148,7 @@ impl Run {
         self.harness.buffer("sim.grid", vec![0; grid_words]);
         let splat = (splat.kernel)(&grid::SplatParams {
             enabled: self.params.hair_friction > 0.0,
+            models: self.params.models,
         });
         self.harness.run(splat.as_ref(), groups, 64);
         let kernel = (pass.kernel)(&self.params);
