@@ -1,11 +1,20 @@
 // What the simulation's passes share (mirrors passes/src/sim/mod.rs).
 // Composed with naga_oil:
-//   #import strandgraph::sim::{SimModel, dot3, normalize3, point}
+//   #import strandgraph::sim::{SimModel, includes, dot3, normalize3, point}
 #define_import_path strandgraph::sim
 
 // passes/src/sim/mod.rs: SimModel, 128 bytes.
 // sim::SIM_SIMULATE: the scene marks the groom `simulate: true`.
 const SIM_SIMULATE: u32 = 1u;
+
+// pbd::Simulated::includes: whether a pass's `models` (0 Flagged, 1 All,
+// 2 None) simulates a groom with SimModel `flags`.
+fn includes(models: u32, flags: u32) -> bool {
+    if models == 0u {
+        return (flags & SIM_SIMULATE) != 0u;
+    }
+    return models == 1u;
+}
 
 struct SimModel {
     inv_world: mat4x4<f32>,

@@ -4,7 +4,7 @@
 // glam's operation order.
 
 #import strandgraph::layout::{FrameData, ModelData}
-#import strandgraph::sim::{SimModel, SIM_SIMULATE, dot3, normalize3, point}
+#import strandgraph::sim::{SimModel, includes, dot3, normalize3, point}
 
 struct PbdParams {
     // 0 Flagged, 1 All, 2 None.
@@ -311,14 +311,8 @@ fn pbd(@builtin(global_invocation_id) gid: vec3<u32>) {
     let range = groom_strands[g];
     let first = range.x;
     let count = range.y;
-    var simulated = false;
-    switch params.models {
-        case 0u: { simulated = (sim.flags & SIM_SIMULATE) != 0u; }
-        case 1u: { simulated = true; }
-        default: { simulated = false; }
-    }
     // The others keep their rest pose in groom_vertices.
-    if !simulated {
+    if !includes(params.models, sim.flags) {
         return;
     }
     let s = Strand(m, models[m].world, sim.inv_world, sim.scale, first);

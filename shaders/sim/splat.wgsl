@@ -3,7 +3,7 @@
 // passes/src/sim/grid.rs (the method and its citation are there).
 
 #import strandgraph::layout::FrameData
-#import strandgraph::sim::{SimModel, SIM_SIMULATE, point}
+#import strandgraph::sim::{SimModel, includes, point}
 
 struct SplatParams {
     strands: u32,
@@ -48,14 +48,8 @@ fn splat(@builtin(global_invocation_id) gid: vec3<u32>) {
         m++;
     }
     let sim = sim_models[m];
-    // Simulated::includes: the other grooms' strands are not read at all.
-    var simulated = false;
-    switch params.models {
-        case 0u: { simulated = (sim.flags & SIM_SIMULATE) != 0u; }
-        case 1u: { simulated = true; }
-        default: { simulated = false; }
-    }
-    if !simulated {
+    // The other grooms' strands are not read at all.
+    if !includes(params.models, sim.flags) {
         return;
     }
     let range = groom_strands[g];
