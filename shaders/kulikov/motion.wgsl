@@ -6,11 +6,9 @@
 // 3 = prev_frame, 4 = prev_lod_models.
 #import strandgraph::layout::{FrameData, ModelLod}
 
+// The pass has no parameters; the block keeps binding 0 the same for every pass.
 struct HistoryParams {
-    vertices: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    reserved: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: HistoryParams;
@@ -21,8 +19,7 @@ struct HistoryParams {
 
 @compute @workgroup_size(256)
 fn store_history(@builtin(local_invocation_index) lane: u32) {
-    // Binding 0 is every pass's parameter block; this entry needs none.
-    _ = params.vertices;
+    _ = params.reserved;
     if lane == 0u {
         prev_frame = frame;
     }

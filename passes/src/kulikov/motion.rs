@@ -23,12 +23,11 @@
 //! decoder ([`pack`], [`motion`]) are tested against each other here.
 
 use super::ModelLod;
-use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
 use crate::layout::{FrameData, read};
 use crate::params::NoParams;
-use strandgraph_graph::Quantities;
 
 const GROUP: u32 = 256;
 /// Largest UNORM16 code used for NDC. Codes are stored plus one, so that
@@ -76,12 +75,9 @@ pub fn drawn_at(v: u32, step: u32, count: u32) -> bool {
 }
 
 crate::gpu_block! {
-    /// `HistoryParams`: vertex count, three pad words.
+    /// `HistoryParams`: one reserved word (the pass has no parameters).
     pub struct HistoryGpu {
-        vertices: u32,
-        _pad0: u32,
-        _pad1: u32,
-        _pad2: u32,
+        reserved: u32,
     }
 }
 
@@ -99,10 +95,7 @@ pub static STORE_HISTORY: PassKind<NoParams, HistoryGpu> = PassKind {
     dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("kulikov/motion.wgsl", "store_history"),
     kernel: |_| Box::new(StoreKernel),
-    gpu: |_, q: &Quantities| HistoryGpu {
-        vertices: count(q.vertices),
-        ..HistoryGpu::default()
-    },
+    gpu: |_, _| HistoryGpu::default(),
     raster: None,
 };
 
