@@ -446,14 +446,21 @@ pub fn run(mut args: Args) -> Result<()> {
     Ok(())
 }
 
-/// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
-/// and the frame times (CPU: wall time of the frame, its queues overlap;
-/// GPU: [`frame_millis`], timestamps only).
-fn frames(
-    session: &mut dyn Session,
-    inputs: &[Upload],
-    args: &Args,
-) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
+/// What [`frames`] measured.
+struct Timed {
+    /// Per-pass times of each timed frame.
+    passes: Vec<Vec<PassTime>>,
+    /// The frame times (CPU: wall time of the frame, its queues overlap;
+    /// GPU: [`frame_millis`], timestamps only).
+    totals: Vec<f64>,
+    /// The same frames run again, timed only at their bounds
+    /// ([`Session::run_frame_timed`]); empty where the backend cannot.
+    bounds: Vec<f64>,
+}
+
+/// Runs `warmup` then `frames` frames timed per pass, then the timed
+/// frames again timed at their bounds only.
+fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<Timed> {
     // Frame k runs inputs[k], the last one again once they run out.
     let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
     // A GPU idle during the CPU's work between cells (counting, references,
@@ -480,7 +487,18 @@ fn frames(
         });
         passes.push(times);
     }
-    Ok((passes, totals))
+    let mut bounds = Vec::with_capacity(args.frames);
+    for k in args.warmup..args.warmup + args.frames {
+        match session.run_frame_timed(input(k))? {
+            Some(ms) => bounds.push(ms),
+            None => break,
+        }
+    }
+    Ok(Timed {
+        passes,
+        totals,
+        bounds,
+    })
 }
 
 /// Runs `input` until [`CLOCK_WARMUP`] has passed and the median GPU time of
@@ -559,9 +577,12 @@ fn measure(
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     // A still scene: a game's frames at 60 fps, the simulation stepping.
     let still = [sequence::running(&p.upload, FPS)];
-    let (passes, totals) = frames(session.as_mut(), animation.unwrap_or(&still), args)?;
+    let timed = frames(session.as_mut(), animation.unwrap_or(&still), args)?;
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
-    let stats = Stats::new(&passes, &totals, v.raster, atomics);
+    let mut stats = Stats::new(&timed.passes, &timed.totals, v.raster, atomics);
+    if !timed.bounds.is_empty() {
+        stats.bounds = Some(report::Spread::of(&timed.bounds));
+    }
     // Read back only what a reference will be compared with, or
     // `--pictures` saves: the last frame; of an animated scene with a
     // reference, every timed frame, from a second run of the sequence (so
@@ -626,7 +647,7 @@ fn roofline(
     drop(counter);
 
     let mut session = runner::open(backend, &plan, &instance, cpu)?;
-    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args)?;
+    let passes = frames(session.as_mut(), std::slice::from_ref(&upload), args)?.passes;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()

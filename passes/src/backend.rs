@@ -97,6 +97,16 @@ pub trait Session {
     /// Uploads `inputs` into the imported and history resources they name,
     /// runs one frame and returns its per-pass times in plan order.
     fn run(&mut self, inputs: &Upload) -> Result<Vec<PassTime>, BackendError>;
+    /// Runs one frame as [`Session::run`] does, with GPU timestamps only
+    /// where each queue's part of the frame begins and ends, and returns
+    /// the frame's time in ms: first begin to last end. A timestamp after
+    /// a pass waits for the queue's work before it, so per-pass queries
+    /// keep independent passes of one queue from overlapping and add their
+    /// own cost; this is the frame without them. `None` where the backend
+    /// has no such mode (its frame time is [`frame_millis`] of `run`).
+    fn run_frame_timed(&mut self, inputs: &Upload) -> Result<Option<f64>, BackendError> {
+        self.run(inputs).map(|_| None)
+    }
     /// A copy of resource `name`'s words after the last frame (a version
     /// reads its resource's memory); `None` when the plan gave it no memory.
     fn read(&self, name: &str) -> Result<Option<Vec<u32>>, BackendError>;

@@ -35,7 +35,7 @@ pub struct Spread {
 }
 
 impl Spread {
-    fn of(v: &[f64]) -> Spread {
+    pub fn of(v: &[f64]) -> Spread {
         Spread {
             median: median(v),
             min: v.iter().copied().fold(f64::INFINITY, f64::min),
@@ -65,6 +65,10 @@ pub struct PassStats {
 pub struct Stats {
     pub frames: usize,
     pub total: Spread,
+    /// The frame timed by timestamps only at its queues' bounds, over as
+    /// many frames run again so (ash; `None` where the backend times passes
+    /// only): per-pass queries make a queue's passes wait for each other.
+    pub bounds: Option<Spread>,
     /// The raster passes' summed time per frame.
     pub raster: Spread,
     /// Per pass, in plan order.
@@ -124,6 +128,7 @@ impl Stats {
         Stats {
             frames: frames.len(),
             total: Spread::of(totals),
+            bounds: None,
             raster: Spread::of(&raster_ms),
             passes,
             raster_atomics: atomics,
@@ -482,6 +487,18 @@ impl Report {
         for why in skipped {
             let _ = writeln!(o, "  skipped: {why}");
         }
+        if self
+            .cells
+            .iter()
+            .any(|c| matches!(&c.3, Cell::Measured(st) if st.bounds.is_some()))
+        {
+            let all: Vec<&(Backend, Variant)> = rows.iter().collect();
+            o += &self.metric_table(
+                &all,
+                "Frame time, ms, timed only at the frame's bounds: median over frames run again with no query between passes (ash; per-pass queries make a queue's passes wait for each other)",
+                |st| st.bounds.map(|b| b.median as f32),
+            );
+        }
         o.push_str(&self.quality_table(&rows));
         for note in &self.notes {
             let _ = writeln!(o, "  {note}");
@@ -599,6 +616,9 @@ impl Report {
                             j["reference_picture"] = json!(p.reference);
                         }
                         j["frame"] = st.total.json();
+                        if let Some(b) = st.bounds {
+                            j["frame_bounds"] = b.json();
+                        }
                         j["raster"] = st.raster.json();
                         j["raster_passes"] = json!(v.raster);
                         j["raster_atomics"] = json!(st.raster_atomics);

@@ -49,6 +49,10 @@ impl api::Session for Session {
             .collect())
     }
 
+    fn run_frame_timed(&mut self, inputs: &Upload) -> Result<Option<f64>, BackendError> {
+        Session::run_frame_timed(self, inputs).map_err(|e| BackendError::new("ash", e))
+    }
+
     fn read(&self, name: &str) -> Result<Option<Vec<u32>>, BackendError> {
         Session::read(self, name).map_err(|e| BackendError::new("ash", e))
     }

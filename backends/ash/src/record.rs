@@ -32,8 +32,20 @@ pub(crate) fn backend_queue(q: Queue, has_compute: bool) -> usize {
     }
 }
 
+/// Where a frame's command buffers write timestamps: the same work is
+/// recorded once for each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Stamps {
+    /// Before and after every pass (`2k`, `2k + 1` for lane position `k`).
+    Passes = 0,
+    /// Only before the lane's first pass (query 0) and after its last
+    /// (query `2n - 1`): the frame with no query between its passes.
+    Frame = 1,
+}
+
 pub(crate) struct Batch {
-    pub cmd: vk::CommandBuffer,
+    /// The batch's command buffer per [`Stamps`] (indexed by it).
+    pub cmds: [vk::CommandBuffer; 2],
     /// Range of lane positions (0-based, inclusive).
     pub first: usize,
     pub last: usize,
@@ -117,12 +129,12 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(lane.pool.raw())
             .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(lane.batches.len() as u32);
+            .command_buffer_count(2 * lane.batches.len() as u32);
         // SAFETY: valid pool; the buffers are freed with it.
         let cmds = unsafe { gpu.device.allocate_command_buffers(&info) }
             .ctx("vkAllocateCommandBuffers")?;
-        for (b, cmd) in lane.batches.iter_mut().zip(cmds) {
-            b.cmd = cmd;
+        for (b, pair) in lane.batches.iter_mut().zip(cmds.chunks_exact(2)) {
+            b.cmds = [pair[0], pair[1]];
         }
     }
     Ok(Lanes { lanes, lane_of })
@@ -170,7 +182,7 @@ fn batches(l: usize, n: usize, points: &[(usize, usize, usize, usize)]) -> Vec<B
                 }
             }
             out.push(Batch {
-                cmd: vk::CommandBuffer::null(),
+                cmds: [vk::CommandBuffer::null(); 2],
                 first: start,
                 last: i,
                 waits,
@@ -246,7 +258,7 @@ pub(crate) fn record_barriers(
     unsafe { d.cmd_pipeline_barrier2(cmd, &info) };
 }
 
-/// Records every batch of every lane.
+/// Records every batch of every lane, once per [`Stamps`].
 pub(crate) fn record_all(
     gpu: &Gpu,
     plan: &Plan,
@@ -259,48 +271,81 @@ pub(crate) fn record_all(
     let d = &gpu.device;
     for lane in &lanes.lanes {
         let pool = timestamps.pool(lane.queue);
-        for batch in &lane.batches {
-            let cmd = batch.cmd;
-            let begin = vk::CommandBufferBeginInfo::default();
-            // SAFETY: a fresh command buffer from this lane's pool.
-            unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
-            if let Some(qp) = pool {
-                let first = 2 * batch.first as u32;
-                let count = 2 * (batch.last - batch.first + 1) as u32;
-                // SAFETY: outside any render pass.
-                unsafe { d.cmd_reset_query_pool(cmd, qp, first, count) };
-            }
-            for i in batch.first..=batch.last {
-                let p = lane.passes[i];
-                let built =
-                    pipelines
-                        .built
-                        .iter()
-                        .find(|b| b.p == p)
-                        .ok_or_else(|| AshError::Pass {
-                            pass: plan.pass_name(p).to_string(),
-                            message: "no pipeline was built".into(),
-                        })?;
-                record_barriers(d, cmd, &sync.before[p], memory);
-                // SAFETY: recording; handles live for the session.
-                unsafe {
-                    if let Some(qp) = pool {
-                        let top = vk::PipelineStageFlags2::TOP_OF_PIPE;
-                        d.cmd_write_timestamp2(cmd, top, qp, 2 * i as u32);
-                    }
-                    record_work(d, cmd, built, memory, sync);
-                    if let Some(qp) = pool {
-                        let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
-                        d.cmd_write_timestamp2(cmd, bottom, qp, 2 * i as u32 + 1);
+        let n = lane.passes.len();
+        for (b, batch) in lane.batches.iter().enumerate() {
+            for stamps in [Stamps::Passes, Stamps::Frame] {
+                let cmd = batch.cmds[stamps as usize];
+                let begin = vk::CommandBufferBeginInfo::default();
+                // SAFETY: a fresh command buffer from this lane's pool.
+                unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
+                // The queries this batch writes: (reset range, per-pass stamps).
+                let (reset, per_pass) = match stamps {
+                    Stamps::Passes => ((2 * batch.first, 2 * (batch.last - batch.first + 1)), true),
+                    Stamps::Frame if b == 0 => ((0, 2 * n), false),
+                    Stamps::Frame => ((0, 0), false),
+                };
+                let top = vk::PipelineStageFlags2::TOP_OF_PIPE;
+                let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
+                if let Some(qp) = pool.filter(|_| reset.1 > 0) {
+                    // SAFETY: outside any render pass.
+                    unsafe { d.cmd_reset_query_pool(cmd, qp, reset.0 as u32, reset.1 as u32) };
+                    if stamps == Stamps::Frame {
+                        // SAFETY: recording; the query was just reset.
+                        unsafe { d.cmd_write_timestamp2(cmd, top, qp, 0) };
                     }
                 }
-                record_barriers(d, cmd, &sync.after[p], memory);
+                for i in batch.first..=batch.last {
+                    let built = built_pass(plan, pipelines, lane.passes[i])?;
+                    let qp = pool.filter(|_| per_pass);
+                    record_pass(d, cmd, built, memory, sync, qp.map(|qp| (qp, 2 * i as u32)));
+                }
+                if let Some(qp) = pool.filter(|_| stamps == Stamps::Frame && batch.last + 1 == n) {
+                    // SAFETY: recording; reset by the lane's first batch.
+                    unsafe { d.cmd_write_timestamp2(cmd, bottom, qp, 2 * n as u32 - 1) };
+                }
+                // SAFETY: recording state.
+                unsafe { d.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
             }
-            // SAFETY: recording state.
-            unsafe { d.end_command_buffer(cmd) }.ctx("vkEndCommandBuffer")?;
         }
     }
     Ok(())
+}
+
+fn built_pass<'a>(plan: &Plan, pipelines: &'a Pipelines, p: PassId) -> Result<&'a Built, AshError> {
+    pipelines
+        .built
+        .iter()
+        .find(|b| b.p == p)
+        .ok_or_else(|| AshError::Pass {
+            pass: plan.pass_name(p).to_string(),
+            message: "no pipeline was built".into(),
+        })
+}
+
+/// One pass: its barriers before, its work (between timestamps `query`
+/// and `query + 1` of the pool, where given) and its barriers after.
+fn record_pass(
+    d: &ash::Device,
+    cmd: vk::CommandBuffer,
+    built: &Built,
+    memory: &Memory,
+    sync: &SyncPlan,
+    stamps: Option<(vk::QueryPool, u32)>,
+) {
+    let p = built.p;
+    record_barriers(d, cmd, &sync.before[p], memory);
+    // SAFETY: recording; handles live for the session; the queries were
+    // reset at the start of this command buffer.
+    unsafe {
+        if let Some((qp, q)) = stamps {
+            d.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::TOP_OF_PIPE, qp, q);
+        }
+        record_work(d, cmd, built, memory, sync);
+        if let Some((qp, q)) = stamps {
+            d.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::BOTTOM_OF_PIPE, qp, q + 1);
+        }
+    }
+    record_barriers(d, cmd, &sync.after[p], memory);
 }
 
 /// # Safety

@@ -12,6 +12,7 @@
 use crate::barriers::Scope;
 use crate::error::{AshError, VkContext};
 use crate::pipelines::DrawCall;
+use crate::record::Stamps;
 use crate::session::{Frame, Session};
 use crate::timing::PassTiming;
 use ash::vk;
@@ -21,10 +22,30 @@ impl Session {
     /// Uploads `inputs` (imported resources every frame, history resources on
     /// the first) and runs one frame; returns its per-pass GPU times.
     pub fn run(&mut self, inputs: &Upload) -> Result<Frame, AshError> {
+        self.run_with(inputs, Stamps::Passes)?;
+        let timings = self.collect_timings()?;
+        self.gpu.check("the frame")?;
+        self.timings = timings.clone();
+        Ok(Frame { timings })
+    }
+
+    /// Runs one frame as [`Session::run`] does, with timestamps only where
+    /// each queue's part of it begins and ends ([`Stamps::Frame`]); returns
+    /// its GPU time in ms, first begin to last end, or `None` where no
+    /// queue it ran on has timestamps. Per-pass times keep those of the
+    /// last [`Session::run`].
+    pub fn run_frame_timed(&mut self, inputs: &Upload) -> Result<Option<f64>, AshError> {
+        self.run_with(inputs, Stamps::Frame)?;
+        let span = self.frame_span()?;
+        self.gpu.check("the frame")?;
+        Ok(span)
+    }
+
+    fn run_with(&mut self, inputs: &Upload, stamps: Stamps) -> Result<(), AshError> {
         self.stage_inputs(inputs)?;
         let prologue = self.record_prologue(inputs)?;
         self.submit_prologue(prologue)?;
-        self.submit_batches()?;
+        self.submit_batches(stamps)?;
         self.frames += 1;
         let t0 = std::time::Instant::now();
         self.wait_frame("the frame")?;
@@ -32,10 +53,7 @@ impl Session {
         for (&r, &l) in &self.sync.last_layout {
             self.layouts.insert(r, l);
         }
-        let timings = self.collect_timings()?;
-        self.gpu.check("the frame")?;
-        self.timings = timings.clone();
-        Ok(Frame { timings })
+        Ok(())
     }
 
     /// Copies the given inputs into the staging buffer.
@@ -110,7 +128,7 @@ impl Session {
     /// Submits every batch of the frame, ordered by their first pass in plan
     /// order: a signal's batch ends at or before the pass its wait starts
     /// with, so every signal is submitted before its wait.
-    fn submit_batches(&self) -> Result<(), AshError> {
+    fn submit_batches(&self, stamps: Stamps) -> Result<(), AshError> {
         let f = self.frames;
         let pos = |p| self.plan.position(p).unwrap_or(usize::MAX);
         let mut order: Vec<(usize, usize)> = Vec::new();
@@ -138,7 +156,9 @@ impl Session {
             }
             let last = f * self.stride + batch.last as u64 + 1;
             let signal = [Self::at(lane.semaphore.raw(), last)];
-            let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(batch.cmd)];
+            let cmds =
+                [vk::CommandBufferSubmitInfo::default()
+                    .command_buffer(batch.cmds[stamps as usize])];
             let submit = vk::SubmitInfo2::default()
                 .wait_semaphore_infos(&waits)
                 .command_buffer_infos(&cmds)
@@ -212,6 +232,28 @@ impl Session {
         } else {
             format!(" (unfinished: {})", stuck.join(", "))
         }
+    }
+
+    /// The last frame's first lane begin to last lane end, from the
+    /// queries [`Stamps::Frame`] writes.
+    fn frame_span(&self) -> Result<Option<f64>, AshError> {
+        let period = f64::from(self.gpu.props.limits.timestamp_period);
+        let mut spans = Vec::new();
+        for lane in &self.lanes.lanes {
+            let q = lane.queue;
+            let last = 2 * lane.passes.len() as u32 - 1;
+            if let Some((a, b)) = self.timestamps.read_pair(&self.gpu, q, 0, last)? {
+                spans.push((
+                    a,
+                    a.wrapping_add(b.wrapping_sub(a) & self.timestamps.mask(q)),
+                ));
+            }
+        }
+        let begin = spans.iter().map(|s| s.0).min();
+        let end = spans.iter().map(|s| s.1).max();
+        Ok(begin
+            .zip(end)
+            .map(|(a, b)| b.saturating_sub(a) as f64 * period / 1e6))
     }
 
     fn collect_timings(&self) -> Result<Vec<PassTiming>, AshError> {

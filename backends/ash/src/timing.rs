@@ -1,5 +1,6 @@
 //! Per-pass GPU times: a timestamp query pool per queue, two queries per
-//! pass, reset at the start of each batch that writes them. Ticks are masked
+//! pass, reset at the start of each batch that writes them. Frames recorded
+//! with `Stamps::Frame` (record.rs) write only the lane's first and last. Ticks are masked
 //! to the family's `timestampValidBits` and scaled by `timestampPeriod`.
 
 use crate::device::Gpu;
@@ -83,6 +84,37 @@ impl Timestamps {
         .ctx("vkGetQueryPoolResults")?;
         let mask = self.mask(q);
         Ok(Some(ticks.into_iter().map(|t| t & mask).collect()))
+    }
+
+    /// Queries `a` and `b` of queue `q`'s pool, masked to the valid bits.
+    pub fn read_pair(
+        &self,
+        gpu: &Gpu,
+        q: usize,
+        a: u32,
+        b: u32,
+    ) -> Result<Option<(u64, u64)>, AshError> {
+        let Some((pool, _)) = &self.pools[q] else {
+            return Ok(None);
+        };
+        let mask = self.mask(q);
+        let mut ticks = [0u64; 2];
+        for (t, query) in ticks.iter_mut().zip([a, b]) {
+            let mut one = [0u64; 1];
+            // SAFETY: the frame that wrote the query has completed (the
+            // host waited on every queue's timeline before reading).
+            unsafe {
+                gpu.device.get_query_pool_results(
+                    pool.raw(),
+                    query,
+                    &mut one,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+            }
+            .ctx("vkGetQueryPoolResults")?;
+            *t = one[0] & mask;
+        }
+        Ok(Some((ticks[0], ticks[1])))
     }
 
     pub fn mask(&self, q: usize) -> u64 {
