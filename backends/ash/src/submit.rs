@@ -139,7 +139,10 @@ impl Session {
             let lane = &self.lanes.lanes[l];
             pos(lane.passes[lane.batches[b].first])
         });
-        for (l, b) in order {
+        // Per batch: its queue, waits, signal and command buffer, kept alive
+        // until the submit calls below.
+        let mut parts = Vec::with_capacity(order.len());
+        for &(l, b) in &order {
             let lane = &self.lanes.lanes[l];
             let batch = &lane.batches[b];
             // ALL_COMMANDS: the plan's happens-before chains run through
@@ -159,16 +162,36 @@ impl Session {
             let cmds =
                 [vk::CommandBufferSubmitInfo::default()
                     .command_buffer(batch.cmds[stamps as usize])];
-            let submit = vk::SubmitInfo2::default()
-                .wait_semaphore_infos(&waits)
-                .command_buffer_infos(&cmds)
-                .signal_semaphore_infos(&signal);
-            let queue = self.gpu.queues[lane.queue].queue;
+            parts.push((lane.queue, waits, signal, cmds));
+        }
+        let submits: Vec<(usize, vk::SubmitInfo2<'_>)> = parts
+            .iter()
+            .map(|(q, waits, signal, cmds)| {
+                let info = vk::SubmitInfo2::default()
+                    .wait_semaphore_infos(waits)
+                    .command_buffer_infos(cmds)
+                    .signal_semaphore_infos(signal);
+                (*q, info)
+            })
+            .collect();
+        let per_queue = std::env::var_os("STRANDGRAPH_ASH_SUBMIT").is_some_and(|v| v == "queue");
+        let calls: Vec<(usize, Vec<vk::SubmitInfo2<'_>>)> = if per_queue {
+            // Timeline semaphores may be waited on before their signal is
+            // submitted: one call per queue, in lane order.
+            (0..self.gpu.queues.len())
+                .map(|q| (q, submits.iter().filter(|s| s.0 == q).map(|s| s.1).collect()))
+                .filter(|(_, v): &(usize, Vec<_>)| !v.is_empty())
+                .collect()
+        } else {
+            submits.iter().map(|&(q, s)| (q, vec![s])).collect()
+        };
+        for (q, infos) in calls {
+            let queue = self.gpu.queues[q].queue;
             // SAFETY: recorded command buffers; the previous frame completed.
             unsafe {
                 self.gpu
                     .device
-                    .queue_submit2(queue, &[submit], vk::Fence::null())
+                    .queue_submit2(queue, &infos, vk::Fence::null())
             }
             .ctx("vkQueueSubmit2")?;
         }
