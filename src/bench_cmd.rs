@@ -296,7 +296,8 @@ pub fn run(mut args: Args) -> Result<()> {
                 tracing::info!(scene = %scene.display(), graph, "preparing");
                 let mut p = prepare_graph(scene, &locate(graph), size, args.quick);
                 if let Ok(p) = &mut p {
-                    let count = args.warmup + args.frames;
+                    // The timed frames, then as many again timed at their bounds.
+                    let count = args.warmup + 2 * args.frames;
                     if let Some(frames) = sequence::animation_frames(p, count, FPS)? {
                         animated.insert((s, graph), frames);
                     }
@@ -458,8 +459,8 @@ struct Timed {
     bounds: Vec<f64>,
 }
 
-/// Runs `warmup` then `frames` frames timed per pass, then the timed
-/// frames again timed at their bounds only.
+/// Runs `warmup` then `frames` frames timed per pass, then `frames` more
+/// timed at their bounds only.
 fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<Timed> {
     // Frame k runs inputs[k], the last one again once they run out.
     let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
@@ -487,8 +488,10 @@ fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<T
         });
         passes.push(times);
     }
+    // An animated scene goes on (its inputs are each frame's changes from
+    // the last); a still one runs its frame again.
     let mut bounds = Vec::with_capacity(args.frames);
-    for k in args.warmup..args.warmup + args.frames {
+    for k in args.warmup + args.frames..args.warmup + 2 * args.frames {
         match session.run_frame_timed(input(k))? {
             Some(ms) => bounds.push(ms),
             None => break,

@@ -55,6 +55,7 @@ pub struct Session {
     /// `(index in plan order, args resource, word)` of indirect dispatches.
     pub(crate) indirect: Vec<(usize, usize, usize)>,
     pub(crate) timeout: Duration,
+    pub(crate) submit: crate::Submit,
     /// The last frame's per-pass GPU times, in plan order.
     pub timings: Vec<PassTiming>,
     /// What the device is and how the plan ran on it.
@@ -243,6 +244,7 @@ impl Session {
             layouts,
             indirect: indirect_dispatches(plan, &prepared),
             timeout: wait_limit(backend.timeout, gpu.props.device_type),
+            submit: backend.submit,
             timings: Vec::new(),
             notes,
             device: gpu.name.clone(),

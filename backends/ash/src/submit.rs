@@ -127,7 +127,9 @@ impl Session {
 
     /// Submits every batch of the frame, ordered by their first pass in plan
     /// order: a signal's batch ends at or before the pass its wait starts
-    /// with, so every signal is submitted before its wait.
+    /// with, so every signal is submitted before its wait. With
+    /// [`crate::Submit::PerQueue`], one call per queue takes that queue's
+    /// batches in that order.
     fn submit_batches(&self, stamps: Stamps) -> Result<(), AshError> {
         let f = self.frames;
         let pos = |p| self.plan.position(p).unwrap_or(usize::MAX);
@@ -174,12 +176,17 @@ impl Session {
                 (*q, info)
             })
             .collect();
-        let per_queue = std::env::var_os("STRANDGRAPH_ASH_SUBMIT").is_some_and(|v| v == "queue");
+        let per_queue = self.submit == crate::Submit::PerQueue;
         let calls: Vec<(usize, Vec<vk::SubmitInfo2<'_>>)> = if per_queue {
             // Timeline semaphores may be waited on before their signal is
-            // submitted: one call per queue, in lane order.
+            // submitted.
             (0..self.gpu.queues.len())
-                .map(|q| (q, submits.iter().filter(|s| s.0 == q).map(|s| s.1).collect()))
+                .map(|q| {
+                    (
+                        q,
+                        submits.iter().filter(|s| s.0 == q).map(|s| s.1).collect(),
+                    )
+                })
                 .filter(|(_, v): &(usize, Vec<_>)| !v.is_empty())
                 .collect()
         } else {

@@ -12,6 +12,13 @@
 //! dispatch: `[groups, 1, 1, count]`; word 3 is the append counter and word
 //! 0 is raised with `atomicMax` by every subgroup, so no scan pass is needed.
 //! `wave_aggregated_atomics: false` appends one lane at a time (the ablation).
+//!
+//! `word_per_lane` (ours): a lane takes a 32-bit word of visibility bits,
+//! not one bit, and appends its set bits in order after the subgroup's
+//! earlier lanes' (`subgroupExclusiveAdd` of the bit counts). The order is
+//! the same natural order; the dispatch is 32 times smaller. Most words are
+//! empty beyond the LOD's kept strands, so most lanes do one load. Off, a
+//! workgroup covers the same 8,192 segments in 32 rounds of a bit per lane.
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
@@ -20,6 +27,8 @@ use crate::params::PassParams;
 use strandgraph_graph::schema::Quantity;
 
 pub const GROUP: u32 = 256;
+/// Segments per workgroup: a word of 32 visibility bits per lane.
+pub const SEGMENTS_PER_GROUP: u32 = GROUP * 32;
 /// Segments per workgroup of `kulikov.shade` (the indirect count's divisor).
 pub const SHADE_GROUP: u32 = 64;
 /// The most workgroups `shade_args` asks for: every Vulkan device launches
@@ -33,12 +42,15 @@ pub const MAX_SHADE_GROUPS: u32 = 65_535;
 pub struct ShadeSortParams {
     /// One `atomicAdd` per subgroup; off, one per lane (the ablation).
     pub wave_aggregated_atomics: bool,
+    /// Ours: a lane appends a word's set bits; off, a bit per lane.
+    pub word_per_lane: bool,
 }
 
 impl Default for ShadeSortParams {
     fn default() -> Self {
         Self {
             wave_aggregated_atomics: true,
+            word_per_lane: true,
         }
     }
 }
@@ -46,9 +58,10 @@ impl Default for ShadeSortParams {
 impl PassParams for ShadeSortParams {}
 
 crate::gpu_block! {
-    /// The WGSL `ShadeSortParams` block (binding 0): switch, segments.
+    /// The WGSL `ShadeSortParams` block (binding 0): switches, segments.
     pub struct ShadeSortGpu {
         wave_aggregated_atomics: u32,
+        word_per_lane: u32,
         /// Scene quantity: segments in the full numbering.
         segments: u32,
     }
@@ -66,16 +79,18 @@ pub static SHADE_SORT: PassKind<ShadeSortParams, ShadeSortGpu> = PassKind {
     workgroup_size: GROUP,
     dispatch: Dispatch::PerElement {
         quantity: Quantity::Segments,
-        per_group: GROUP,
+        per_group: SEGMENTS_PER_GROUP,
     },
     shader: Shader::compute("kulikov/shade_sort.wgsl", "shade_sort"),
     kernel: |p| {
         Box::new(ShadeSortKernel {
             aggregated: p.wave_aggregated_atomics,
+            word_per_lane: p.word_per_lane,
         })
     },
     gpu: |p, q| ShadeSortGpu {
         wave_aggregated_atomics: flag(p.wave_aggregated_atomics),
+        word_per_lane: flag(p.word_per_lane),
         segments: count(q.segments),
     },
     raster: None,
@@ -83,67 +98,105 @@ pub static SHADE_SORT: PassKind<ShadeSortParams, ShadeSortGpu> = PassKind {
 
 struct ShadeSortKernel {
     aggregated: bool,
+    word_per_lane: bool,
 }
 
 impl CpuKernel for ShadeSortKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let (bits, args, out) = (
-            ctx.words("segment_visibility"),
-            ctx.words("shade_args"),
-            ctx.words("shading_segments"),
-        );
-        let width = ctx.subgroup_width.max(1);
+        let bits = ctx.words("segment_visibility");
+        let segments = ctx.quantities.segments;
+        // Lane l's visibility bits and the segment of its bit 0.
+        let lane_bits = |first: u32, one_bit: bool| -> u32 {
+            let word = if u64::from(first) < segments {
+                bits.load((first / 32) as usize)
+            } else {
+                0
+            };
+            if one_bit {
+                return (word >> (first % 32)) & 1;
+            }
+            // A whole word (`first` is a multiple of 32): off with the bits
+            // of segments past the end, which no pass sets.
+            let valid = (segments - u64::from(first)).min(32) as u32;
+            word & if valid == 32 { !0 } else { (1 << valid) - 1 }
+        };
+        let base = group * SEGMENTS_PER_GROUP;
         let mut tally = CounterValues::default();
-        for sub in (0..GROUP).step_by(width as usize) {
-            let ids: Vec<u32> = (sub..(sub + width).min(GROUP))
-                .map(|l| group * GROUP + l)
+        if self.word_per_lane {
+            let lanes: Vec<(u32, u32)> = (0..GROUP)
+                .map(|l| base + 32 * l)
+                .map(|first| (lane_bits(first, false), first))
                 .collect();
-            let active: Vec<bool> = ids
-                .iter()
-                .map(|&id| {
-                    u64::from(id) < ctx.quantities.segments
-                        && bits.load((id / 32) as usize) & (1 << (id % 32)) != 0
-                })
-                .collect();
-            let n = subgroup::count(&active);
+            self.append(&lanes, ctx, &mut tally);
+        } else {
+            for round in 0..32 {
+                let lanes: Vec<(u32, u32)> = (0..GROUP)
+                    .map(|l| base + round * GROUP + l)
+                    .map(|id| (lane_bits(id, true), id))
+                    .collect();
+                self.append(&lanes, ctx, &mut tally);
+            }
+        }
+        if ctx.instrument {
+            ctx.counters.add(&tally);
+        }
+    }
+}
+
+impl ShadeSortKernel {
+    /// One workgroup step: each lane's `(bits, first segment)`; a lane's
+    /// set bits are appended as segments `first + bit`, in bit order, after
+    /// those of the subgroup's earlier lanes.
+    fn append(&self, lanes: &[(u32, u32)], ctx: &Ctx<'_>, tally: &mut CounterValues) {
+        let (args, out) = (ctx.words("shade_args"), ctx.words("shading_segments"));
+        let width = ctx.subgroup_width.max(1) as usize;
+        for sub in lanes.chunks(width) {
+            let counts: Vec<u32> = sub.iter().map(|(b, _)| b.count_ones()).collect();
+            let n: u32 = counts.iter().sum();
             if n == 0 {
                 continue;
             }
-            let (slots, end) = if self.aggregated {
-                let ones = vec![1; ids.len()];
+            let mut end = 0;
+            if self.aggregated {
                 let base = args.fetch_add(3, n);
                 tally.atomics += 1;
-                let offs = subgroup::exclusive_add(&ones, &active);
-                (offs.iter().map(|o| base + o).collect::<Vec<_>>(), base + n)
+                let offsets = subgroup::exclusive_add(&counts, &vec![true; sub.len()]);
+                for (&(b, first), offset) in sub.iter().zip(offsets) {
+                    for (k, bit) in set_bits(b).enumerate() {
+                        out.store((base + offset) as usize + k, first + bit);
+                    }
+                }
+                end = base + n;
             } else {
-                let slots: Vec<u32> = active
-                    .iter()
-                    .map(|&a| if a { args.fetch_add(3, 1) } else { 0 })
-                    .collect();
+                // One append per segment.
                 tally.atomics += u64::from(n);
-                let end = slots
-                    .iter()
-                    .zip(&active)
-                    .filter(|(_, a)| **a)
-                    .map(|(s, _)| s + 1);
-                (slots.clone(), end.max().unwrap_or(0))
-            };
-            for ((id, slot), a) in ids.iter().zip(&slots).zip(&active) {
-                if *a {
-                    out.store(*slot as usize, *id);
+                for &(b, first) in sub {
+                    for bit in set_bits(b) {
+                        let slot = args.fetch_add(3, 1);
+                        out.store(slot as usize, first + bit);
+                        end = end.max(slot + 1);
+                    }
                 }
             }
             args.fetch_max(0, end.div_ceil(SHADE_GROUP).min(MAX_SHADE_GROUPS));
             args.store(1, 1);
             args.store(2, 1);
             tally.atomics += 1;
-            tally.active_lanes += u64::from(n);
-            tally.total_lanes += u64::from(width);
-        }
-        if ctx.instrument {
-            ctx.counters.add(&tally);
+            tally.active_lanes += counts.iter().filter(|&&c| c > 0).count() as u64;
+            tally.total_lanes += width as u64;
         }
     }
+}
+
+/// The set bits of `b`, lowest first.
+fn set_bits(mut b: u32) -> impl Iterator<Item = u32> {
+    std::iter::from_fn(move || {
+        (b != 0).then(|| {
+            let bit = b.trailing_zeros();
+            b &= b - 1;
+            bit
+        })
+    })
 }
 
 #[cfg(test)]
@@ -153,15 +206,18 @@ mod tests {
     use strandgraph_graph::Quantities;
 
     fn run(aggregated: bool, width: u32) -> (Vec<u32>, Vec<u32>, u64) {
-        run_on(1000, aggregated, width, |i| (i * 7919) % 3 != 0)
+        let (args, visible, atomics, _) =
+            run_on(1000, (aggregated, true), width, |i| (i * 7919) % 3 != 0);
+        (args, visible, atomics)
     }
 
+    /// `switches`: (wave_aggregated_atomics, word_per_lane).
     fn run_on(
         segments: u32,
-        aggregated: bool,
+        switches: (bool, bool),
         width: u32,
         shown: impl Fn(u32) -> bool,
-    ) -> (Vec<u32>, Vec<u32>, u64) {
+    ) -> (Vec<u32>, Vec<u32>, u64, Vec<u32>) {
         let visible: Vec<u32> = (0..segments).filter(|&i| shown(i)).collect();
         let mut bits = vec![0u32; segments.div_ceil(32) as usize];
         for &v in &visible {
@@ -175,15 +231,19 @@ mod tests {
         hs.buffer("segment_visibility", bits)
             .buffer("shade_args", vec![0; 4])
             .buffer("shading_segments", vec![u32::MAX; segments as usize + 4]);
-        let params: ron::Value =
-            ron::from_str(&format!("{{\"wave_aggregated_atomics\": {aggregated}}}")).unwrap();
+        let (aggregated, words) = switches;
+        let params: ron::Value = ron::from_str(&format!(
+            "{{\"wave_aggregated_atomics\": {aggregated}, \"word_per_lane\": {words}}}"
+        ))
+        .unwrap();
         let k = crate::PassDef::cpu_kernel(&SHADE_SORT, &params).unwrap();
-        let c = hs.run(k.as_ref(), segments.div_ceil(GROUP), GROUP);
+        let c = hs.run(k.as_ref(), segments.div_ceil(SEGMENTS_PER_GROUP), GROUP);
         let args = hs.read("shade_args");
-        let mut list = hs.read("shading_segments")[..args[3] as usize].to_vec();
+        let appended = hs.read("shading_segments")[..args[3] as usize].to_vec();
+        let mut list = appended.clone();
         list.sort_unstable();
         assert_eq!(list, visible);
-        (args, visible, c.atomics)
+        (args, visible, c.atomics, appended)
     }
 
     #[test]
@@ -200,7 +260,23 @@ mod tests {
     #[test]
     fn more_segments_than_one_dispatch_holds_cap_the_groups() {
         let n = MAX_SHADE_GROUPS * SHADE_GROUP + 100;
-        let (args, ..) = run_on(n, true, 32, |_| true);
+        let (args, ..) = run_on(n, (true, true), 32, |_| true);
         assert_eq!(args, vec![MAX_SHADE_GROUPS, 1, 1, n]);
+    }
+
+    #[test]
+    fn a_word_per_lane_keeps_natural_order_with_fewer_appends() {
+        // One workgroup (its subgroups run in order), a count that is not a
+        // multiple of 32, visibility in runs as the LOD's kept strands give.
+        let shown = |i: u32| ((i / 40) % 3 != 1 && i % 7 != 0) || i >= 4990;
+        let (args, visible, words, in_words) = run_on(5000, (true, true), 32, shown);
+        let (bit_args, _, bits, in_bits) = run_on(5000, (true, false), 32, shown);
+        assert_eq!(in_words, visible);
+        assert_eq!(in_bits, visible);
+        assert_eq!(args, bit_args);
+        assert!(words * 8 < bits, "{words} vs {bits}");
+        // Per-segment appends of either layout give the same set.
+        run_on(5000, (false, true), 8, shown);
+        run_on(5000, (false, false), 8, shown);
     }
 }
