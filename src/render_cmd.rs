@@ -304,7 +304,7 @@ fn tagged(path: &Path, tag: Option<&str>) -> PathBuf {
 /// writes it), else the scene depth every graph keeps (all its versions
 /// share the memory, so this reads the last one).
 const DEPTHS: [&str; 2] = ["hair_depth", "scene.depth"];
-/// Per-pixel motion (kulikov.pixel_motion).
+/// Per-pixel motion (kulikov.compose).
 const MOTION: &str = "pixel_motion";
 
 /// The main image's alpha (the hair's coverage) as a 16-bit grey PNG.

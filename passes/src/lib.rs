@@ -73,7 +73,6 @@ pub static PASSES: &[&dyn PassDef] = &[
     &kulikov::shade_sort::SHADE_SORT,
     &kulikov::shade::SHADE,
     &kulikov::compose::COMPOSE,
-    &kulikov::pixel_motion::PIXEL_MOTION,
     &kulikov::skin_shadow::SKIN_SHADOW,
     &kulikov::motion::STORE_HISTORY,
     // Lipp et al., deferred software rasterization of hair meshes.

@@ -6,7 +6,8 @@
 // premultiplied over the pixel (src One, dst OneMinusSrcAlpha, as the talk's
 // per-model quads blend), and writes the front layer's depth where the
 // coverage reaches depth_threshold and is nearer ("We write hair to depth as
-// we render it").
+// we render it"), with the pixel's motion: of the segment that wrote the
+// depth, else the depth reprojected (compose/motion.rs).
 // Why compute rather than the talk's camera-facing quads: Hopper runs pixel
 // shaders on few of its SMs, and the quads ran the whole reconstruction twice
 // per pixel (colour, then frag_depth); here it runs once, on every SM.
@@ -48,6 +49,10 @@ struct ComposeParams {
 @group(0) @binding(10) var scene_depth: texture_2d<f32>;
 @group(0) @binding(11) var output: texture_storage_2d<rgba16float, read_write>;
 @group(0) @binding(12) var hair_depth: texture_storage_2d<r32float, write>;
+@group(0) @binding(13) var<storage, read> prev_frame: FrameData;
+// Per vertex: this frame's screen position minus last frame's, pixels.
+@group(0) @binding(14) var<storage, read> vertex_motion: array<vec2<f32>>;
+@group(0) @binding(15) var<storage, read_write> pixel_motion: array<vec2<f32>>;
 
 const GROUP: u32 = 256u;
 // Models whose order fits in workgroup memory; a frame with more takes the
@@ -147,11 +152,15 @@ struct Hair {
     alpha: f32,
     // View depth of the front layer (0 when none).
     front_w: f32,
+    // The front layer's segment and where the sample projects on it (motion::Front).
+    front_va: u32,
+    front_vb: u32,
+    front_t: f32,
 }
 
 // One pixel of one model: compose::ComposeKernel and reconstruct::reconstruct.
 fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
-    var out = Hair(vec3<f32>(0.0), 0.0, 0.0);
+    var out = Hair(vec3<f32>(0.0), 0.0, 0.0, 0u, 0u, 0.0);
     let t = load_tiles(atlas_tiles[m]);
     let d = t.downscale;
     var sx = x;
@@ -214,6 +223,9 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
         }
         if n == 0u {
             out.front_w = trapezoid_depth_at(trap.a, trap.b, trap.wa, trap.wb, u, v);
+            out.front_va = seg.va;
+            out.front_vb = seg.vb;
+            out.front_t = tt;
         }
         cov[n] = clamp(coverage, 0.0, 1.0);
         // The vertex lighting at the ends of the part in front of the near plane.
@@ -246,6 +258,24 @@ fn compose_pixel(m: u32, x: u32, y: u32) -> Hair {
     return out;
 }
 
+// motion::reprojected: the surface at depth z moved by the camera alone;
+// zero without a previous camera or behind its near plane.
+fn reprojected(x: u32, y: u32, z: f32) -> vec2<f32> {
+    if prev_frame.screen.x <= 0.0 {
+        return vec2<f32>(0.0);
+    }
+    let w = frame.screen.x;
+    let h = frame.screen.y;
+    let ndc = vec2<f32>((f32(x) + 0.5) / w * 2.0 - 1.0, 1.0 - (f32(y) + 0.5) / h * 2.0);
+    let world = frame.inv_view_proj * vec4<f32>(ndc, z, 1.0);
+    let c = prev_frame.view_proj * (world / world.w);
+    if !(c.w > prev_frame.near) {
+        return vec2<f32>(0.0);
+    }
+    let p = c.xy / c.w;
+    return vec2<f32>((ndc.x - p.x) * 0.5 * w, (p.y - ndc.y) * 0.5 * h);
+}
+
 @compute @workgroup_size(256)
 fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let models_n = frame.model_count;
@@ -267,6 +297,11 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
     var z = scene_z;
     var color = textureLoad(output, vec2<u32>(x, y));
     var touched = false;
+    // The front layer that wrote the depth, for motion.
+    var front = false;
+    var front_va = 0u;
+    var front_vb = 0u;
+    var front_t = 0.0;
     for (var r = 0u; r < models_n; r++) {
         var m = 0u;
         var reach = 1u;
@@ -289,9 +324,23 @@ fn compose(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
         // compose::ndc_depth of the front layer, where nearer.
         if h.alpha >= params.depth_threshold && h.front_w > 0.0 {
             let hz = frame.far * (h.front_w - frame.near) / (h.front_w * (frame.far - frame.near));
-            z = min(z, hz);
+            if hz < z {
+                z = hz;
+                front = true;
+                front_va = h.front_va;
+                front_vb = h.front_vb;
+                front_t = h.front_t;
+            }
         }
     }
+    var m = vec2<f32>(0.0);
+    if front {
+        let ma = vertex_motion[front_va];
+        m = ma + front_t * (vertex_motion[front_vb] - ma);
+    } else if z < 1.0 {
+        m = reprojected(x, y, z);
+    }
+    pixel_motion[i] = m;
     if touched {
         textureStore(output, vec2<u32>(x, y), color);
     }

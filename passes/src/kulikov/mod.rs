@@ -10,7 +10,6 @@ pub mod depth_downsample;
 pub mod lod;
 pub mod motion;
 pub mod payload;
-pub mod pixel_motion;
 pub mod raster;
 pub mod shade;
 pub mod shade_sort;

@@ -29,12 +29,15 @@
 //! - [`reconstruct`] [`reconstruct_missing`: false uses the 3 front layers only;
 //!   `layers`: how many of the 3 it reads, for the one-layer ablation];
 //! - hair depth (the front layer's) where the result's coverage reaches
-//!   [`depth_threshold`] and is nearer than `scene.depth`, into `hair_depth`.
+//!   [`depth_threshold`] and is nearer than `scene.depth`, into `hair_depth`;
+//! - per-pixel motion ([`motion`]): of the front segment that wrote the
+//!   depth, else the depth reprojected, into `pixel_motion`.
 //!
 //! Models sort by the view depth of their bounds' centre; facial hair is
 //! pushed back by [`facial_hair_bias`] metres so it composes before the
 //! main hair piece ("Large bias for facial hair").
 
+pub mod motion;
 pub mod reconstruct;
 #[cfg(test)]
 mod tests;
@@ -49,8 +52,9 @@ use super::{Scene, TILE};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
 use crate::kernel::{CounterValues, Ctx, Words};
-use crate::layout::MODEL_FACIAL_HAIR;
+use crate::layout::{FrameData, MODEL_FACIAL_HAIR, read};
 use crate::params::{Invalid, PassParams, in_range};
+use motion::Front;
 use reconstruct::{Layer, reconstruct};
 use strandgraph_graph::Quantities;
 use strandgraph_graph::schema::Quantity;
@@ -181,7 +185,7 @@ crate::gpu_block! {
 
 pub static COMPOSE: PassKind<ComposeParams, ComposeGpu> = PassKind {
     kind: "kulikov.compose",
-    summary: "per pixel, models back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth (motion: kulikov.pixel_motion)",
+    summary: "per pixel, models back to front: coverage reconstruction, weighted lighting, Poisson-disk atlas sampling, hair depth and motion",
     source: "Kulikov 2025, 'Composition', 'Motion vectors'",
     bindings: Some(&[
         Binding::read("frame"),
@@ -197,6 +201,9 @@ pub static COMPOSE: PassKind<ComposeParams, ComposeGpu> = PassKind {
         // Blended in place (read_write storage image).
         Binding::write("output"),
         Binding::write("hair_depth"),
+        Binding::read("prev_frame"),
+        Binding::read("vertex_motion"),
+        Binding::write("pixel_motion"),
     ]),
     workgroup_size: GROUP,
     dispatch: Dispatch::PerElement {
@@ -317,8 +324,17 @@ pub(crate) fn axis_t(trap: &Trapezoid, u: i32, v: i32) -> f32 {
         .clamp(0.0, 1.0)
 }
 
+/// One atlas layer of a texel as composition reads it.
+struct Sample {
+    layer: Layer,
+    /// View depth at the texel.
+    depth: f32,
+    /// The segment, and where the texel centre projects on it.
+    front: Front,
+}
+
 impl ComposeKernel {
-    /// The up-to-3 layers of one texel: coverage, lighting and view depth.
+    /// The up-to-3 layers of one texel.
     #[allow(clippy::too_many_arguments)]
     fn layers(
         &self,
@@ -329,7 +345,7 @@ impl ComposeKernel {
         texel: usize,
         u: i32,
         v: i32,
-    ) -> Vec<(Layer, f32)> {
+    ) -> Vec<Sample> {
         let (vis, light) = (ctx.words("vis_atlas"), ctx.words("vertex_lighting"));
         let stride = vis.len() / LAYERS;
         let mut out = Vec::with_capacity(LAYERS);
@@ -365,7 +381,14 @@ impl ComposeKernel {
                 let [a, b] = part.ends(l0[k], l1[k]);
                 a + t * (b - a)
             });
-            out.push((Layer { coverage, lighting }, trap.depth_at(u, v)));
+            out.push(Sample {
+                layer: Layer { coverage, lighting },
+                depth: trap.depth_at(u, v),
+                front: Front {
+                    ends: [seg.v0, seg.v1],
+                    t,
+                },
+            });
         }
         out
     }
@@ -396,12 +419,16 @@ impl CpuKernel for ComposeKernel {
             ctx.words("scene.depth"),
             ctx.words("hair_depth"),
         );
+        let (vertex_motion, pixel_motion) = (ctx.words("vertex_motion"), ctx.words("pixel_motion"));
+        let prev: FrameData = read(&ctx.words("prev_frame"), 0);
         let (near, far) = (scene.frame.near, scene.frame.far);
         let mut tally = CounterValues::default();
         for i in group * GROUP..((group + 1) * GROUP).min(pixels) {
             let (x, y) = (i % width, i / width);
             let mut color = load_rgba16f(&out, i as usize);
             let mut z_out = depth.load_f32(i as usize);
+            // The front layer that wrote the depth, for motion.
+            let mut front = None;
             let mut touched = false;
             for md in &models {
                 let d = md.tiles.downscale;
@@ -420,8 +447,8 @@ impl CpuKernel for ComposeKernel {
                 };
                 let u = (sx / d - md.tiles.origin_x * TILE) as i32;
                 let v = (sy / d - md.tiles.origin_y * TILE) as i32;
-                let layers = self.layers(&scene, &lods, ctx, md, texel as usize, u, v);
-                let ls: Vec<Layer> = layers.iter().map(|(l, _)| *l).collect();
+                let samples = self.layers(&scene, &lods, ctx, md, texel as usize, u, v);
+                let ls: Vec<Layer> = samples.iter().map(|s| s.layer).collect();
                 let (hair, alpha) = reconstruct(&ls, c_total, self.0.reconstruct_missing);
                 for k in 0..3 {
                     color[k] = hair[k] + (1.0 - alpha) * color[k];
@@ -429,15 +456,19 @@ impl CpuKernel for ComposeKernel {
                 color[3] = alpha + (1.0 - alpha) * color[3];
                 touched = true;
                 if alpha >= self.0.depth_threshold
-                    && let Some((_, w)) = layers.first()
+                    && let Some(s) = samples.first()
                 {
-                    let z = ndc_depth(*w, near, far);
+                    let z = ndc_depth(s.depth, near, far);
                     if z < z_out {
                         z_out = z;
+                        front = Some(s.front);
                     }
                 }
             }
             hair_depth.store_f32(i as usize, z_out);
+            let m = motion::pixel_motion(front, &vertex_motion, &scene.frame, &prev, (x, y), z_out);
+            pixel_motion.store_f32(2 * i as usize, m[0]);
+            pixel_motion.store_f32(2 * i as usize + 1, m[1]);
             if touched {
                 store_rgba16f(&out, i as usize, color);
                 tally.pixels_written += 1;

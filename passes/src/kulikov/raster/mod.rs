@@ -186,8 +186,7 @@ struct Targets<'a> {
 
 /// The part of segment `v0`–`v1` in front of the near plane
 /// ([`near_clip`]) as a trapezoid in its model's raster grid: the shape the
-/// raster measures, and that composition and `kulikov.pixel_motion`
-/// evaluate again per pixel. Also returns the clipped part, whose ends
+/// raster measures, and that composition evaluates again per pixel. Also returns the clipped part, whose ends
 /// composition interpolates the vertex lighting between.
 pub(crate) fn segment_trapezoid(
     scene: &Scene,
