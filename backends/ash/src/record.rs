@@ -125,7 +125,12 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
     }
     let points = cross_points(plan, &lanes, &lane_of);
     for (l, lane) in lanes.iter_mut().enumerate() {
-        lane.batches = batches(l, lane.passes.len(), &points);
+        let order: Vec<usize> = lane
+            .passes
+            .iter()
+            .map(|&p| plan.position(p).unwrap_or(usize::MAX))
+            .collect();
+        lane.batches = batches(l, &order, &points);
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(lane.pool.raw())
             .level(vk::CommandBufferLevel::PRIMARY)
@@ -140,42 +145,52 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
     Ok(Lanes { lanes, lane_of })
 }
 
-/// Cross-queue sync points of the plan in backend lanes:
-/// `(signalling lane, its position, waiting lane, its position)`.
-fn cross_points(
-    plan: &Plan,
-    lanes: &[Lane],
-    lane_of: &[usize],
-) -> Vec<(usize, usize, usize, usize)> {
+/// A cross-queue sync point of the plan in backend lanes.
+#[derive(Debug, Clone, Copy)]
+struct Point {
+    /// Signalling lane and its 0-based position there.
+    signal: (usize, usize),
+    /// Waiting lane and the position of the pass that waits.
+    wait: (usize, usize),
+    /// The signalling pass's position in the plan's order.
+    signal_order: usize,
+}
+
+fn cross_points(plan: &Plan, lanes: &[Lane], lane_of: &[usize]) -> Vec<Point> {
     plan.sync_points
         .iter()
         .filter(|s| lane_of[s.after] != lane_of[s.before])
         .map(|s| {
             let (la, lb) = (lane_of[s.after], lane_of[s.before]);
-            (
-                la,
-                lanes[la].position(s.after).unwrap_or(0),
-                lb,
-                lanes[lb].position(s.before).unwrap_or(0),
-            )
+            Point {
+                signal: (la, lanes[la].position(s.after).unwrap_or(0)),
+                wait: (lb, lanes[lb].position(s.before).unwrap_or(0)),
+                signal_order: plan.position(s.after).unwrap_or(usize::MAX),
+            }
         })
         .collect()
 }
 
-/// Lane `l`'s `n` passes cut into batches: a batch ends after a pass another
-/// lane waits for, and before a pass that waits.
-fn batches(l: usize, n: usize, points: &[(usize, usize, usize, usize)]) -> Vec<Batch> {
+/// Lane `l`'s passes (`order[k]`: the plan position of its `k`th) cut into
+/// batches: a batch ends after a pass another lane waits for, and before a
+/// pass that waits, unless that wait can move up to the batch's start:
+/// Vulkan waits at submission boundaries only, and each boundary costs the
+/// queue time (10-20 us on the H100). A wait moves up when its signalling
+/// pass comes before the batch's first pass in the plan's order, which
+/// expects it done by then (Kulikov: the skin shadows' wait for the head's
+/// depth joins the batch after skinning). Waiting earlier is always safe.
+fn batches(l: usize, order: &[usize], points: &[Point]) -> Vec<Batch> {
+    let n = order.len();
+    let waits_at = |i: usize| points.iter().filter(move |pt| pt.wait == (l, i));
     let mut out = Vec::new();
     let mut start = 0;
     for i in 0..n {
-        let signals = points.iter().any(|&(la, pa, _, _)| la == l && pa == i);
-        let next_waits = points.iter().any(|&(_, _, lb, pb)| lb == l && pb == i + 1);
-        if signals || next_waits || i + 1 == n {
+        let signals = points.iter().any(|pt| pt.signal == (l, i));
+        let next_waits_late = waits_at(i + 1).any(|pt| pt.signal_order > order[start]);
+        if signals || next_waits_late || i + 1 == n {
             let mut waits: Vec<(usize, u64)> = Vec::new();
-            for &(la, pa, _, _) in points
-                .iter()
-                .filter(|&&(_, _, lb, pb)| lb == l && pb == start)
-            {
+            for pt in (start..=i).flat_map(waits_at) {
+                let (la, pa) = pt.signal;
                 match waits.iter_mut().find(|w| w.0 == la) {
                     Some(w) => w.1 = w.1.max(pa as u64 + 1),
                     None => waits.push((la, pa as u64 + 1)),
@@ -531,5 +546,51 @@ unsafe fn record_raster(
             }
         }
         d.cmd_end_rendering(cmd);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Point, batches};
+
+    fn point(signal: (usize, usize), wait: (usize, usize), signal_order: usize) -> Point {
+        Point {
+            signal,
+            wait,
+            signal_order,
+        }
+    }
+
+    fn ranges(
+        l: usize,
+        order: &[usize],
+        points: &[Point],
+    ) -> Vec<(usize, usize, Vec<(usize, u64)>)> {
+        batches(l, order, points)
+            .into_iter()
+            .map(|b| (b.first, b.last, b.waits))
+            .collect()
+    }
+
+    #[test]
+    fn a_wait_cuts_the_lane_unless_its_signal_comes_first_in_plan_order() {
+        // Lane 1 at plan positions 0, 1, 6, 7, 8, 9; it signals after its
+        // position 1, and its position 4 waits for lane 0's position 2.
+        let order = [0, 1, 6, 7, 8, 9];
+        let signal = point((1, 1), (0, 3), 1);
+        // Lane 0's pass at plan position 5 comes before the batch's first
+        // (6): the wait joins the batch that starts after the signal.
+        let early = [signal, point((0, 2), (1, 4), 5)];
+        assert_eq!(
+            ranges(1, &order, &early),
+            vec![(0, 1, vec![]), (2, 5, vec![(0, 3)])]
+        );
+        // At plan position 7 it may not be done when the batch starts: the
+        // lane is cut before the waiting pass.
+        let late = [signal, point((0, 2), (1, 4), 7)];
+        assert_eq!(
+            ranges(1, &order, &late),
+            vec![(0, 1, vec![]), (2, 3, vec![]), (4, 5, vec![(0, 3)])]
+        );
     }
 }
