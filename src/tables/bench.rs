@@ -119,6 +119,23 @@ pub fn frame_table(json: &Value) -> Result<String, String> {
             cell_text,
         );
         md.push_str(&roofline_line(json, &backend));
+        if cells(json, &backend).any(|c| c["frame_bounds"].is_object()) {
+            let _ = writeln!(
+                md,
+                "\n{}; ms: median frame timed only at its bounds (the same frames run again with no timestamp between passes; per-pass timestamps make a queue's passes wait for each other):\n",
+                caption(json, &backend, &device)
+            );
+            grid(
+                &mut md,
+                || Box::new(cells(json, &backend)),
+                &rows,
+                &views,
+                |c| match c["frame_bounds"]["median_ms"].as_f64() {
+                    Some(ms) => format!("{ms:.3}"),
+                    None => "–".into(),
+                },
+            );
+        }
     }
     Ok(md)
 }
@@ -301,10 +318,16 @@ pub fn delta_table(
         "{variant}, {view}, {dev_a}; ms, median per pass:\n\n| pass | kind | before | after | change |\n|---|---|---:|---:|---:|\n"
     );
     let frame = |c: &Value| c["frame"]["median_ms"].as_f64();
+    let bounds = |c: &Value| c["frame_bounds"]["median_ms"].as_f64();
+    let timed_at_bounds = [&a, &b].iter().any(|c| bounds(c).is_some());
     for (pass, kind, x, y) in passes
         .iter()
         .map(|(p, k)| (p.as_str(), format!("`{k}`"), median(&a, p), median(&b, p)))
         .chain([("**frame**", String::new(), frame(&a), frame(&b))])
+        .chain(timed_at_bounds.then(|| {
+            let label = "**frame, timed at its bounds**";
+            (label, String::new(), bounds(&a), bounds(&b))
+        }))
     {
         let change = match (x, y) {
             (Some(x), Some(y)) if x > 0.0 => format!("{:+.0}%", 100.0 * (y - x) / x),
@@ -360,6 +383,28 @@ mod tests {
         let mut other = after.clone();
         other["devices"][0]["device"] = serde_json::json!("another GPU");
         assert!(delta_table(&sample(), &other, "K: all", "close").is_err());
+    }
+
+    #[test]
+    fn frames_timed_at_their_bounds_get_a_table_and_a_delta_row() {
+        let before = sample();
+        let mut after = sample();
+        assert!(
+            !frame_table(&after)
+                .unwrap()
+                .contains("timed only at its bounds")
+        );
+        after["cells"][0]["frame_bounds"] = serde_json::json!({"median_ms": 2.25});
+        let md = frame_table(&after).unwrap();
+        assert!(md.contains("timed only at its bounds"), "{md}");
+        assert!(md.contains("2.250"), "{md}");
+        let label = label(&after["cells"][0]);
+        let view = after["cells"][0]["view"].as_str().unwrap().to_string();
+        let delta = delta_table(&before, &after, &label, &view).unwrap();
+        assert!(
+            delta.contains("| **frame, timed at its bounds** |  | – | 2.250 | – |"),
+            "{delta}"
+        );
     }
 
     #[test]

@@ -561,11 +561,10 @@ mod tests {
         }
     }
 
-    fn ranges(
-        l: usize,
-        order: &[usize],
-        points: &[Point],
-    ) -> Vec<(usize, usize, Vec<(usize, u64)>)> {
+    /// A batch as (first, last, waits).
+    type Range = (usize, usize, Vec<(usize, u64)>);
+
+    fn ranges(l: usize, order: &[usize], points: &[Point]) -> Vec<Range> {
         batches(l, order, points)
             .into_iter()
             .map(|b| (b.first, b.last, b.waits))

@@ -268,7 +268,7 @@ mod tests {
     fn a_word_per_lane_keeps_natural_order_with_fewer_appends() {
         // One workgroup (its subgroups run in order), a count that is not a
         // multiple of 32, visibility in runs as the LOD's kept strands give.
-        let shown = |i: u32| ((i / 40) % 3 != 1 && i % 7 != 0) || i >= 4990;
+        let shown = |i: u32| ((i / 40) % 3 != 1 && !i.is_multiple_of(7)) || i >= 4990;
         let (args, visible, words, in_words) = run_on(5000, (true, true), 32, shown);
         let (bit_args, _, bits, in_bits) = run_on(5000, (true, false), 32, shown);
         assert_eq!(in_words, visible);
