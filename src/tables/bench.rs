@@ -106,31 +106,22 @@ pub fn frame_table(json: &Value) -> Result<String, String> {
     for (backend, device) in devices(json)? {
         let views = distinct(cells(json, &backend), view_of);
         let rows = distinct(cells(json, &backend), label);
-        let _ = writeln!(
-            md,
-            "{}; ms: median frame (raster median; raster atomics as % of the atomicMin roofline):\n",
-            caption(json, &backend, &device)
-        );
-        grid(
+        let table = |md: &mut String, what: &str, text: &dyn Fn(&Value) -> String| {
+            let _ = writeln!(md, "{}; ms: {what}:\n", caption(json, &backend, &device));
+            grid(md, || Box::new(cells(json, &backend)), &rows, &views, text);
+        };
+        table(
             &mut md,
-            || Box::new(cells(json, &backend)),
-            &rows,
-            &views,
-            cell_text,
+            "median frame (raster median; raster atomics as % of the atomicMin roofline)",
+            &cell_text,
         );
         md.push_str(&roofline_line(json, &backend));
         if cells(json, &backend).any(|c| c["frame_bounds"].is_object()) {
-            let _ = writeln!(
-                md,
-                "\n{}; ms: median frame timed only at its bounds (the same frames run again with no timestamp between passes; per-pass timestamps make a queue's passes wait for each other):\n",
-                caption(json, &backend, &device)
-            );
-            grid(
+            md.push('\n');
+            table(
                 &mut md,
-                || Box::new(cells(json, &backend)),
-                &rows,
-                &views,
-                |c| match c["frame_bounds"]["median_ms"].as_f64() {
+                "median frame timed only at its bounds (the same frames run again with no timestamp between passes; per-pass timestamps make a queue's passes wait for each other)",
+                &|c| match c["frame_bounds"]["median_ms"].as_f64() {
                     Some(ms) => format!("{ms:.3}"),
                     None => "–".into(),
                 },

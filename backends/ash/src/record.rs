@@ -299,14 +299,19 @@ pub(crate) fn record_all(
                     Stamps::Frame if b == 0 => ((0, 2 * n), false),
                     Stamps::Frame => ((0, 0), false),
                 };
-                let top = vk::PipelineStageFlags2::TOP_OF_PIPE;
                 let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
                 if let Some(qp) = pool.filter(|_| reset.1 > 0) {
                     // SAFETY: outside any render pass.
                     unsafe { d.cmd_reset_query_pool(cmd, qp, reset.0 as u32, reset.1 as u32) };
                     if stamps == Stamps::Frame {
+                        // ALL_COMMANDS, not TOP_OF_PIPE: in a semaphore
+                        // wait's second scope TOP_OF_PIPE means no stage, so
+                        // a TOP_OF_PIPE stamp first in the batch may be
+                        // written before the wait for the frame's uploads
+                        // ends, and the frame would include them.
+                        let after_wait = vk::PipelineStageFlags2::ALL_COMMANDS;
                         // SAFETY: recording; the query was just reset.
-                        unsafe { d.cmd_write_timestamp2(cmd, top, qp, 0) };
+                        unsafe { d.cmd_write_timestamp2(cmd, after_wait, qp, 0) };
                     }
                 }
                 for i in batch.first..=batch.last {
