@@ -447,21 +447,14 @@ pub fn run(mut args: Args) -> Result<()> {
     Ok(())
 }
 
-/// What [`frames`] measured.
-struct Timed {
-    /// Per-pass times of each timed frame.
-    passes: Vec<Vec<PassTime>>,
-    /// The frame times (CPU: wall time of the frame, its queues overlap;
-    /// GPU: [`frame_millis`], timestamps only).
-    totals: Vec<f64>,
-    /// The same frames run again, timed only at their bounds
-    /// ([`Session::run_frame_timed`]); empty where the backend cannot.
-    bounds: Vec<f64>,
-}
-
-/// Runs `warmup` then `frames` frames timed per pass, then `frames` more
-/// timed at their bounds only.
-fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<Timed> {
+/// Runs `warmup` then `frames` frames; per-pass times of each timed frame,
+/// and the frame times (CPU: wall time of the frame, its queues overlap;
+/// GPU: [`frame_millis`], timestamps only).
+fn frames(
+    session: &mut dyn Session,
+    inputs: &[Upload],
+    args: &Args,
+) -> Result<(Vec<Vec<PassTime>>, Vec<f64>)> {
     // Frame k runs inputs[k], the last one again once they run out.
     let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
     // A GPU idle during the CPU's work between cells (counting, references,
@@ -488,8 +481,15 @@ fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<T
         });
         passes.push(times);
     }
-    // An animated scene goes on (its inputs are each frame's changes from
-    // the last); a still one runs its frame again.
+    Ok((passes, totals))
+}
+
+/// After [`frames`]: `frames` more frames timed only at their bounds
+/// ([`Session::run_frame_timed`]); empty where the backend cannot. An
+/// animated scene goes on (its inputs are each frame's changes from the
+/// last); a still one runs its frame again.
+fn bounds_frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<Vec<f64>> {
+    let input = |k: usize| &inputs[k.min(inputs.len() - 1)];
     let mut bounds = Vec::with_capacity(args.frames);
     for k in args.warmup + args.frames..args.warmup + 2 * args.frames {
         match session.run_frame_timed(input(k))? {
@@ -497,11 +497,7 @@ fn frames(session: &mut dyn Session, inputs: &[Upload], args: &Args) -> Result<T
             None => break,
         }
     }
-    Ok(Timed {
-        passes,
-        totals,
-        bounds,
-    })
+    Ok(bounds)
 }
 
 /// Runs `input` until [`CLOCK_WARMUP`] has passed and the median GPU time of
@@ -580,11 +576,13 @@ fn measure(
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     // A still scene: a game's frames at 60 fps, the simulation stepping.
     let still = [sequence::running(&p.upload, FPS)];
-    let timed = frames(session.as_mut(), animation.unwrap_or(&still), args)?;
+    let inputs = animation.unwrap_or(&still);
+    let (passes, totals) = frames(session.as_mut(), inputs, args)?;
+    let bounds = bounds_frames(session.as_mut(), inputs, args)?;
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
-    let mut stats = Stats::new(&timed.passes, &timed.totals, v.raster, atomics);
-    if !timed.bounds.is_empty() {
-        stats.bounds = Some(report::Spread::of(&timed.bounds));
+    let mut stats = Stats::new(&passes, &totals, v.raster, atomics);
+    if !bounds.is_empty() {
+        stats.bounds = Some(report::Spread::of(&bounds));
     }
     // Read back only what a reference will be compared with, or
     // `--pictures` saves: the last frame; of an animated scene with a
@@ -650,7 +648,7 @@ fn roofline(
     drop(counter);
 
     let mut session = runner::open(backend, &plan, &instance, cpu)?;
-    let passes = frames(session.as_mut(), std::slice::from_ref(&upload), args)?.passes;
+    let (passes, _) = frames(session.as_mut(), std::slice::from_ref(&upload), args)?;
     let median = |name: &str| {
         let v: Vec<f64> = passes
             .iter()
