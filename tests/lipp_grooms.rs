@@ -12,6 +12,7 @@ use std::path::Path;
 use strandgraph::frame::{Prepared, override_param, prepare};
 use strandgraph_cpu::{CpuBackend, Frame};
 use strandgraph_passes::lipp::payload::{EMPTY, from_words, unpack};
+use strandgraph_passes::lipp::shaded::unpack_rgb9e5;
 
 const W: u32 = 240;
 const H: u32 = 135;
@@ -51,9 +52,10 @@ fn redness(shaded: &[u32], gbuffer: &[u32]) -> f64 {
         if from_words(gbuffer[2 * i], gbuffer[2 * i + 1]) == EMPTY {
             continue;
         }
-        // Interleaved rgba32f, centre layer first.
-        r += f64::from(f32::from_bits(shaded[8 * i]));
-        g += f64::from(f32::from_bits(shaded[8 * i + 1]));
+        // The centre layer's record (passes/src/lipp/shaded.rs).
+        let c = unpack_rgb9e5(shaded[2 * i]);
+        r += f64::from(c[0]);
+        g += f64::from(c[1]);
     }
     r / g.max(1e-9)
 }

@@ -5,7 +5,8 @@
 
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
-#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, INV_DEPTH_MAX, F32_MIN}
+#import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, F32_MIN}
+#import strandgraph::lipp_shaded::{unpack_rgb9e5, record_depth, HIT, CONS_HIT}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -31,12 +32,14 @@ struct FilterParams {
     // lipp.raster's centre_diameter, pixels.
     centre_diameter: f32,
     model_index: u32,
+    // Ours: a tap reads the neighbour's centre-layer record (shaded.rs).
+    packed_taps: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
 @group(0) @binding(1) var<storage, read> frame: FrameData;
 @group(0) @binding(2) var<storage, read> gbuffer: array<vec2<u32>>;
-@group(0) @binding(3) var<storage, read> shaded: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> shaded: array<vec2<u32>>;
 @group(0) @binding(4) var output: texture_storage_2d<rgba16float, read_write>;
 // NDC depth (f32 bits) the next groom's rasterizer is tested against.
 @group(0) @binding(5) var<storage, read_write> hair_depth: array<u32>;
@@ -58,8 +61,20 @@ fn layer_count() -> u32 {
     return max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / pixels, 2u);
 }
 
-fn color(layer: u32, i: u32) -> vec4<f32> {
-    return shaded[layer_count() * i + layer];
+// View::color.
+fn color(layer: u32, i: u32) -> vec3<f32> {
+    return unpack_rgb9e5(shaded[layer * params.width * params.height + i].x);
+}
+
+// View::tap: neighbour q's centre-layer record, or with packed_taps off its
+// flags and depth from both G-buffer layers (colour word left 0).
+fn tap(q: u32) -> vec2<u32> {
+    if params.packed_taps != 0u {
+        return shaded[q];
+    }
+    let g = payload(0u, q);
+    let a = payload(1u, q);
+    return vec2<u32>(0u, (g.y & 0xFFFFFF00u) | select(0u, HIT, !is_empty(g)) | select(0u, CONS_HIT, !is_empty(a)));
 }
 
 fn lin(z: f32) -> f32 {
@@ -69,11 +84,6 @@ fn lin(z: f32) -> f32 {
 // filter::ndc_depth: the NDC depth at linear depth d > 0 (lin's inverse).
 fn ndc(d: f32) -> f32 {
     return frame.far * (d - frame.near) / (d * (frame.far - frame.near));
-}
-
-// payload::unpack's depth alone.
-fn payload_depth(p: vec2<u32>) -> f32 {
-    return f32(p.y >> 8u) * INV_DEPTH_MAX;
 }
 
 // filter::screen_tangent.
@@ -95,7 +105,7 @@ fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
 }
 
 // filter::reconstruct: (filtered colour, alpha).
-fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promoted: bool) -> vec4<f32> {
+fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promoted: bool) -> vec4<f32> {
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
@@ -127,30 +137,35 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec4<f32>, promote
             let ox = fx - dpar * tp.x;
             let oy = fy - dpar * tp.y;
             let perp2 = ox * ox + oy * oy;
-            let gq = payload(0u, q);
-            let aq = payload(1u, q);
+            let t = tap(q);
+            let hit = (t.y & HIT) != 0u;
             if perp2 <= strip2 {
-                if !is_empty(gq) {
+                if hit {
                     hc += 1.0;
-                } else if !is_empty(aq) {
+                } else if (t.y & CONS_HIT) != 0u {
                     hcons += 1.0;
                 }
             }
-            if is_empty(gq) {
+            if !hit {
                 continue;
             }
-            let zq = payload_depth(gq);
+            let zq = record_depth(t.y);
             if zq < z_near || zq > z_far {
                 continue;
             }
-            let cq = color(0u, q);
-            let d = cp.xyz - cq.xyz;
+            var cq: vec3<f32>;
+            if params.packed_taps != 0u {
+                cq = unpack_rgb9e5(t.x);
+            } else {
+                cq = color(0u, q);
+            }
+            let d = cp - cq;
             let w = exp(-(dpar * dpar) * k_par - perp2 * k_perp - dot(d, d) * k_c);
-            sum += cq.xyz * w;
+            sum += cq * w;
             wsum += w;
         }
     }
-    var c = cp.xyz;
+    var c = cp;
     if wsum > 0.0 {
         c = sum / wsum;
     }
@@ -207,7 +222,7 @@ fn filter_pixel(i: u32) {
         for (var s = 0u; s < min(params.msaa, layer_count()); s++) {
             let q = payload(s, i);
             if !is_empty(q) {
-                sum += color(s, i).xyz;
+                sum += color(s, i);
                 hits += 1u;
                 depth = min(depth, unpack_payload(q).depth);
             }
@@ -220,7 +235,7 @@ fn filter_pixel(i: u32) {
         if !centre {
             return;
         }
-        out = vec4<f32>(color(0u, i).xyz, 1.0);
+        out = vec4<f32>(color(0u, i), 1.0);
         depth = unpack_payload(g).depth;
     } else if centre {
         let sg = unpack_payload(g);

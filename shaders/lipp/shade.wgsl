@@ -1,9 +1,9 @@
 // lipp.shade: Lipp §3.4, deferred shading of both G-buffer layers, one
 // invocation per pixel. Port of passes/src/lipp/shade.rs; the shading of a
 // point is shading.wgsl's (shared with the ground truth's
-// reference_shade.wgsl). Writes rgba32f into `shaded` (pixel i: vec4 2i
-// centre layer, 2i+1 conservative layer) where a sample is, and lists the
-// workgroup's 64 pixels for lipp.filter if any is (lipp::tiles).
+// reference_shade.wgsl). Writes the `shaded` records (shaded.wgsl: RGB9E5
+// radiance, depth and hit flags, planar like the G-buffer), and lists the
+// workgroup's 64 pixels for lipp.filter if any has a sample (lipp::tiles).
 
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
@@ -15,11 +15,12 @@
 #import strandgraph::lipp_dom::frame
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
+#import strandgraph::lipp_shaded::{shaded_record, HIT, CONS_HIT}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
 @group(0) @binding(6) var<storage, read> raster_args: array<u32>;
-@group(0) @binding(9) var<storage, read_write> shaded: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> shaded: array<vec2<u32>>;
 @group(0) @binding(11) var<storage, read_write> filter_tiles: array<u32>;
 // (workgroups, 1, 1, tiles listed): lipp.filter's indirect dispatch.
 @group(0) @binding(12) var<storage, read_write> filter_args: array<atomic<u32>>;
@@ -54,14 +55,19 @@ fn shade(
     if i < pixels {
         let x = i % params.width;
         let y = i / params.width;
-        // lipp::gbuffer_layers.
+        // lipp::gbuffer_layers: 8 bytes a pixel and layer in both.
         let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
+        let cons = select(0u, CONS_HIT, !is_empty(gbuffer[pixels + i]));
         for (var layer = 0u; layer < layers; layer++) {
             let p = gbuffer[layer * pixels + i];
-            // The filter reads no colour of an empty sample.
+            // shaded.rs: the centre layer's record for every pixel (the
+            // filter's taps read its flags), the others where a sample is.
             if !is_empty(p) {
                 atomicStore(&tile_has_hair, 1u);
-                shaded[layers * i + layer] = vec4<f32>(shade_sample(unpack_payload(p), x, y), 1.0);
+                let c = shade_sample(unpack_payload(p), x, y);
+                shaded[layer * pixels + i] = shaded_record(c, p.y, HIT | cons);
+            } else if layer == 0u {
+                shaded[i] = shaded_record(vec3<f32>(0.0), 0u, cons);
             }
         }
     }

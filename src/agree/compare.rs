@@ -3,6 +3,7 @@
 
 use serde::Serialize;
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl};
+use strandgraph_passes::lipp::shaded::unpack_rgb9e5;
 
 /// How closely a GPU output must match the CPU's.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -23,6 +24,10 @@ pub enum Rule {
     Multiset,
     /// Unsigned counts (fixed-point sums) within `max` of each other.
     Near { max: u32 },
+    /// `lipp.shade`'s records (passes/src/lipp/shaded.rs): even words RGB9E5
+    /// colours whose channels are within `rel` of the brighter colour's
+    /// largest channel (or `abs`), odd words (depth and flags) identical.
+    Rgb9e5Records { rel: f32, abs: f32 },
 }
 
 /// The rule for an image format: exact unless it stores floats or UNORMs.
@@ -112,7 +117,10 @@ pub fn compare(cpu: &[u32], gpu: &[u32], rule: Rule) -> Outcome {
         if c == g {
             continue;
         }
-        let error = word_error(c, g, rule);
+        let error = match rule {
+            Rule::Rgb9e5Records { .. } if i % 2 == 1 => word_error(c, g, Rule::Exact),
+            _ => word_error(c, g, rule),
+        };
         out.worst = out.worst.max(error.0);
         if !error.1 {
             out.failing += 1;
@@ -144,6 +152,14 @@ fn word_error(c: u32, g: u32, rule: Rule) -> (f64, bool) {
         Rule::Near { max } => {
             let d = c.abs_diff(g);
             (f64::from(d), d <= max)
+        }
+        Rule::Rgb9e5Records { rel, abs } => {
+            let (x, y) = (unpack_rgb9e5(c), unpack_rgb9e5(g));
+            let bright = x.into_iter().chain(y).fold(0.0f32, f32::max);
+            let d = (0..3).map(|k| (x[k] - y[k]).abs()).fold(0.0f32, f32::max);
+            // In units of the brighter colour's largest channel.
+            let error = if bright > 0.0 { d / bright } else { 0.0 };
+            (f64::from(error), d <= rel * bright || d <= abs)
         }
         Rule::Unorm16 { steps } => {
             let d = [0, 16]
@@ -233,5 +249,15 @@ mod tests {
         assert!(!compare(&[0x3c00_3c00], &[0x3c00_3c02], h).passed());
         // Padding: a longer GPU buffer compares its tail with zero.
         assert!(compare(&[7], &[7, 0, 0], Rule::Exact).passed());
+        use strandgraph_passes::lipp::shaded::pack_rgb9e5;
+        let r = Rule::Rgb9e5Records {
+            rel: 0.01,
+            abs: 0.0,
+        };
+        let (a, b) = (pack_rgb9e5([1.0, 0.5, 0.0]), pack_rgb9e5([1.005, 0.5, 0.0]));
+        assert!(compare(&[a, 9], &[b, 9], r).passed());
+        assert!(!compare(&[a, 9], &[b, 8], r).passed(), "odd words exact");
+        let c = pack_rgb9e5([1.0, 0.52, 0.0]);
+        assert!(!compare(&[a, 9], &[c, 9], r).passed());
     }
 }

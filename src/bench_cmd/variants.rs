@@ -312,6 +312,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // A filter tap reading both G-buffer layers, then its colour, rather
+    // than the neighbour's 8-byte record (passes/src/lipp/shaded.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, filter taps from the G-buffer",
+        graph: LIPP,
+        overrides: &["filter.packed_taps=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 2",

@@ -50,6 +50,7 @@
 
 use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::shade::world_position;
+use super::shaded;
 use super::tiles::{self, TILE};
 use super::{add, frame, normalize, scale, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
@@ -88,6 +89,10 @@ pub struct FilterParams {
     pub centre_diameter: f32,
     /// The groom being filtered (set by the graph's per-model repeat).
     pub model_index: u32,
+    /// Ours: a tap reads the neighbour's centre-layer record in `shaded`
+    /// (8 bytes) rather than both G-buffer layers and then its colour
+    /// ([`super::shaded`] says why). The output is the same.
+    pub packed_taps: bool,
 }
 
 impl Default for FilterParams {
@@ -108,6 +113,7 @@ impl Default for FilterParams {
             true_width: true,
             centre_diameter: 0.5,
             model_index: 0,
+            packed_taps: true,
         }
     }
 }
@@ -161,6 +167,7 @@ crate::gpu_block! {
         true_width: u32,
         centre_diameter: f32,
         model_index: u32,
+        packed_taps: u32,
     }
 }
 
@@ -204,6 +211,7 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         true_width: flag(p.true_width),
         centre_diameter: p.centre_diameter,
         model_index: p.model_index,
+        packed_taps: flag(p.packed_taps),
     },
     raster: None,
 };
@@ -259,8 +267,26 @@ impl View<'_> {
         let slot = (layer * self.width * self.height + i) as usize;
         from_words(self.gbuffer.load(2 * slot), self.gbuffer.load(2 * slot + 1))
     }
-    pub fn color(&self, layer: u32, i: u32) -> [f32; 4] {
-        self.shaded.load_vec4((self.layers * i + layer) as usize)
+    /// A layer's shaded colour ([`shaded`]'s record, word 0).
+    pub fn color(&self, layer: u32, i: u32) -> [f32; 3] {
+        let slot = (layer * self.width * self.height + i) as usize;
+        shaded::unpack_rgb9e5(self.shaded.load(2 * slot))
+    }
+    /// What a tap needs of neighbour `q`: the centre layer's record, whose
+    /// colour word is read only once the tap passes its tests. With
+    /// `packed_taps` off, its flags and depth come from both G-buffer
+    /// layers, as before the records held them (the same bits).
+    fn tap(&self, q: u32, packed_taps: bool) -> [u32; 2] {
+        if packed_taps {
+            return [
+                self.shaded.load(2 * q as usize),
+                self.shaded.load(2 * q as usize + 1),
+            ];
+        }
+        let (g, a) = (self.payload(0, q), self.payload(1, q));
+        let flag = |p: u64, f: u32| if p == EMPTY { 0 } else { f };
+        let depth = (g >> 32) as u32 & !0xFF;
+        [0, depth | flag(g, shaded::HIT) | flag(a, shaded::CONS_HIT)]
     }
 }
 
@@ -272,13 +298,13 @@ pub struct Reference {
     /// Screen tangent.
     pub tp: [f32; 2],
     /// The pixel's own shaded colour.
-    pub cp: [f32; 4],
+    pub cp: [f32; 3],
     /// A conservative-only pixel borrowing colour (w_color = 1).
     pub promoted: bool,
 }
 
 impl Reference {
-    fn of(v: &View<'_>, x: u32, y: u32, s: &Sample, cp: [f32; 4], promoted: bool) -> Self {
+    fn of(v: &View<'_>, x: u32, y: u32, s: &Sample, cp: [f32; 3], promoted: bool) -> Self {
         Self {
             z: s.depth,
             tp: screen_tangent(v.f, x, y, s),
@@ -332,22 +358,27 @@ pub fn reconstruct(
             let dpar = fx * tp[0] + fy * tp[1];
             let (ox, oy) = (fx - dpar * tp[0], fy - dpar * tp[1]);
             let perp2 = ox * ox + oy * oy;
-            let (gq, aq) = (v.payload(0, q), v.payload(1, q));
+            let t = v.tap(q, p.packed_taps);
+            let hit = t[1] & shaded::HIT != 0;
             if perp2 <= strip2 {
-                if gq != EMPTY {
+                if hit {
                     hc += 1.0;
-                } else if aq != EMPTY {
+                } else if t[1] & shaded::CONS_HIT != 0 {
                     hcons += 1.0;
                 }
             }
-            if gq == EMPTY {
+            if !hit {
                 continue;
             }
-            let zq = unpack(gq).depth;
+            let zq = shaded::depth(t[1]);
             if zq < z_near || zq > z_far {
                 continue;
             }
-            let cq = v.color(0, q);
+            let cq = if p.packed_taps {
+                shaded::unpack_rgb9e5(t[0])
+            } else {
+                v.color(0, q)
+            };
             let dc2 = (0..3)
                 .map(|k| (cp[k] - cq[k]) * (cp[k] - cq[k]))
                 .sum::<f32>();
@@ -361,7 +392,7 @@ pub fn reconstruct(
     let c = if wsum > 0.0 {
         [sum[0] / wsum, sum[1] / wsum, sum[2] / wsum]
     } else {
-        [cp[0], cp[1], cp[2]]
+        cp
     };
     let alpha = if !p.opacity_reconstruction || hc + hcons == 0.0 {
         1.0
@@ -448,8 +479,7 @@ pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Ha
         if !centre {
             return None;
         }
-        let c = v.color(0, i);
-        return hair([c[0], c[1], c[2]], 1.0, unpack(g).depth);
+        return hair(v.color(0, i), 1.0, unpack(g).depth);
     }
     if !(centre || cons && p.reconnect) {
         return None;
@@ -528,6 +558,7 @@ impl CpuKernel for FilterKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::atomic::{AtomicU32, AtomicU64, Ordering::Relaxed};
 
     #[test]
     fn params_are_checked() {
@@ -538,6 +569,98 @@ mod tests {
         assert!(FILTER.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"centre_diameter": 1.0}"#).unwrap();
         assert!(FILTER.params(&v).is_err());
+    }
+
+    /// A 96×64 frame of random samples in a 20 cm depth range (a quarter
+    /// of centre pixels and half of conservative ones empty), shaded with
+    /// colours from their hash, as lipp.shade would leave the records.
+    fn scene(gbuffer: &mut Vec<AtomicU32>, records: &mut Vec<AtomicU32>) -> (FrameData, u32, u32) {
+        use super::super::payload::pack;
+        use super::super::raster::tests::frame;
+        let mut f = frame();
+        let (w, h) = (f.screen[0] as u32, f.screen[1] as u32);
+        // The frame's fov is 0.8 rad.
+        f.pixels_per_unit = h as f32 / (2.0 * 0.4f32.tan());
+        let n = (w * h) as usize;
+        let sample = |k: u32| {
+            let u = |j: u32| super::super::unit(super::super::pcg(k * 7 + j));
+            (
+                u(0) < [0.25, 0.5][(k as usize) / n],
+                Sample {
+                    depth: ndc_depth(&f, 0.5 + 0.2 * u(1)),
+                    tangent: normalize([u(2) - 0.5, u(3) - 0.5, u(4) - 0.5]),
+                    uvw: [u(5), u(6), u(7)],
+                    ao: u(8),
+                },
+            )
+        };
+        let words: Vec<u64> = (0..2 * n as u32)
+            .map(|k| match sample(k) {
+                (true, _) => EMPTY,
+                (false, s) => pack(&s),
+            })
+            .collect();
+        *gbuffer = words
+            .iter()
+            .flat_map(|&p| [p as u32, (p >> 32) as u32])
+            .map(AtomicU32::new)
+            .collect();
+        *records = (0..4 * n).map(|_| AtomicU32::new(0)).collect();
+        let out = |slot: usize, r: [u32; 2]| {
+            records[2 * slot].store(r[0], Relaxed);
+            records[2 * slot + 1].store(r[1], Relaxed);
+        };
+        for i in 0..n {
+            let cons = if words[n + i] == EMPTY {
+                0
+            } else {
+                shaded::CONS_HIT
+            };
+            for layer in 0..2 {
+                let p = words[layer * n + i];
+                let c = [0, 1, 2]
+                    .map(|j| super::super::unit(super::super::pcg((layer * n + i) as u32 * 3 + j)));
+                match p {
+                    EMPTY if layer == 0 => out(i, shaded::record([0.0; 3], 0, cons)),
+                    EMPTY => {}
+                    _ => out(
+                        layer * n + i,
+                        shaded::record(c, (p >> 32) as u32, shaded::HIT | cons),
+                    ),
+                }
+            }
+        }
+        (f, w, h)
+    }
+
+    #[test]
+    fn packed_taps_filter_the_same_as_taps_from_the_gbuffer() {
+        let (mut g, mut sh) = (Vec::new(), Vec::new());
+        let (f, w, h) = scene(&mut g, &mut sh);
+        let oob = AtomicU64::new(0);
+        let v = View {
+            f: &f,
+            layers: 2,
+            width: w,
+            height: h,
+            gbuffer: Words::new(&g, &oob),
+            shaded: Words::new(&sh, &oob),
+            thickness: 7e-5,
+        };
+        let on = FilterParams::default();
+        let off = FilterParams {
+            packed_taps: false,
+            ..on
+        };
+        let mut filtered = 0;
+        for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+            let a = filter_pixel(&on, &v, x, y);
+            assert_eq!(a, filter_pixel(&off, &v, x, y), "pixel ({x}, {y})");
+            filtered += usize::from(a.is_some_and(|a| a.alpha < 1.0));
+        }
+        assert_eq!(oob.load(Relaxed), 0);
+        // The window did something: many pixels got a partial opacity.
+        assert!(filtered > (w * h / 10) as usize, "{filtered}");
     }
 
     #[test]

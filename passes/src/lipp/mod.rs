@@ -18,6 +18,7 @@ pub mod probe;
 pub mod raster;
 pub mod reference;
 pub mod shade;
+pub mod shaded;
 pub mod strand;
 pub mod tiles;
 pub mod upload;
@@ -198,12 +199,11 @@ pub fn bundle_of_strand(first_strand: impl Fn(usize) -> u32, bundles: usize, s: 
 }
 
 /// G-buffer layers the graph gave (2: centre and conservative; N for the
-/// MSAA reference mode): whole layers of both `gbuffer` (8 bytes per pixel
-/// per layer) and `shaded` (16 bytes), at least 2. `shaded` is interleaved:
-/// vec4 `layers · pixel + layer`.
+/// MSAA reference mode): whole layers of both `gbuffer` and `shaded` (8
+/// bytes per pixel per layer each, planar), at least 2.
 pub fn gbuffer_layers(gbuffer: &Words<'_>, shaded: &Words<'_>, pixels: u32) -> u32 {
     let p = pixels.max(1) as usize;
-    (gbuffer.len() / (2 * p)).min(shaded.len() / (4 * p)).max(2) as u32
+    (gbuffer.len().min(shaded.len()) / (2 * p)).max(2) as u32
 }
 
 /// Number of bundles actually packed (the buffer may be larger).

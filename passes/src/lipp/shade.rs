@@ -1,7 +1,9 @@
 //! `lipp.shade`: Lipp §3.4, deferred shading of both G-buffer layers, one
-//! invocation per pixel. Empty samples are not written (nothing reads
-//! them); the tiles with a sample are listed for `lipp.filter`
-//! ([`super::tiles`], `hair_tiles`).
+//! invocation per pixel, into the `shaded` records ([`super::shaded`]:
+//! RGB9E5 radiance, depth and hit flags). Only the centre layer's record is
+//! written where no sample is (the filter's taps read its flags); the tiles
+//! with a sample are listed for `lipp.filter` ([`super::tiles`],
+//! `hair_tiles`).
 //!
 //! Position is reconstructed from the 24-bit depth at the pixel centre ("we
 //! use the common approach in deferred engines and reconstruct it from the
@@ -40,6 +42,7 @@ pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
+use super::shaded::{CONS_HIT, HIT, record};
 use super::tiles;
 use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -429,18 +432,30 @@ impl CpuKernel for ShadeKernel {
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let layers = super::gbuffer_layers(&g, &out, pixels);
         let mut hair = false;
+        let payload = |layer: u32, i: u32| {
+            let slot = (layer * pixels + i) as usize;
+            super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1))
+        };
+        let store = |slot: u32, r: [u32; 2]| {
+            out.store(2 * slot as usize, r[0]);
+            out.store(2 * slot as usize + 1, r[1]);
+        };
         for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
+            let cons = if payload(1, i) != EMPTY { CONS_HIT } else { 0 };
             for layer in 0..layers {
-                let slot = (layer * pixels + i) as usize;
-                let p = super::payload::from_words(g.load(2 * slot), g.load(2 * slot + 1));
-                // The filter reads no colour of an empty sample.
+                let p = payload(layer, i);
+                // The centre layer's record for every pixel (the filter's
+                // taps read its flags), the others where a sample is.
                 if p == EMPTY {
+                    if layer == 0 {
+                        store(i, record([0.0; 3], 0, cons));
+                    }
                     continue;
                 }
                 hair = true;
                 let c = shade_sample(&inp, &unpack(p), x, y);
-                out.store_vec4((layers * i + layer) as usize, [c[0], c[1], c[2], 1.0]);
+                store(layer * pixels + i, record(c, (p >> 32) as u32, HIT | cons));
             }
         }
         if hair || !self.0.hair_tiles {
