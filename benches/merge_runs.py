@@ -7,9 +7,9 @@ in its own call (benches/device.sh).
     python3 benches/merge_runs.py ash/bench.json wgpu/bench.json > benches/results/h100.json
 
 With `--add PIPELINE`, the first file is an already merged result and the
-cells of PIPELINE's rows (say, "HW mesh") from the later runs of the same
-device are added to it, replacing those it had on the backends the later
-runs measured; the notes say which runs.
+cells of PIPELINE's rows (say, "HW mesh"), or of one row ("Lipp: SWR 1"),
+from the later runs of the same device are added to it, replacing those it
+had on the backends the later runs measured; the notes say which runs.
 
     python3 benches/merge_runs.py --add "HW mesh" benches/results/h100.json ash/bench.json wgpu/bench.json
 """
@@ -36,13 +36,17 @@ if add is None:
     out["elapsed_s"] = sum(r["elapsed_s"] for r in runs)
     out["notes"].append(f"merged from one run per backend (benches/merge_runs.py): {backends}")
 else:
-    added = [c for r in runs[1:] for c in r["cells"] if c["pipeline"] == add]
+    # "Lipp" adds a pipeline's rows; "Lipp: SWR 1" one row of it.
+    row_of = lambda c: add in (c["pipeline"], f'{c["pipeline"]}: {c["variant"]}')
+    added = [c for r in runs[1:] for c in r["cells"] if row_of(c)]
     if not added:
         sys.exit(f"no `{add}` cells in the added runs")
     measured = {c["backend"] for c in added}
-    replaced = lambda c: c["pipeline"] == add and c["backend"] in measured
+    replaced = lambda c: row_of(c) and c["backend"] in measured
     # In place of the cells they replace, so the tables keep their row order.
-    at = next((i for i, c in enumerate(out["cells"]) if replaced(c)), len(out["cells"]))
+    # A new row goes after its pipeline's last cell.
+    same = [i for i, c in enumerate(out["cells"]) if c["pipeline"] == added[0]["pipeline"]]
+    at = next((i for i, c in enumerate(out["cells"]) if replaced(c)), same[-1] + 1 if same else len(out["cells"]))
     kept = [c for c in out["cells"] if not replaced(c)]
     out["cells"] = kept[:at] + added + kept[at:]
     out["elapsed_s"] = out["elapsed_s"] + sum(r["elapsed_s"] for r in runs[1:])

@@ -312,6 +312,26 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // The window of Lipp's Fig. 5 ("a single 7 × 7 kernel pass"), where
+    // §3.3.1 says r = 5 (the default) and Code 2 r = 7.
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, 7×7 window (Fig. 5)",
+        graph: LIPP,
+        overrides: &["filter.radius=3"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    // Without the camera's LOD but with the maps' own (ours): SWR 1 with
+    // its deep opacity maps built like SWR 1+F+L's.
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1, shadow LOD",
+        graph: LIPP,
+        overrides: &["lod.enabled=false", "filter.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // A filter tap reading both G-buffer layers, then its colour, rather
     // than the neighbour's 8-byte record (passes/src/lipp/shaded.rs).
     Variant {
