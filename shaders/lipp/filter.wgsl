@@ -7,6 +7,7 @@
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, F32_MIN}
 #import strandgraph::lipp_shaded::{unpack_rgb9e5, record_depth, HIT, CONS_HIT}
+#import strandgraph::lipp_rect::{FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -77,6 +78,15 @@ fn tap(q: u32) -> vec2<u32> {
     return vec2<u32>(0u, (g.y & 0xFFFFFF00u) | select(0u, HIT, !is_empty(g)) | select(0u, CONS_HIT, !is_empty(a)));
 }
 
+// filter::shaded_rect: the pixels lipp.shade wrote records for this frame
+// (lipp::rect); taps outside it read no hair.
+fn shaded_rect() -> vec4<i32> {
+    if arrayLength(&filter_args) <= FILTER_RECT_HI {
+        return vec4<i32>(0, 0, i32(params.width), i32(params.height));
+    }
+    return vec4<i32>(rect_from_args(filter_args[FILTER_RECT_LO], filter_args[FILTER_RECT_HI]));
+}
+
 fn lin(z: f32) -> f32 {
     return linear_depth(frame.near, frame.far, z);
 }
@@ -123,11 +133,12 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promote
     let near = d_ref - params.depth_threshold;
     let z_near = select(F32_MIN, ndc(near), near > 0.0);
     let z_far = ndc(d_ref + params.depth_threshold);
+    let rect = shaded_rect();
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let qx = i32(x) + dx;
             let qy = i32(y) + dy;
-            if qx < 0 || qy < 0 || qx >= i32(params.width) || qy >= i32(params.height) {
+            if qx < rect.x || qy < rect.y || qx >= rect.z || qy >= rect.w {
                 continue;
             }
             let q = u32(qy) * params.width + u32(qx);

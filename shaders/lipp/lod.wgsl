@@ -11,6 +11,7 @@
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp_rect::{extended_corner, box_pad, screen_rect, pack_tiles}
 #import strandgraph::lipp::{LightFrame, light_project, unit, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, LOD_CULLED, LOD_OTHER_GROOM, F32_MAX, F32_MIN}
 
 // LodParams (booleans as 0/1).
@@ -99,11 +100,41 @@ fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
     return min(p + 1u, c_max);
 }
 
-// lod::choose for bundle b: (N_LOD, C, flags).
-fn choose(b: u32) -> vec3<u32> {
+// rect::bundle_box, then rect::screen_rect packed in tiles.
+fn bundle_rect(o: u32, first_layer: u32, layers: u32) -> u32 {
+    var lo = vec3<f32>(F32_MAX);
+    var hi = vec3<f32>(F32_MIN);
+    var chord = 0.0;
+    var prev: array<vec3<f32>, 4>;
+    for (var i = 0u; i < layers; i++) {
+        let c0 = corner(first_layer, i, 0u);
+        let c1 = corner(first_layer, i, 1u);
+        let c2 = corner(first_layer, i, 2u);
+        let c3 = corner(first_layer, i, 3u);
+        var e: array<vec3<f32>, 4>;
+        for (var k = 0u; k < 4u; k++) {
+            let p = extended_corner(c0, c1, c2, c3, k);
+            e[k] = p;
+            lo = min(lo, p);
+            hi = max(hi, p);
+            if i > 0u {
+                for (var q = 0u; q < 4u; q++) {
+                    chord = max(chord, distance(p, prev[q]));
+                }
+            }
+        }
+        prev = e;
+    }
+    let pad = box_pad(bitcast<f32>(hairmesh_bundles[o + 4u]), bitcast<f32>(hairmesh_bundles[o + 7u]), chord);
+    let r = screen_rect(frame.view_proj, frame.screen.xy, frame.near, lo - pad, hi + pad);
+    return pack_tiles(r, u32(frame.screen.x), u32(frame.screen.y));
+}
+
+// lod::choose for bundle b: (N_LOD, C, screen rectangle, flags).
+fn choose(b: u32) -> vec4<u32> {
     let o = b * BUNDLE_WORDS;
     if params.model != ALL_MODELS && hairmesh_bundles[o + 3u] != params.model {
-        return vec3<u32>(0u, 3u, LOD_OTHER_GROOM);
+        return vec4<u32>(0u, 3u, 0u, LOD_OTHER_GROOM);
     }
     let first_layer = hairmesh_bundles[o];
     let layers = clamp(hairmesh_bundles[o + 1u], 2u, MAX_LAYERS);
@@ -170,7 +201,11 @@ fn choose(b: u32) -> vec3<u32> {
         c_max = groom_cap(hairmesh_bundles[o + 10u], c_max);
     }
     let c = snap_control_points(c_raw, c_max);
-    return vec3<u32>(strands, c, select(0u, LOD_CULLED, culled));
+    var rect = 0u;
+    if params.light_view == 0u && !culled {
+        rect = bundle_rect(o, first_layer, layers);
+    }
+    return vec4<u32>(strands, c, rect, select(0u, LOD_CULLED, culled));
 }
 
 @compute @workgroup_size(64)
@@ -183,6 +218,6 @@ fn lod(@builtin(global_invocation_id) id: vec3<u32>) {
     let d = choose(b);
     lod_choices[b * LOD_WORDS] = d.x;
     lod_choices[b * LOD_WORDS + 1u] = d.y;
-    lod_choices[b * LOD_WORDS + 2u] = 0u;
-    lod_choices[b * LOD_WORDS + 3u] = d.z;
+    lod_choices[b * LOD_WORDS + 2u] = d.z;
+    lod_choices[b * LOD_WORDS + 3u] = d.w;
 }

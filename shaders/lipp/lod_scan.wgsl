@@ -4,14 +4,16 @@
 // contiguous run of bundles; the lanes' sums are scanned in workgroup memory
 // (Hillis and Steele), then each lane writes its run.
 
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, rect_union, rect_is_empty, unpack_tiles, rect_args}
 #import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED}
 
 struct ScanParams {
     // Scene quantity: bundles packed.
     bundles: u32,
+    // Scene quantities: the screen.
+    width: u32,
+    height: u32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ScanParams;
@@ -26,6 +28,8 @@ const SCAN_GROUP: u32 = 256u;
 var<workgroup> sums: array<u32, SCAN_GROUP>;
 var<workgroup> full_sums: array<u32, SCAN_GROUP>;
 var<workgroup> kept_sums: array<u32, SCAN_GROUP>;
+// The drawn bundles' screen rectangle (rect.rs): min x0, y0 and max x1, y1.
+var<workgroup> groom_rect: array<atomic<u32>, 4>;
 
 // scan.rs: a frustum-culled bundle draws none of the strands it keeps.
 fn drawn(b: u32) -> u32 {
@@ -38,15 +42,32 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
     let per = (count + SCAN_GROUP - 1u) / SCAN_GROUP;
     let begin = min(lane * per, count);
     let end = min(begin + per, count);
+    if lane == 0u {
+        atomicStore(&groom_rect[0], 0xFFFFFFFFu);
+        atomicStore(&groom_rect[1], 0xFFFFFFFFu);
+        atomicStore(&groom_rect[2], 0u);
+        atomicStore(&groom_rect[3], 0u);
+    }
+    workgroupBarrier();
     var sum = 0u;
     var full = 0u;
     var kept = 0u;
+    var rect = vec4<u32>(0u);
     for (var b = begin; b < end; b++) {
         sum += drawn(b);
+        if drawn(b) > 0u {
+            rect = rect_union(rect, unpack_tiles(lod_choices[b * LOD_WORDS + 2u], params.width, params.height));
+        }
         if (lod_choices[b * LOD_WORDS + 3u] & LOD_OTHER_GROOM) == 0u {
             full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
             kept += lod_choices[b * LOD_WORDS];
         }
+    }
+    if !rect_is_empty(rect) {
+        atomicMin(&groom_rect[0], rect.x);
+        atomicMin(&groom_rect[1], rect.y);
+        atomicMax(&groom_rect[2], rect.z);
+        atomicMax(&groom_rect[3], rect.w);
     }
     sums[lane] = sum;
     full_sums[lane] = full;
@@ -90,5 +111,15 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         // β of Lipp Eq. 8 is word 5 / word 4 (lipp::ARGS_KEPT, ARGS_ALL).
         raster_args[4] = full_sums[SCAN_GROUP - 1u];
         raster_args[5] = kept_sums[SCAN_GROUP - 1u];
+        // The drawn bundles' screen rectangle, if there is room.
+        if arrayLength(&raster_args) > ARGS_RECT_HI {
+            var groom = vec4<u32>(atomicLoad(&groom_rect[0]), atomicLoad(&groom_rect[1]), atomicLoad(&groom_rect[2]), atomicLoad(&groom_rect[3]));
+            if rect_is_empty(groom) {
+                groom = vec4<u32>(0u);
+            }
+            let a = rect_args(groom);
+            raster_args[ARGS_RECT_LO] = a.x;
+            raster_args[ARGS_RECT_HI] = a.y;
+        }
     }
 }

@@ -4,6 +4,8 @@
 // reference_shade.wgsl). Writes the `shaded` records (shaded.wgsl: RGB9E5
 // radiance, depth and hit flags, planar like the G-buffer), and lists the
 // workgroup's 64 pixels for lipp.filter if any has a sample (lipp::tiles).
+// With groom_rect, workgroups outside the groom's screen rectangle return
+// at once (lipp::rect).
 
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
@@ -16,6 +18,7 @@
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
 #import strandgraph::lipp_shaded::{shaded_record, HIT, CONS_HIT}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, touches_run}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
@@ -40,12 +43,32 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
     return shade_point(shading_of(params), pos, sm.tangent, strand, sm.ao, params.model_index, delta);
 }
 
+// ShadeKernel::shaded_rect: the groom's screen rectangle (lipp::rect), or
+// the whole screen; workgroup 0 tells lipp.filter.
+fn shaded_rect(wg: u32, lane: u32) -> vec4<u32> {
+    let room = arrayLength(&filter_args) > FILTER_RECT_HI && arrayLength(&raster_args) > ARGS_RECT_HI;
+    var r = vec4<u32>(0u, 0u, params.width, params.height);
+    if params.groom_rect != 0u && room {
+        r = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
+    }
+    if room && wg == 0u && lane == 0u {
+        let a = rect_args(r);
+        atomicStore(&filter_args[FILTER_RECT_LO], a.x);
+        atomicStore(&filter_args[FILTER_RECT_HI], a.y);
+    }
+    return r;
+}
+
 @compute @workgroup_size(64)
 fn shade(
     @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
+    // The same for the whole workgroup: it returns as one.
+    if !touches_run(shaded_rect(wg.x, lane), wg.x * SHADE_GROUP, SHADE_GROUP, params.width) {
+        return;
+    }
     if lane == 0u {
         atomicStore(&tile_has_hair, 0u);
     }

@@ -302,13 +302,24 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // lipp.filter over every tile of the screen rather than the tiles with
-    // hair lipp.shade lists (passes/src/lipp/tiles.rs).
+    // lipp.filter over every tile lipp.shade ran rather than the tiles with
+    // hair it lists (passes/src/lipp/tiles.rs); with its groom_rect, the
+    // tiles in the groom's screen rectangle.
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+F+L, filter over every tile",
         graph: LIPP,
         overrides: &["shade.hair_tiles=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    // lipp.shade over every pixel, as the paper's deferred shading, rather
+    // than the groom's screen rectangle (passes/src/lipp/rect.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, shading every pixel",
+        graph: LIPP,
+        overrides: &["shade.groom_rect=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

@@ -49,6 +49,7 @@
 //! averaged, α = hits / N (SWR 2/4/8).
 
 use super::payload::{EMPTY, Sample, from_words, unpack};
+use super::rect::{FILTER_RECT_HI, FILTER_RECT_LO, Rect};
 use super::shade::world_position;
 use super::shaded;
 use super::tiles::{self, TILE};
@@ -260,6 +261,8 @@ pub struct View<'a> {
     pub shaded: Words<'a>,
     /// The groom's strand thickness, metres.
     pub thickness: f32,
+    /// The pixels `lipp.shade` wrote records for ([`shaded_rect`]).
+    pub rect: Rect,
 }
 
 impl View<'_> {
@@ -350,7 +353,8 @@ pub fn reconstruct(
     for dy in -r..=r {
         for dx in -r..=r {
             let (qx, qy) = (x as i32 + dx, y as i32 + dy);
-            if qx < 0 || qy < 0 || qx >= v.width as i32 || qy >= v.height as i32 {
+            let r = &v.rect;
+            if qx < r.x0 as i32 || qy < r.y0 as i32 || qx >= r.x1 as i32 || qy >= r.y1 as i32 {
                 continue;
             }
             let q = qy as u32 * v.width + qx as u32;
@@ -516,6 +520,16 @@ pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Ha
     hair(c, alpha, sa.depth)
 }
 
+/// The pixels `lipp.shade` wrote records for this frame (`filter_args`
+/// words [`FILTER_RECT_LO`], [`FILTER_RECT_HI`]; the whole screen without
+/// room for them): outside, a tap reads no hair ([`super::rect`]).
+pub fn shaded_rect(args: &Words<'_>, w: u32, h: u32) -> Rect {
+    if args.len() <= FILTER_RECT_HI {
+        return Rect::full(w, h);
+    }
+    Rect::from_args(args.load(FILTER_RECT_LO), args.load(FILTER_RECT_HI))
+}
+
 struct FilterKernel(FilterParams);
 
 impl CpuKernel for FilterKernel {
@@ -523,6 +537,7 @@ impl CpuKernel for FilterKernel {
         let f = frame(ctx);
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let (gbuffer, shaded) = (ctx.words("gbuffer"), ctx.words("shaded"));
+        let (tiles, args) = (ctx.words("filter_tiles"), ctx.words("filter_args"));
         let v = View {
             f: &f,
             layers: super::gbuffer_layers(&gbuffer, &shaded, w * h),
@@ -532,9 +547,9 @@ impl CpuKernel for FilterKernel {
             shaded,
             thickness: read::<ModelData>(&ctx.words("models"), self.0.model_index as usize)
                 .thickness,
+            rect: shaded_rect(&args, w, h),
         };
         let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
-        let (tiles, args) = (ctx.words("filter_tiles"), ctx.words("filter_args"));
         let count = tiles::listed(&args, &tiles);
         let mut t = group;
         while t < count {
@@ -646,6 +661,7 @@ mod tests {
             gbuffer: Words::new(&g, &oob),
             shaded: Words::new(&sh, &oob),
             thickness: 7e-5,
+            rect: Rect::full(w, h),
         };
         let on = FilterParams::default();
         let off = FilterParams {
@@ -661,6 +677,70 @@ mod tests {
         assert_eq!(oob.load(Relaxed), 0);
         // The window did something: many pixels got a partial opacity.
         assert!(filtered > (w * h / 10) as usize, "{filtered}");
+    }
+
+    /// lipp.shade writes no records outside the groom's rectangle: there the
+    /// filter must read no hair, whatever the records hold.
+    #[test]
+    fn taps_outside_the_shaded_rectangle_read_no_hair() {
+        let (mut g, mut sh) = (Vec::new(), Vec::new());
+        let (f, w, h) = scene(&mut g, &mut sh);
+        // Hair only in the middle of the screen, as the shade leaves it.
+        let hair = Rect {
+            x0: w / 4,
+            y0: h / 4,
+            x1: 3 * w / 4,
+            y1: 3 * h / 4,
+        };
+        let n = (w * h) as usize;
+        let empty = shaded::record([0.0; 3], 0, 0);
+        for i in (0..n).filter(|&i| !hair.contains(i as u32 % w, i as u32 / w)) {
+            for slot in [i, n + i] {
+                g[2 * slot].store(EMPTY as u32, Relaxed);
+                g[2 * slot + 1].store((EMPTY >> 32) as u32, Relaxed);
+            }
+            sh[2 * i].store(empty[0], Relaxed);
+            sh[2 * i + 1].store(empty[1], Relaxed);
+        }
+        let oob = AtomicU64::new(0);
+        let full = View {
+            f: &f,
+            layers: 2,
+            width: w,
+            height: h,
+            gbuffer: Words::new(&g, &oob),
+            shaded: Words::new(&sh, &oob),
+            thickness: 7e-5,
+            rect: Rect::full(w, h),
+        };
+        let expect: Vec<Option<Hair>> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| filter_pixel(&FilterParams::default(), &full, x, y))
+            .collect();
+        // Stale records outside: a near, lit hit everywhere.
+        let stale: Vec<AtomicU32> = (0..sh.len())
+            .map(|k| {
+                let (slot, word) = ((k / 2) as u32, k % 2);
+                let (x, y) = ((slot % (w * h)) % w, (slot % (w * h)) / w);
+                if hair.contains(x, y) {
+                    AtomicU32::new(sh[k].load(Relaxed))
+                } else if word == 0 {
+                    AtomicU32::new(shaded::pack_rgb9e5([5.0, 0.0, 0.0]))
+                } else {
+                    AtomicU32::new(shaded::HIT | shaded::CONS_HIT | 0x100)
+                }
+            })
+            .collect();
+        let clipped = View {
+            shaded: Words::new(&stale, &oob),
+            rect: hair,
+            ..full
+        };
+        for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+            let got = filter_pixel(&FilterParams::default(), &clipped, x, y);
+            assert_eq!(got, expect[(y * w + x) as usize], "pixel ({x}, {y})");
+        }
+        assert_eq!(oob.load(Relaxed), 0);
     }
 
     #[test]

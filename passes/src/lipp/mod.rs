@@ -16,6 +16,7 @@ pub mod lod;
 pub mod payload;
 pub mod probe;
 pub mod raster;
+pub mod rect;
 pub mod reference;
 pub mod shade;
 pub mod shaded;
@@ -143,7 +144,9 @@ pub struct BundleLod {
     pub strands: u32,
     /// C, control points per strand (Eq. 4-5).
     pub control_points: u32,
-    /// First drawn strand of this bundle in the dispatch's numbering.
+    /// First drawn strand of this bundle in the dispatch's numbering. In
+    /// `lod_choices`, before the scan: the bundle's screen rectangle in the
+    /// camera's view ([`rect::Rect::pack_tiles`]), 0 if not drawn.
     pub first_strand: u32,
     /// Bit 0: frustum-culled; bit 1: another groom's (not drawn this time).
     pub flags: u32,
@@ -158,6 +161,7 @@ pub const LOD_OTHER_GROOM: u32 = 2;
 /// Σ N of the groom (4) and Σ N_LOD of the groom (5): β of Lipp Eq. 8 is
 /// word 5 / word 4, the strands the LOD keeps whether or not the frustum
 /// cull then draws them: a bundle out of view thins no visible strand.
+/// Words 6 and 7 hold the groom's screen rectangle ([`rect::ARGS_RECT_LO`]).
 pub const ARGS_DRAWN: usize = 3;
 pub const ARGS_ALL: usize = 4;
 pub const ARGS_KEPT: usize = 5;

@@ -3,7 +3,8 @@
 //! RGB9E5 radiance, depth and hit flags). Only the centre layer's record is
 //! written where no sample is (the filter's taps read its flags); the tiles
 //! with a sample are listed for `lipp.filter` ([`super::tiles`],
-//! `hair_tiles`).
+//! `hair_tiles`). With `groom_rect` (ours), only the workgroups of pixels
+//! in the groom's screen rectangle shade ([`super::rect`]).
 //!
 //! Position is reconstructed from the 24-bit depth at the pixel centre ("we
 //! use the common approach in deferred engines and reconstruct it from the
@@ -42,6 +43,7 @@ pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
+use super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, FILTER_RECT_HI, FILTER_RECT_LO, Rect};
 use super::shaded::{CONS_HIT, HIT, record};
 use super::tiles;
 use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
@@ -86,6 +88,9 @@ pub struct ShadeParams {
     /// Ours: list only the tiles with hair for `lipp.filter` ([`super::tiles`]);
     /// off, every tile.
     pub hair_tiles: bool,
+    /// Ours: shade only the groom's screen rectangle ([`super::rect`]);
+    /// off, every pixel, as the paper's deferred shading does.
+    pub groom_rect: bool,
 }
 
 impl Default for ShadeParams {
@@ -103,6 +108,7 @@ impl Default for ShadeParams {
             dom_layer_thickness: 0.02,
             model_index: 0,
             hair_tiles: true,
+            groom_rect: true,
         }
     }
 }
@@ -142,7 +148,8 @@ crate::gpu_block! {
         slots: u32,
         /// `lipp.shade` only: list only the tiles with hair.
         hair_tiles: u32,
-        padding: u32,
+        /// `lipp.shade` only: only the groom's screen rectangle.
+        groom_rect: u32,
     }
 }
 
@@ -164,7 +171,7 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         probe_specular: flag(p.probe_specular),
         slots,
         hair_tiles: flag(p.hair_tiles),
-        padding: 0,
+        groom_rect: flag(p.groom_rect),
     }
 }
 
@@ -406,6 +413,28 @@ pub fn shade_point(inp: &Inputs<'_>, model: &ModelData, p: &Point) -> [f32; 3] {
 
 struct ShadeKernel(ShadeParams);
 
+impl ShadeKernel {
+    /// The pixels this pass shades ([`super::rect`]): the groom's screen
+    /// rectangle with `groom_rect` on and room in `filter_args` to tell
+    /// `lipp.filter`, else the whole screen. Workgroup 0 tells the filter.
+    fn shaded_rect(&self, ctx: &Ctx<'_>, group: u32) -> Rect {
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let (args, filter_args) = (ctx.words("raster_args"), ctx.words("filter_args"));
+        let room = filter_args.len() > FILTER_RECT_HI && args.len() > ARGS_RECT_HI;
+        let r = if self.0.groom_rect && room {
+            Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI))
+        } else {
+            Rect::full(w, h)
+        };
+        if room && group == 0 {
+            let [lo, hi] = r.args();
+            filter_args.store(FILTER_RECT_LO, lo);
+            filter_args.store(FILTER_RECT_HI, hi);
+        }
+        r
+    }
+}
+
 /// `env.sh` as 9 rgb coefficients.
 pub fn load_sh(w: &Words<'_>) -> [[f32; 3]; 9] {
     std::array::from_fn(|i| {
@@ -428,6 +457,10 @@ impl CpuKernel for ShadeKernel {
         } else {
             0.0
         };
+        let shaded_rect = self.shaded_rect(ctx, group);
+        if !shaded_rect.touches_run(group * SHADE_GROUP, SHADE_GROUP, w) {
+            return;
+        }
         let inp = Inputs::load(ctx, &f, &model, &lights, &self.0, delta);
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let layers = super::gbuffer_layers(&g, &out, pixels);

@@ -7,7 +7,9 @@
 //! with a per-bundle random δ), and the control-point count C (Eq. 4-5,
 //! snapped to 2^k + 1). Bundles whose footprint lies outside the viewport are
 //! frustum-culled (flag `LOD_CULLED`: they keep N_LOD for β of Eq. 8 and
-//! draw nothing). The decisions go to `lod_choices`;
+//! draw nothing). The decisions go to `lod_choices`, with each drawn
+//! bundle's screen rectangle in the camera's view where the scan will put its
+//! first strand ([`super::rect`]);
 //! `lipp.lod_scan` ([`scan`]) turns them into first strands and the
 //! rasterizer's indirect dispatch.
 //!
@@ -35,6 +37,7 @@ pub mod footprint;
 pub mod scan;
 
 use super::dom::{LightFrame, light_frames};
+use super::rect;
 use super::{
     BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED, LOD_OTHER_GROOM, LOD_WORDS,
     MAX_CONTROL_POINTS, bundle_count, frame, pcg, unit,
@@ -315,10 +318,18 @@ pub fn choose(
         raw_control_points(l_res, p.max_control_points, b.layers()),
         c_max,
     );
+    // The bundle's screen rectangle in the camera's view (rect.rs), which
+    // lipp.lod_scan unites and then overwrites with the first strand.
+    let rect = if p.view == View::Camera && !culled {
+        let (lo, hi) = rect::bundle_box(layers, b);
+        rect::screen_rect(f, lo, hi).pack_tiles(w as u32, h as u32)
+    } else {
+        0
+    };
     BundleLod {
         strands,
         control_points: c,
-        first_strand: 0,
+        first_strand: rect,
         flags: if culled { LOD_CULLED } else { 0 },
     }
 }
@@ -551,7 +562,15 @@ mod tests {
             0.02,
             &[lf],
         );
-        assert_eq!(bound, camera);
+        // The same decision; only the camera's view keeps a screen rectangle.
+        assert_eq!(
+            bound,
+            BundleLod {
+                first_strand: 0,
+                ..camera
+            }
+        );
+        assert_ne!(camera.first_strand, 0);
         assert!(camera.strands * 5 < expect as u32);
         // No light with a map: culled (the scan draws none of its strands).
         let dark = decide_lit(&p, 1.0, 0, 0.02, &[]);

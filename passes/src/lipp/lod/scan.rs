@@ -6,7 +6,8 @@
 //! over all drawn strands (a workgroup per strand), so each bundle needs its
 //! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
 //! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
-//! drawn, Σ N, Σ N_LOD). A frustum-culled bundle draws nothing (its
+//! drawn, Σ N, Σ N_LOD, and the drawn bundles' screen rectangle,
+//! [`super::super::rect`]). A frustum-culled bundle draws nothing (its
 //! `bundle_lod` count is 0) but its N_LOD counts in β = Σ N_LOD / Σ N of
 //! Eq. 8, over the bundles the decision was for (not another groom's): β is
 //! the fraction of strands the LOD removed, which culling must not change.
@@ -14,6 +15,7 @@
 //! scans their sums in workgroup memory (shaders/lipp/lod_scan.wgsl); the
 //! CPU kernel computes the same values sequentially.
 
+use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 use super::super::{
     ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED,
     LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
@@ -31,9 +33,10 @@ crate::gpu_block! {
     pub struct ScanGpu {
         /// Scene quantity: bundles packed.
         bundles: u32,
+        /// Scene quantities: the screen.
+        width: u32,
+        height: u32,
         _pad0: u32,
-        _pad1: u32,
-        _pad2: u32,
     }
 }
 
@@ -53,6 +56,8 @@ pub static LOD_SCAN: PassKind<NoParams, ScanGpu> = PassKind {
     kernel: |_| Box::new(ScanKernel),
     gpu: |_, q| ScanGpu {
         bundles: count(q.bundles),
+        width: q.width,
+        height: q.height,
         ..ScanGpu::default()
     },
     raster: None,
@@ -72,6 +77,8 @@ impl CpuKernel for ScanKernel {
             .min(choices.len() / LOD_WORDS)
             .min(out.len() / LOD_WORDS);
         let (mut total, mut full, mut kept) = (0u32, 0u32, 0u32);
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let mut groom = Rect::EMPTY;
         for b in 0..count {
             let mut lod = BundleLod::load(&choices, b);
             if lod.flags & LOD_OTHER_GROOM == 0 {
@@ -80,6 +87,9 @@ impl CpuKernel for ScanKernel {
             }
             if lod.flags & LOD_CULLED != 0 {
                 lod.strands = 0;
+            }
+            if lod.strands > 0 {
+                groom = groom.union(Rect::unpack_tiles(lod.first_strand, w, h));
             }
             lod.first_strand = total;
             total = total.wrapping_add(lod.strands);
@@ -93,6 +103,12 @@ impl CpuKernel for ScanKernel {
         // β of Lipp Eq. 8 is word 5 / word 4.
         args.store(ARGS_ALL, full);
         args.store(ARGS_KEPT, kept);
+        // The screen rectangle of the bundles drawn (rect.rs), if there is room.
+        if args.len() > ARGS_RECT_HI {
+            let [lo, hi] = groom.args();
+            args.store(ARGS_RECT_LO, lo);
+            args.store(ARGS_RECT_HI, hi);
+        }
     }
 }
 
@@ -113,6 +129,9 @@ mod tests {
             (5, 0),
             (3, LOD_CULLED),
         ];
+        // Screen rectangles in 8-pixel tiles (x0 | y0 << 8 | x1 << 16 | y1 << 24):
+        // only the drawn bundles' (the first and the fourth) count.
+        let mut rects = [0x0402_0301u32, 0x6464_0000, 0x0101_0000, 0x0906_0505, 1].into_iter();
         let mut bundles = Vec::new();
         let mut choices = Vec::new();
         for (n, flags) in counts {
@@ -121,10 +140,12 @@ mod tests {
                 ..Default::default()
             };
             bundles.extend(rec.words());
-            choices.extend([n, 9, 123, flags]);
+            choices.extend([n, 9, rects.next().unwrap(), flags]);
         }
         let mut h = Harness::new(Quantities {
             bundles: counts.len() as u64,
+            width: 640,
+            height: 480,
             ..Default::default()
         });
         h.buffer("hairmesh.bundles", bundles)
@@ -140,5 +161,16 @@ mod tests {
         assert!(lod.chunks(4).all(|w| w[1] == 9), "C copied");
         // Drawn 15; β = (10 + 7 + 5 + 3) / (4 · 20).
         assert_eq!(&h.read("raster_args")[..6], &[15, 1, 1, 15, 80, 25]);
+        // Tiles x 1..6, y 3..9 of 8 pixels.
+        let args = h.read("raster_args");
+        assert_eq!(
+            Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]),
+            Rect {
+                x0: 8,
+                y0: 24,
+                x1: 48,
+                y1: 72
+            }
+        );
     }
 }
