@@ -100,36 +100,6 @@ fn snap_control_points(c_raw: u32, c_max: u32) -> u32 {
     return min(p + 1u, c_max);
 }
 
-// rect::bundle_box, then rect::screen_rect packed in tiles.
-fn bundle_rect(o: u32, first_layer: u32, layers: u32) -> u32 {
-    var lo = vec3<f32>(F32_MAX);
-    var hi = vec3<f32>(F32_MIN);
-    var chord = 0.0;
-    var prev: array<vec3<f32>, 4>;
-    for (var i = 0u; i < layers; i++) {
-        let c0 = corner(first_layer, i, 0u);
-        let c1 = corner(first_layer, i, 1u);
-        let c2 = corner(first_layer, i, 2u);
-        let c3 = corner(first_layer, i, 3u);
-        var e: array<vec3<f32>, 4>;
-        for (var k = 0u; k < 4u; k++) {
-            let p = extended_corner(c0, c1, c2, c3, k);
-            e[k] = p;
-            lo = min(lo, p);
-            hi = max(hi, p);
-            if i > 0u {
-                for (var q = 0u; q < 4u; q++) {
-                    chord = max(chord, distance(p, prev[q]));
-                }
-            }
-        }
-        prev = e;
-    }
-    let pad = box_pad(bitcast<f32>(hairmesh_bundles[o + 4u]), bitcast<f32>(hairmesh_bundles[o + 7u]), chord);
-    let r = screen_rect(frame.view_proj, frame.screen.xy, frame.near, lo - pad, hi + pad);
-    return pack_tiles(r, u32(frame.screen.x), u32(frame.screen.y));
-}
-
 // lod::choose for bundle b: (N_LOD, C, screen rectangle, flags).
 fn choose(b: u32) -> vec4<u32> {
     let o = b * BUNDLE_WORDS;
@@ -142,18 +112,44 @@ fn choose(b: u32) -> vec4<u32> {
     let seed = hairmesh_bundles[o + 8u];
     let w = frame.screen.x;
     let h = frame.screen.y;
-    // footprint::screen (Lipp Eq. 3).
+    // footprint::screen (Lipp Eq. 3), and in the same pass over the layers
+    // rect::bundle_box (the camera's view only).
     var fp = empty_footprint();
     var behind = false;
+    var lo = vec3<f32>(F32_MAX);
+    var hi = vec3<f32>(F32_MIN);
+    var chord = 0.0;
+    var prev_c = vec3<f32>(0.0);
+    var prev_r = 0.0;
     for (var i = 0u; i < layers; i++) {
+        var q: array<vec3<f32>, 4>;
         for (var k = 0u; k < 4u; k++) {
-            let c = transform(frame.view_proj, vec4<f32>(corner(first_layer, i, k), 1.0));
+            q[k] = corner(first_layer, i, k);
+            let c = transform(frame.view_proj, vec4<f32>(q[k], 1.0));
             if c.w <= frame.near {
                 behind = true;
                 continue;
             }
             let s = clip_to_screen(c, w, h);
             fp = Footprint(min(fp.lo, s.xy), max(fp.hi, s.xy));
+        }
+        if params.light_view == 0u {
+            var e: array<vec3<f32>, 4>;
+            for (var k = 0u; k < 4u; k++) {
+                e[k] = extended_corner(q[0], q[1], q[2], q[3], k);
+            }
+            let centre = (e[0] + e[1] + e[2] + e[3]) * 0.25;
+            var r = 0.0;
+            for (var k = 0u; k < 4u; k++) {
+                lo = min(lo, e[k]);
+                hi = max(hi, e[k]);
+                r = max(r, distance(e[k], centre));
+            }
+            if i > 0u {
+                chord = max(chord, distance(centre, prev_c) + r + prev_r);
+            }
+            prev_c = centre;
+            prev_r = r;
         }
     }
     // The groom's own strength multiplies the pass's.
@@ -203,7 +199,9 @@ fn choose(b: u32) -> vec4<u32> {
     let c = snap_control_points(c_raw, c_max);
     var rect = 0u;
     if params.light_view == 0u && !culled {
-        rect = bundle_rect(o, first_layer, layers);
+        let pad = box_pad(bitcast<f32>(hairmesh_bundles[o + 4u]), bitcast<f32>(hairmesh_bundles[o + 7u]), chord);
+        let r = screen_rect(frame.view_proj, frame.screen.xy, frame.near, lo - pad, hi + pad);
+        rect = pack_tiles(r, u32(w), u32(h));
     }
     return vec4<u32>(strands, c, rect, select(0u, LOD_CULLED, culled));
 }

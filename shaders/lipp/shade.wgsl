@@ -59,9 +59,11 @@ fn shaded_rect(wg: u32, lane: u32) -> vec4<u32> {
     return r;
 }
 
-@compute @workgroup_size(64)
+// Two threads a pixel, one per G-buffer layer (every other layer past two):
+// a far groom covers few tiles, and its pixels' shading, a long chain of
+// dependent loads and transcendentals, set the pass's time (shade.rs).
+@compute @workgroup_size(128)
 fn shade(
-    @builtin(global_invocation_id) gid: vec3<u32>,
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
@@ -74,14 +76,14 @@ fn shade(
     }
     workgroupBarrier();
     let pixels = params.width * params.height;
-    let i = gid.x;
+    let i = wg.x * SHADE_GROUP + lane % SHADE_GROUP;
     if i < pixels {
         let x = i % params.width;
         let y = i / params.width;
         // lipp::gbuffer_layers: 8 bytes a pixel and layer in both.
         let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
         let cons = select(0u, CONS_HIT, !is_empty(gbuffer[pixels + i]));
-        for (var layer = 0u; layer < layers; layer++) {
+        for (var layer = lane / SHADE_GROUP; layer < layers; layer += 2u) {
             let p = gbuffer[layer * pixels + i];
             // shaded.rs: the centre layer's record for every pixel (the
             // filter's taps read its flags), the others where a sample is.

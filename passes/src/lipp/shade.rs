@@ -6,6 +6,11 @@
 //! `hair_tiles`). With `groom_rect` (ours), only the workgroups of pixels
 //! in the groom's screen rectangle shade ([`super::rect`]).
 //!
+//! The WGSL gives each pixel two threads, one per G-buffer layer: a far
+//! groom covers a few tiles, too few threads to hide the latency of a
+//! sample's shading (dependent loads of the maps and the probe, Chiang's
+//! transcendentals), which then sets the pass's time.
+//!
 //! Position is reconstructed from the 24-bit depth at the pixel centre ("we
 //! use the common approach in deferred engines and reconstruct it from the
 //! depth value", §3.1.2); the tangent is the octahedral one; the material is
@@ -193,7 +198,8 @@ pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
         Binding::write("filter_tiles"),
         Binding::atomic("filter_args"),
     ]),
-    workgroup_size: SHADE_GROUP,
+    // Threads: two a pixel, one per layer (shaders/lipp/shade.wgsl).
+    workgroup_size: 2 * SHADE_GROUP,
     dispatch: Dispatch::PerElement {
         quantity: Quantity::Pixels,
         per_group: SHADE_GROUP,
