@@ -114,8 +114,10 @@ fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
     return n.xy;
 }
 
-// filter::reconstruct: (filtered colour, alpha).
-fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promoted: bool) -> vec4<f32> {
+// filter::reconstruct: (filtered colour, alpha). With `parts` lanes a
+// pixel (filter_pairs), lane `part` takes every parts-th row of the window
+// and the lanes add their sums (filter.rs, `pairs`).
+fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promoted: bool, part: u32, parts: u32) -> vec4<f32> {
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
     let sq = f32(params.radius) * params.s_perp;
@@ -134,7 +136,7 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promote
     let z_near = select(F32_MIN, ndc(near), near > 0.0);
     let z_far = ndc(d_ref + params.depth_threshold);
     let rect = shaded_rect();
-    for (var dy = -r; dy <= r; dy++) {
+    for (var dy = -r + i32(part); dy <= r; dy += i32(parts)) {
         for (var dx = -r; dx <= r; dx++) {
             let qx = i32(x) + dx;
             let qy = i32(y) + dy;
@@ -176,6 +178,13 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promote
             wsum += w;
         }
     }
+    if parts == 2u {
+        // The pair's lanes are neighbours and take the same branches.
+        sum += subgroupShuffleXor(sum, 1u);
+        wsum += subgroupShuffleXor(wsum, 1u);
+        hc += subgroupShuffleXor(hc, 1u);
+        hcons += subgroupShuffleXor(hcons, 1u);
+    }
     var c = cp;
     if wsum > 0.0 {
         c = sum / wsum;
@@ -200,7 +209,8 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
-// A workgroup per listed tile, striding past 65,535 of them.
+// A workgroup per listed tile, striding past 65,535 of them: a lane a
+// pixel (pairs off).
 @compute @workgroup_size(64)
 fn filter_pixels(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -209,11 +219,26 @@ fn filter_pixels(
 ) {
     let count = min(filter_args[3], arrayLength(&filter_tiles));
     for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
-        filter_pixel(filter_tiles[t] * TILE + lane);
+        filter_pixel(filter_tiles[t] * TILE + lane, 0u, 1u);
     }
 }
 
-fn filter_pixel(i: u32) {
+// filter.rs `pairs`: two neighbouring lanes a pixel, each taking every other
+// row of the window.
+@compute @workgroup_size(128)
+fn filter_pairs(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+) {
+    let count = min(filter_args[3], arrayLength(&filter_tiles));
+    for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
+        filter_pixel(filter_tiles[t] * TILE + lane / 2u, lane & 1u, 2u);
+    }
+}
+
+// Lane `part` of `parts` filtering pixel i; part 0 writes.
+fn filter_pixel(i: u32, part: u32, parts: u32) {
     if i >= params.width * params.height {
         return;
     }
@@ -270,7 +295,7 @@ fn filter_pixel(i: u32) {
             let z = select(sg.depth, sa.depth, borrowed);
             let t = select(sg.tangent, sa.tangent, borrowed);
             let tp = screen_tangent(x, y, Sample(z, t, sg.uvw, sg.ao));
-            let r = reconstruct(x, y, z, tp, color(select(0u, 1u, borrowed), i), borrowed);
+            let r = reconstruct(x, y, z, tp, color(select(0u, 1u, borrowed), i), borrowed, part, parts);
             if k == 0u {
                 own = r;
             } else {
@@ -291,6 +316,9 @@ fn filter_pixel(i: u32) {
             depth = sa.depth;
         }
     } else {
+        return;
+    }
+    if part != 0u {
         return;
     }
     let alpha = out.w;

@@ -313,6 +313,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // lipp.filter with a lane a pixel rather than two, each taking every
+    // other row of the window (passes/src/lipp/filter.rs, `pairs`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, filter a lane per pixel",
+        graph: LIPP,
+        overrides: &["filter.pairs=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // lipp.shade over every pixel, as the paper's deferred shading, rather
     // than the groom's screen rectangle (passes/src/lipp/rect.rs).
     Variant {

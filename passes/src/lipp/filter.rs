@@ -94,6 +94,12 @@ pub struct FilterParams {
     /// (8 bytes) rather than both G-buffer layers and then its colour
     /// ([`super::shaded`] says why). The output is the same.
     pub packed_taps: bool,
+    /// Ours: two lanes a pixel on the GPU (entry point `filter_pairs`), each
+    /// taking every other row of the window, their sums added through a
+    /// subgroup shuffle. A far groom lists a few tiles, a workgroup or two
+    /// an SM, and each lane's 121 taps in a row then set the pass's time.
+    /// The sums are the same up to the order of two additions.
+    pub pairs: bool,
 }
 
 impl Default for FilterParams {
@@ -115,11 +121,18 @@ impl Default for FilterParams {
             centre_diameter: 0.5,
             model_index: 0,
             packed_taps: true,
+            pairs: true,
         }
     }
 }
 
 impl PassParams for FilterParams {
+    const VARIANT_ENTRIES: &'static [&'static str] = &["filter_pairs"];
+
+    fn entry(&self, default: &'static str) -> &'static str {
+        if self.pairs { "filter_pairs" } else { default }
+    }
+
     fn validate(&self) -> Result<(), Invalid> {
         if ![0, 1, 2, 4, 8].contains(&self.msaa) {
             return Err(Invalid::new(
