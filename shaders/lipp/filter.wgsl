@@ -209,18 +209,23 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
-// A workgroup per listed tile, striding past 65,535 of them: a lane a
-// pixel (pairs off).
+// A workgroup per listed tile, striding past 65,535 of them, `parts`
+// neighbouring lanes a pixel.
+fn filter_listed(wg: u32, groups: u32, lane: u32, parts: u32) {
+    let count = min(filter_args[3], arrayLength(&filter_tiles));
+    for (var t = wg; t < count; t += max(groups, 1u)) {
+        filter_pixel(filter_tiles[t] * TILE + lane / parts, lane % parts, parts);
+    }
+}
+
+// A lane a pixel (pairs off).
 @compute @workgroup_size(64)
 fn filter_pixels(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    let count = min(filter_args[3], arrayLength(&filter_tiles));
-    for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
-        filter_pixel(filter_tiles[t] * TILE + lane, 0u, 1u);
-    }
+    filter_listed(wg.x, groups.x, lane, 1u);
 }
 
 // filter.rs `pairs`: two neighbouring lanes a pixel, each taking every other
@@ -231,10 +236,7 @@ fn filter_pairs(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    let count = min(filter_args[3], arrayLength(&filter_tiles));
-    for (var t = wg.x; t < count; t += max(groups.x, 1u)) {
-        filter_pixel(filter_tiles[t] * TILE + lane / 2u, lane & 1u, 2u);
-    }
+    filter_listed(wg.x, groups.x, lane, 2u);
 }
 
 // Lane `part` of `parts` filtering pixel i; part 0 writes.

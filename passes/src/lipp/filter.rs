@@ -661,21 +661,32 @@ mod tests {
         (f, w, h)
     }
 
+    /// [`scene`]'s two layers and records over the whole screen.
+    fn test_view<'a>(
+        f: &'a FrameData,
+        g: &'a [AtomicU32],
+        sh: &'a [AtomicU32],
+        oob: &'a AtomicU64,
+    ) -> View<'a> {
+        let (w, h) = (f.screen[0] as u32, f.screen[1] as u32);
+        View {
+            f,
+            layers: 2,
+            width: w,
+            height: h,
+            gbuffer: Words::new(g, oob),
+            shaded: Words::new(sh, oob),
+            thickness: 7e-5,
+            rect: Rect::full(w, h),
+        }
+    }
+
     #[test]
     fn packed_taps_filter_the_same_as_taps_from_the_gbuffer() {
         let (mut g, mut sh) = (Vec::new(), Vec::new());
         let (f, w, h) = scene(&mut g, &mut sh);
         let oob = AtomicU64::new(0);
-        let v = View {
-            f: &f,
-            layers: 2,
-            width: w,
-            height: h,
-            gbuffer: Words::new(&g, &oob),
-            shaded: Words::new(&sh, &oob),
-            thickness: 7e-5,
-            rect: Rect::full(w, h),
-        };
+        let v = test_view(&f, &g, &sh, &oob);
         let on = FilterParams::default();
         let off = FilterParams {
             packed_taps: false,
@@ -716,16 +727,7 @@ mod tests {
             sh[2 * i + 1].store(empty[1], Relaxed);
         }
         let oob = AtomicU64::new(0);
-        let full = View {
-            f: &f,
-            layers: 2,
-            width: w,
-            height: h,
-            gbuffer: Words::new(&g, &oob),
-            shaded: Words::new(&sh, &oob),
-            thickness: 7e-5,
-            rect: Rect::full(w, h),
-        };
+        let full = test_view(&f, &g, &sh, &oob);
         let expect: Vec<Option<Hair>> = (0..h)
             .flat_map(|y| (0..w).map(move |x| (x, y)))
             .map(|(x, y)| filter_pixel(&FilterParams::default(), &full, x, y))
