@@ -209,17 +209,20 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
-// A workgroup per listed tile, striding past 65,535 of them, `parts`
-// neighbouring lanes a pixel.
+// The listed tiles, striding past 65,535 workgroups: 128 lanes a
+// workgroup, `parts` neighbouring lanes a pixel, so 2 / parts tiles a
+// workgroup (with a lane a pixel, the dispatch's second half has none).
 fn filter_listed(wg: u32, groups: u32, lane: u32, parts: u32) {
     let count = min(filter_args[3], arrayLength(&filter_tiles));
-    for (var t = wg; t < count; t += max(groups, 1u)) {
-        filter_pixel(filter_tiles[t] * TILE + lane / parts, lane % parts, parts);
+    let per = 2u / parts;
+    let pixel = lane / parts;
+    for (var t = wg * per + pixel / TILE; t < count; t += max(groups, 1u) * per) {
+        filter_pixel(filter_tiles[t] * TILE + pixel % TILE, lane % parts, parts);
     }
 }
 
 // A lane a pixel (pairs off).
-@compute @workgroup_size(64)
+@compute @workgroup_size(128)
 fn filter_pixels(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,

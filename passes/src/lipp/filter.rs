@@ -61,7 +61,9 @@ use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::layout::{FrameData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
 
-pub const FILTER_GROUP: u32 = super::tiles::TILE;
+/// Lanes a workgroup on the GPU: a tile of two lanes a pixel (`pairs`), or
+/// two tiles of a lane a pixel. The CPU kernel filters a tile a workgroup.
+pub const FILTER_GROUP: u32 = 2 * super::tiles::TILE;
 pub const MAX_RADIUS: u32 = 8;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
@@ -98,7 +100,8 @@ pub struct FilterParams {
     /// taking every other row of the window, their sums added through a
     /// subgroup shuffle. A far groom lists a few tiles, a workgroup or two
     /// an SM, and each lane's 121 taps in a row then set the pass's time.
-    /// The sums are the same up to the order of two additions.
+    /// The sums are the same up to the order of two additions. Off
+    /// (`filter_pixels`), a workgroup of the same 128 lanes takes two tiles.
     pub pairs: bool,
 }
 
