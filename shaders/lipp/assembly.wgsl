@@ -14,7 +14,7 @@
 #define_import_path strandgraph::lipp_assembly
 
 #import strandgraph::hash::pcg
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, bilinear, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 
 @group(0) @binding(2) var<storage, read> raster_args: array<u32>;
 @group(0) @binding(3) var<storage, read> bundle_lod: array<u32>;
@@ -57,12 +57,6 @@ struct LayerPoint {
     pos: vec3<f32>,
     axis: vec3<f32>,
     ao: f32,
-}
-
-fn bilinear(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>, c3: vec3<f32>, u: f32, v: f32) -> vec3<f32> {
-    let bottom = lerp_vec(c0, c1, u);
-    let top = lerp_vec(c3, c2, u);
-    return lerp_vec(bottom, top, v);
 }
 
 // strand::layer_point.

@@ -46,6 +46,14 @@ fn lerp_vec(a: vec3<f32>, b: vec3<f32>, t: f32) -> vec3<f32> {
     return a + (b - a) * t;
 }
 
+// strand::bilinear: the quad c0..c3 at (u, v), corner k at
+// [(0,0), (1,0), (1,1), (0,1)][k].
+fn bilinear(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>, c3: vec3<f32>, u: f32, v: f32) -> vec3<f32> {
+    let bottom = lerp_vec(c0, c1, u);
+    let top = lerp_vec(c3, c2, u);
+    return lerp_vec(bottom, top, v);
+}
+
 // Sign that is 1 at zero (oct_encode's sign_not_zero).
 fn sign_nz(x: f32) -> f32 {
     return select(-1.0, 1.0, x >= 0.0);

@@ -6,6 +6,7 @@
 #define_import_path strandgraph::lipp_rect
 
 #import strandgraph::clip::{transform, clip_to_screen}
+#import strandgraph::lipp::bilinear
 
 // rect::ARGS_RECT_LO/HI and FILTER_RECT_LO/HI.
 const ARGS_RECT_LO: u32 = 6u;
@@ -85,9 +86,7 @@ fn touches_run(r: vec4<u32>, first: u32, len: u32, w: u32) -> bool {
 fn extended_corner(c0: vec3<f32>, c1: vec3<f32>, c2: vec3<f32>, c3: vec3<f32>, k: u32) -> vec3<f32> {
     let u = select(-TWIST_REACH, 1.0 + TWIST_REACH, k == 1u || k == 2u);
     let v = select(-TWIST_REACH, 1.0 + TWIST_REACH, k >= 2u);
-    let bottom = c0 + (c1 - c0) * u;
-    let top = c3 + (c2 - c3) * u;
-    return bottom + (top - bottom) * v;
+    return bilinear(c0, c1, c2, c3, u, v);
 }
 
 // rect::bundle_box's growth: the styling reach and the Hermite bulge.

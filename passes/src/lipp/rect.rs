@@ -36,7 +36,8 @@
 //! the whole screen. `tests/lipp_rect.rs` checks every sample the
 //! rasterizer wrote lies inside, on the built-in scenes.
 
-use super::{BundleRecord, Corner, transform};
+use super::strand::bilinear;
+use super::{BundleRecord, Corner, length, sub, transform};
 use crate::kernel::Words;
 use crate::kulikov::clip_to_screen;
 use crate::layout::FrameData;
@@ -177,16 +178,14 @@ pub fn granularity(w: u32, h: u32) -> u32 {
 /// Corner `k` of layer `layer`'s quad extended to (u, v) ∈ [−¼, 1¼]²
 /// (bilinear, as `strand::layer_point` evaluates it).
 fn extended_corner(layers: &Words<'_>, layer: usize, k: usize) -> V3 {
-    let c = |k: usize| Corner::load(layers, layer, k).position;
-    let lerp = |a: V3, b: V3, t: f32| [0, 1, 2].map(|i| a[i] + (b[i] - a[i]) * t);
+    let c = std::array::from_fn(|k| Corner::load(layers, layer, k).position);
     let (lo, hi) = (-TWIST_REACH, 1.0 + TWIST_REACH);
     let (u, v) = [(lo, lo), (hi, lo), (hi, hi), (lo, hi)][k];
-    lerp(lerp(c(0), c(1), u), lerp(c(3), c(2), u), v)
+    bilinear(c, u, v)
 }
 
 fn distance(a: V3, b: V3) -> f32 {
-    let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    length(sub(a, b))
 }
 
 /// The world box (lo, hi) holding everything bundle `b` can draw (module

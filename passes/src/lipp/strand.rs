@@ -58,7 +58,8 @@ pub struct LayerPoint {
     pub ao: f32,
 }
 
-fn bilinear(c: [[f32; 3]; 4], u: f32, v: f32) -> [f32; 3] {
+/// The quad `c` at (u, v), corner k at [(0,0), (1,0), (1,1), (0,1)][k].
+pub fn bilinear(c: [[f32; 3]; 4], u: f32, v: f32) -> [f32; 3] {
     let bottom = mix(c[0], c[1], u);
     let top = mix(c[3], c[2], u);
     mix(bottom, top, v)
