@@ -22,6 +22,7 @@
 
 use std::path::PathBuf;
 use strandgraph::frame::{Prepared, prepare};
+use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 
 mod common;
 use common::{ash, check_flip, cpu, out_dir, read_ash, root, wgpu};
@@ -83,9 +84,11 @@ fn small_scene(tag: &str, beard: bool) -> PathBuf {
     path
 }
 
-/// Per G-buffer layer: (covered by exactly one side, covered by either,
-/// covered by both, both covered with depth within 1e-4, bit-identical).
-fn gbuffer_agreement(a: &[u32], b: &[u32]) -> Vec<(usize, usize, usize, usize, usize)> {
+/// Per G-buffer layer, over the groom's screen rectangle `r` (outside it
+/// `lipp.clear_gbuffer` leaves the buffer as it was: passes/src/lipp/rect.rs):
+/// (covered by exactly one side, covered by either, covered by both, both
+/// covered with depth within 1e-4, bit-identical).
+fn gbuffer_agreement(a: &[u32], b: &[u32], r: &Rect) -> Vec<(usize, usize, usize, usize, usize)> {
     let pixels = (W * H) as usize;
     let layers = a.len() / (2 * pixels);
     assert_eq!(a.len(), b.len());
@@ -93,6 +96,9 @@ fn gbuffer_agreement(a: &[u32], b: &[u32]) -> Vec<(usize, usize, usize, usize, u
         .map(|layer| {
             let (mut one, mut either, mut both, mut close, mut exact) = (0, 0, 0, 0, 0);
             for i in 0..pixels {
+                if !r.contains(i as u32 % W, i as u32 / W) {
+                    continue;
+                }
                 let slot = layer * pixels + i;
                 let pa = u64::from(a[2 * slot]) | (u64::from(a[2 * slot + 1]) << 32);
                 let pb = u64::from(b[2 * slot]) | (u64::from(b[2 * slot + 1]) << 32);
@@ -115,10 +121,13 @@ fn gbuffer_agreement(a: &[u32], b: &[u32]) -> Vec<(usize, usize, usize, usize, u
         .collect()
 }
 
-/// `min_covered`: pixels a layer must cover for the comparison to mean something.
-fn check_gbuffer(label: &str, reference: &[u32], test: &[u32], min_covered: usize) {
-    for (layer, (one, either, both, close, exact)) in
-        gbuffer_agreement(reference, test).into_iter().enumerate()
+/// `min_covered`: pixels a layer must cover for the comparison to mean
+/// something; `args`: the groom's `raster_args` on the CPU (its rectangle).
+fn check_gbuffer(label: &str, reference: &[u32], test: &[u32], args: &[u32], min_covered: usize) {
+    let r = Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]);
+    for (layer, (one, either, both, close, exact)) in gbuffer_agreement(reference, test, &r)
+        .into_iter()
+        .enumerate()
     {
         eprintln!(
             "gbuffer layer {layer} {label}: covered by one side {one} of {either}, depth close on {close} of {both}, payload bit-identical on {exact}"
@@ -252,14 +261,20 @@ fn run(graph: Option<&str>, beard: bool) {
     }
 
     let g = read_cpu("gbuffer");
-    check_gbuffer("cpu/ash", &g, &read_ash(&plain, "gbuffer"), 500);
-    check_gbuffer("cpu/wgpu", &g, &read_wgpu("gbuffer"), 500);
+    check_gbuffer("cpu/ash", &g, &read_ash(&plain, "gbuffer"), &args, 500);
+    check_gbuffer("cpu/wgpu", &g, &read_wgpu("gbuffer"), &args, 500);
     if beard {
         // The second groom's own copy of the G-buffer: what shows of the
         // beard through the hair (about 190 pixels per layer).
-        let g = read_cpu("gbuffer[1]");
-        check_gbuffer("beard cpu/ash", &g, &read_ash(&plain, "gbuffer[1]"), 100);
-        check_gbuffer("beard cpu/wgpu", &g, &read_wgpu("gbuffer[1]"), 100);
+        let (g, args) = (read_cpu("gbuffer[1]"), read_cpu("raster_args[1]"));
+        check_gbuffer(
+            "beard cpu/ash",
+            &g,
+            &read_ash(&plain, "gbuffer[1]"),
+            &args,
+            100,
+        );
+        check_gbuffer("beard cpu/wgpu", &g, &read_wgpu("gbuffer[1]"), &args, 100);
     }
 
     let (dd, dl) = (read_cpu("dom_depth"), read_cpu("dom_layers"));

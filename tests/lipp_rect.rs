@@ -5,12 +5,20 @@
 //!
 //! Each groom's `lipp.shade` is checked with the bindings it ran with
 //! (the simulator's per-pass capture, as the agreement tests use): the
-//! G-buffer the rasterizer left and the rectangle `lipp.lod_scan` put in
-//! `raster_args`.
+//! G-buffer the rasterizer left, against the one it started from (the
+//! clear's, which `lipp.clear_gbuffer` leaves stale outside the rectangle),
+//! and the rectangle `lipp.lod_scan` put in `raster_args`.
+//!
+//! And the rectangle changes no pixel: two grooms drawn one after the other
+//! on the simulator with its transients aliased, so that the G-buffer
+//! outside the rectangle holds what was there before, give the same
+//! output as with `lipp.lod_scan`'s `groom_rect` off (everything shaded
+//! and cleared).
 
 use std::path::Path;
 use strandgraph::agree::capture;
-use strandgraph::frame::prepare_with;
+use strandgraph::frame::{Prepared, prepare_with};
+use strandgraph_cpu::CpuBackend;
 use strandgraph_passes::lipp::payload::EMPTY;
 use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 
@@ -37,17 +45,28 @@ fn grooms(scene: &str, graph: Option<&str>, (w, h): (u32, u32)) -> Vec<(Rect, us
     )
     .unwrap_or_else(|e| panic!("{scene}: {e:?}"));
     let mut out = Vec::new();
+    // The G-buffer as the pass after its clear found it, and whether the
+    // last pass that bound it was a clear.
+    let (mut cleared, mut after_clear): (Option<Vec<u32>>, bool) = (None, false);
     for c in capture(&p).unwrap_or_else(|e| panic!("{scene}: {e:?}")) {
-        if p.plan.graph.passes[c.pass].kind != "lipp.shade" {
+        let kind = p.plan.graph.passes[c.pass].kind.as_str();
+        let words = |name: &str| c.bindings.iter().find(|(n, _)| n == name).map(|b| &b.1);
+        let Some(g) = words("gbuffer") else { continue };
+        if after_clear {
+            cleared = Some(g.clone());
+        }
+        after_clear = kind.ends_with("clear") || kind == "lipp.clear_gbuffer";
+        if kind != "lipp.shade" {
             continue;
         }
-        let words = |name: &str| &c.bindings.iter().find(|(n, _)| n == name).unwrap().1;
-        let (g, args) = (words("gbuffer"), words("raster_args"));
+        let args = words("raster_args").expect("lipp.shade binds raster_args");
         let rect = Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]);
+        let before = cleared.as_ref().expect("a clear before lipp.shade");
         let pixels = (w * h) as usize;
         let mut samples = 0;
         for (slot, pair) in g.chunks_exact(2).enumerate() {
-            if (pair[0] as u64 | (pair[1] as u64) << 32) == EMPTY {
+            let was = &before[2 * slot..2 * slot + 2];
+            if (pair[0] as u64 | (pair[1] as u64) << 32) == EMPTY || pair == was {
                 continue;
             }
             let i = (slot % pixels) as u32;
@@ -94,4 +113,40 @@ fn the_hardware_rasterizers_samples_lie_in_the_rectangle_too() {
         let g = grooms("scenes/distances/mid.ron", Some(graph), (480, 270));
         assert!(g.iter().all(|(_, n)| *n > 0), "{graph}: {g:?}");
     }
+}
+
+fn output(p: &Prepared) -> Vec<u32> {
+    let frame = CpuBackend {
+        alias: true,
+        ..CpuBackend::default()
+    }
+    .execute(&p.plan, &p.instance, &p.upload)
+    .unwrap_or_else(|e| panic!("cpu backend failed: {e}"));
+    frame.read(&p.plan, "output.final").expect("output.final")
+}
+
+#[test]
+fn the_rectangle_changes_no_pixel_of_two_grooms_drawn_one_after_the_other() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("scenes/grooms.ron");
+    let prepared = |overrides: &[String]| {
+        prepare_with(&scene, None, Some((240, 135)), overrides).unwrap_or_else(|e| panic!("{e:?}"))
+    };
+    let on = prepared(&[]);
+    let shades = on
+        .plan
+        .graph
+        .passes
+        .iter()
+        .filter(|p| p.kind == "lipp.shade")
+        .count();
+    assert!(shades > 1, "two grooms, {shades} lipp.shade passes");
+    let off = prepared(&["lod_scan.groom_rect=false".to_string()]);
+    let (a, b) = (output(&on), output(&off));
+    assert!(
+        a.iter().any(|&w| w != a[0]),
+        "an image with something in it"
+    );
+    let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert_eq!(differ, 0, "{differ} words of the output differ");
 }

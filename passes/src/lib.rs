@@ -78,6 +78,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     // Lipp et al., deferred software rasterization of hair meshes.
     &lipp::lod::LOD,
     &lipp::lod::scan::LOD_SCAN,
+    &lipp::clear::CLEAR_GBUFFER,
     &lipp::raster::RASTER,
     &lipp::dom::DOM_DEPTH,
     &lipp::dom::DOM_OPACITY,

@@ -4,7 +4,7 @@
 // contiguous run of bundles; the lanes' sums are scanned in workgroup memory
 // (Hillis and Steele), then each lane writes its run.
 
-#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, rect_union, rect_is_empty, unpack_tiles, rect_args}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, ARGS_RUNS, rect_union, rect_is_empty, unpack_tiles, rect_args, rect_runs}
 #import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED}
 
 struct ScanParams {
@@ -13,7 +13,8 @@ struct ScanParams {
     // Scene quantities: the screen.
     width: u32,
     height: u32,
-    _pad0: u32,
+    // Ours: off, the rectangle is the whole screen (scan.rs).
+    groom_rect: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: ScanParams;
@@ -111,15 +112,24 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         // β of Lipp Eq. 8 is word 5 / word 4 (lipp::ARGS_KEPT, ARGS_ALL).
         raster_args[4] = full_sums[SCAN_GROUP - 1u];
         raster_args[5] = kept_sums[SCAN_GROUP - 1u];
-        // The drawn bundles' screen rectangle, if there is room.
+        // The drawn bundles' screen rectangle and the dispatch over its
+        // runs, if there is room.
+        var groom = vec4<u32>(atomicLoad(&groom_rect[0]), atomicLoad(&groom_rect[1]), atomicLoad(&groom_rect[2]), atomicLoad(&groom_rect[3]));
+        if rect_is_empty(groom) {
+            groom = vec4<u32>(0u);
+        }
+        if params.groom_rect == 0u {
+            groom = vec4<u32>(0u, 0u, params.width, params.height);
+        }
         if arrayLength(&raster_args) > ARGS_RECT_HI {
-            var groom = vec4<u32>(atomicLoad(&groom_rect[0]), atomicLoad(&groom_rect[1]), atomicLoad(&groom_rect[2]), atomicLoad(&groom_rect[3]));
-            if rect_is_empty(groom) {
-                groom = vec4<u32>(0u);
-            }
             let a = rect_args(groom);
             raster_args[ARGS_RECT_LO] = a.x;
             raster_args[ARGS_RECT_HI] = a.y;
+        }
+        if arrayLength(&raster_args) > ARGS_RUNS + 2u {
+            raster_args[ARGS_RUNS] = min(rect_runs(groom, params.width).y, MAX_GROUPS_X);
+            raster_args[ARGS_RUNS + 1u] = 1u;
+            raster_args[ARGS_RUNS + 2u] = 1u;
         }
     }
 }

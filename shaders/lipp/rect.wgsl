@@ -8,9 +8,11 @@
 #import strandgraph::clip::{transform, clip_to_screen}
 #import strandgraph::lipp::bilinear
 
-// rect::ARGS_RECT_LO/HI and FILTER_RECT_LO/HI.
+// rect::ARGS_RECT_LO/HI, ARGS_RUNS and FILTER_RECT_LO/HI; tiles::TILE.
 const ARGS_RECT_LO: u32 = 6u;
 const ARGS_RECT_HI: u32 = 7u;
+const ARGS_RUNS: u32 = 8u;
+const RUN: u32 = 64u;
 const FILTER_RECT_LO: u32 = 4u;
 const FILTER_RECT_HI: u32 = 5u;
 const TWIST_REACH: f32 = 0.25;
@@ -69,6 +71,16 @@ fn rect_args(r: vec4<u32>) -> vec2<u32> {
 // Rect::from_args.
 fn rect_from_args(lo: u32, hi: u32) -> vec4<u32> {
     return vec4<u32>(lo & 0xFFFFu, lo >> 16u, hi & 0xFFFFu, hi >> 16u);
+}
+
+// Rect::runs: (first run, count) of RUN pixels.
+fn rect_runs(r: vec4<u32>, w: u32) -> vec2<u32> {
+    if rect_is_empty(r) {
+        return vec2<u32>(0u);
+    }
+    let first = (r.y * w + r.x) / RUN;
+    let last = ((r.w - 1u) * w + r.z - 1u) / RUN;
+    return vec2<u32>(first, last - first + 1u);
 }
 
 // Rect::touches_run.

@@ -4,8 +4,9 @@
 // reference_shade.wgsl). Writes the `shaded` records (shaded.wgsl: RGB9E5
 // radiance, depth and hit flags, planar like the G-buffer), and lists the
 // workgroup's 64 pixels for lipp.filter if any has a sample (lipp::tiles).
-// With groom_rect, workgroups outside the groom's screen rectangle return
-// at once (lipp::rect).
+// A workgroup per run of 64 pixels from the groom's screen rectangle's first
+// to its last (lipp::rect, the dispatch lipp.lod_scan wrote); a run the
+// rectangle's rows pass by returns at once.
 
 #define FRAME_BINDING 1
 #define MODELS_BINDING 2
@@ -18,7 +19,7 @@
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
 #import strandgraph::lipp_shaded::{shaded_record, HIT, CONS_HIT}
-#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, touches_run}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, touches_run}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
@@ -43,15 +44,11 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
     return shade_point(shading_of(params), pos, sm.tangent, strand, sm.ao, params.model_index, delta);
 }
 
-// ShadeKernel::shaded_rect: the groom's screen rectangle (lipp::rect), or
-// the whole screen; workgroup 0 tells lipp.filter.
+// ShadeKernel::shaded_rect: the groom's screen rectangle (lipp::rect);
+// workgroup 0 tells lipp.filter.
 fn shaded_rect(wg: u32, lane: u32) -> vec4<u32> {
-    let room = arrayLength(&filter_args) > FILTER_RECT_HI && arrayLength(&raster_args) > ARGS_RECT_HI;
-    var r = vec4<u32>(0u, 0u, params.width, params.height);
-    if params.groom_rect != 0u && room {
-        r = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
-    }
-    if room && wg == 0u && lane == 0u {
+    let r = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
+    if arrayLength(&filter_args) > FILTER_RECT_HI && wg == 0u && lane == 0u {
         let a = rect_args(r);
         atomicStore(&filter_args[FILTER_RECT_LO], a.x);
         atomicStore(&filter_args[FILTER_RECT_HI], a.y);
@@ -65,18 +62,29 @@ fn shaded_rect(wg: u32, lane: u32) -> vec4<u32> {
 @compute @workgroup_size(128)
 fn shade(
     @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    // The same for the whole workgroup: it returns as one.
-    if !touches_run(shaded_rect(wg.x, lane), wg.x * SHADE_GROUP, SHADE_GROUP, params.width) {
-        return;
+    let rect = shaded_rect(wg.x, lane);
+    let runs = rect_runs(rect, params.width);
+    // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).
+    for (var k = wg.x; k < runs.y; k += max(groups.x, 1u)) {
+        let run = runs.x + k;
+        // The same for the whole workgroup: it skips the run as one.
+        if touches_run(rect, run * SHADE_GROUP, SHADE_GROUP, params.width) {
+            shade_run(run, lane);
+        }
     }
+}
+
+// ShadeKernel::shade_run: run `run`'s 64 pixels, two threads a pixel.
+fn shade_run(run: u32, lane: u32) {
     if lane == 0u {
         atomicStore(&tile_has_hair, 0u);
     }
     workgroupBarrier();
     let pixels = params.width * params.height;
-    let i = wg.x * SHADE_GROUP + lane % SHADE_GROUP;
+    let i = run * SHADE_GROUP + lane % SHADE_GROUP;
     if i < pixels {
         let x = i % params.width;
         let y = i / params.width;
@@ -100,7 +108,7 @@ fn shade(
     // tiles::list.
     if lane == 0u && (atomicLoad(&tile_has_hair) != 0u || params.hair_tiles == 0u) {
         let k = atomicAdd(&filter_args[3], 1u);
-        filter_tiles[k] = wg.x;
+        filter_tiles[k] = run;
         atomicMax(&filter_args[0], min(k + 1u, MAX_GROUPS_X));
         if k == 0u {
             atomicStore(&filter_args[1], 1u);

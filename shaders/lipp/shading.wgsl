@@ -51,8 +51,7 @@ struct ShadeParams {
     slots: u32,
     // lipp.shade: list only the tiles with hair (lipp::tiles).
     hair_tiles: u32,
-    // lipp.shade: only the groom's screen rectangle (lipp::rect).
-    groom_rect: u32,
+    reserved: u32,
 }
 
 // shade::ShadeParams as the shading reads it (booleans as 0/1).

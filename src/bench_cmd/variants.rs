@@ -303,8 +303,8 @@ pub const VARIANTS: &[Variant] = &[
         ceiling: "atomic_min64",
     },
     // lipp.filter over every tile lipp.shade ran rather than the tiles with
-    // hair it lists (passes/src/lipp/tiles.rs); with its groom_rect, the
-    // tiles in the groom's screen rectangle.
+    // hair it lists (passes/src/lipp/tiles.rs): the tiles in the groom's
+    // screen rectangle.
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+F+L, filter over every tile",
@@ -323,13 +323,14 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // lipp.shade over every pixel, as the paper's deferred shading, rather
-    // than the groom's screen rectangle (passes/src/lipp/rect.rs).
+    // lipp.shade over every pixel, as the paper's deferred shading, and
+    // lipp.clear_gbuffer over the whole G-buffer, rather than the groom's
+    // screen rectangle (passes/src/lipp/rect.rs).
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+F+L, shading every pixel",
         graph: LIPP,
-        overrides: &["shade.groom_rect=false"],
+        overrides: &["lod_scan.groom_rect=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

@@ -10,6 +10,7 @@ pub mod assemble;
 pub mod chiang;
 #[cfg(test)]
 mod chiang_reference;
+pub mod clear;
 pub mod dom;
 pub mod filter;
 pub mod lod;

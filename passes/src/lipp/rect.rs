@@ -13,8 +13,20 @@
 //!   overwrites with the bundle's first strand ([`Rect::pack_tiles`]).
 //! - `lipp.lod_scan` unites the drawn bundles' rectangles into `raster_args`
 //!   words [`ARGS_RECT_LO`] and [`ARGS_RECT_HI`] ([`Rect::args`]).
-//! - `lipp.shade` (`groom_rect`) skips every workgroup of pixels outside
-//!   it, and tells `lipp.filter` which pixels it shaded (`filter_args`
+//!   With its `groom_rect` off the rectangle is the whole screen (the bench
+//!   row "shading every pixel").
+//! - The scan also writes the indirect dispatch (`raster_args` words
+//!   [`ARGS_RUNS`]..) of the passes that work in runs of [`TILE`] pixels,
+//!   one workgroup per run from the one holding the rectangle's first
+//!   pixel to the one holding its last ([`Rect::runs`]): `lipp.shade`,
+//!   which returns at once in a run the rectangle's rows pass by, and
+//!   `lipp.clear_gbuffer`. A full-screen dispatch whose workgroups return
+//!   still cost the H100 launching them: 36 µs of shading for the far
+//!   view's groom, about 60 µs for each of the crowd's.
+//! - `lipp.clear_gbuffer` clears those runs only: every pixel `lipp.shade`
+//!   reads. Elsewhere the G-buffer keeps what an earlier groom, or another
+//!   resource aliased to it, left there, which nothing reads.
+//! - `lipp.shade` tells `lipp.filter` which pixels it shaded (`filter_args`
 //!   words [`FILTER_RECT_LO`], [`FILTER_RECT_HI`]): the filter's taps
 //!   outside them read no hair, where the `shaded` records are not this
 //!   frame's.
@@ -37,7 +49,8 @@
 //! rasterizer wrote lies inside, on the built-in scenes.
 
 use super::strand::bilinear;
-use super::{BundleRecord, Corner, length, sub, transform};
+use super::tiles::TILE;
+use super::{BundleRecord, Corner, MAX_GROUPS_X, length, sub, transform};
 use crate::kernel::Words;
 use crate::kulikov::clip_to_screen;
 use crate::layout::FrameData;
@@ -46,6 +59,10 @@ use crate::layout::FrameData;
 /// pixel and of the pixel past its last (exclusive).
 pub const ARGS_RECT_LO: usize = 6;
 pub const ARGS_RECT_HI: usize = 7;
+/// `raster_args` words 8..=10: the workgroups (x, 1, 1) of one per run of
+/// [`TILE`] pixels [`Rect::runs`] covers, at most [`MAX_GROUPS_X`] (the
+/// kernels stride past it).
+pub const ARGS_RUNS: usize = 8;
 /// `filter_args` words: the pixels `lipp.shade` wrote records for, the same
 /// packing; a `filter_args` with no room for them shades the whole screen.
 pub const FILTER_RECT_LO: usize = 4;
@@ -123,6 +140,24 @@ impl Rect {
             return false;
         }
         ya != yb || (last % w >= self.x0 && first % w < self.x1)
+    }
+
+    /// The row-major runs of [`TILE`] pixels from the one holding the
+    /// rectangle's first pixel to the one holding its last, on a `w`-wide
+    /// screen: (first run, count). Every pixel of the rectangle lies in one.
+    pub fn runs(&self, w: u32) -> (u32, u32) {
+        if self.is_empty() {
+            return (0, 0);
+        }
+        let first = (self.y0 * w + self.x0) / TILE;
+        let last = ((self.y1 - 1) * w + self.x1 - 1) / TILE;
+        (first, last - first + 1)
+    }
+
+    /// `raster_args` words [`ARGS_RUNS`]..: a workgroup per run of
+    /// [`Rect::runs`], at most [`MAX_GROUPS_X`].
+    pub fn run_dispatch(&self, w: u32) -> [u32; 3] {
+        [self.runs(w).1.min(MAX_GROUPS_X), 1, 1]
     }
 
     /// The rectangle in tiles of [`granularity`] pixels, a byte per edge

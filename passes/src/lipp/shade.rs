@@ -3,8 +3,11 @@
 //! RGB9E5 radiance, depth and hit flags). Only the centre layer's record is
 //! written where no sample is (the filter's taps read its flags); the tiles
 //! with a sample are listed for `lipp.filter` ([`super::tiles`],
-//! `hair_tiles`). With `groom_rect` (ours), only the workgroups of pixels
-//! in the groom's screen rectangle shade ([`super::rect`]).
+//! `hair_tiles`). The pass runs over the groom's screen rectangle (ours,
+//! [`super::rect`]): a workgroup per run of 64 pixels the rectangle
+//! touches, through the indirect dispatch `lipp.lod_scan` writes (the
+//! scan's `groom_rect` off: the whole screen, as the paper's deferred
+//! shading does).
 //!
 //! The WGSL gives each pixel two threads, one per G-buffer layer: a far
 //! groom covers a few tiles, too few threads to hide the latency of a
@@ -48,7 +51,7 @@ pub use super::chiang::{Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
-use super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, FILTER_RECT_HI, FILTER_RECT_LO, Rect};
+use super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, FILTER_RECT_HI, FILTER_RECT_LO, Rect};
 use super::shaded::{CONS_HIT, HIT, record};
 use super::tiles;
 use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
@@ -58,7 +61,6 @@ use crate::kernel::{Ctx, Words};
 use crate::layout::{FrameData, LightData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
 use strandgraph_graph::Quantities;
-use strandgraph_graph::schema::Quantity;
 
 pub const SHADE_GROUP: u32 = tiles::TILE;
 const PI: f32 = std::f32::consts::PI;
@@ -93,9 +95,6 @@ pub struct ShadeParams {
     /// Ours: list only the tiles with hair for `lipp.filter` ([`super::tiles`]);
     /// off, every tile.
     pub hair_tiles: bool,
-    /// Ours: shade only the groom's screen rectangle ([`super::rect`]);
-    /// off, every pixel, as the paper's deferred shading does.
-    pub groom_rect: bool,
 }
 
 impl Default for ShadeParams {
@@ -113,7 +112,6 @@ impl Default for ShadeParams {
             dom_layer_thickness: 0.02,
             model_index: 0,
             hair_tiles: true,
-            groom_rect: true,
         }
     }
 }
@@ -153,8 +151,7 @@ crate::gpu_block! {
         slots: u32,
         /// `lipp.shade` only: list only the tiles with hair.
         hair_tiles: u32,
-        /// `lipp.shade` only: only the groom's screen rectangle.
-        groom_rect: u32,
+        reserved: u32,
     }
 }
 
@@ -176,7 +173,7 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         probe_specular: flag(p.probe_specular),
         slots,
         hair_tiles: flag(p.hair_tiles),
-        groom_rect: flag(p.groom_rect),
+        reserved: 0,
     }
 }
 
@@ -200,9 +197,10 @@ pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
     ]),
     // Threads: two a pixel, one per layer (shaders/lipp/shade.wgsl).
     workgroup_size: 2 * SHADE_GROUP,
-    dispatch: Dispatch::PerElement {
-        quantity: Quantity::Pixels,
-        per_group: SHADE_GROUP,
+    // A workgroup per run of the groom's rectangle (rect::Rect::runs).
+    dispatch: Dispatch::Indirect {
+        binding: "raster_args",
+        word: ARGS_RUNS,
     },
     shader: Shader::compute("lipp/shade.wgsl", "shade"),
     kernel: |p| Box::new(ShadeKernel(*p)),
@@ -421,18 +419,14 @@ struct ShadeKernel(ShadeParams);
 
 impl ShadeKernel {
     /// The pixels this pass shades ([`super::rect`]): the groom's screen
-    /// rectangle with `groom_rect` on and room in `filter_args` to tell
-    /// `lipp.filter`, else the whole screen. Workgroup 0 tells the filter.
+    /// rectangle, which `lipp.lod_scan` wrote with the dispatch over its
+    /// runs. Workgroup 0 tells `lipp.filter`, if `filter_args` has room
+    /// (`filter_args` needs 24 bytes: the filter reads a smaller one as
+    /// the whole screen shaded).
     fn shaded_rect(&self, ctx: &Ctx<'_>, group: u32) -> Rect {
-        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let (args, filter_args) = (ctx.words("raster_args"), ctx.words("filter_args"));
-        let room = filter_args.len() > FILTER_RECT_HI && args.len() > ARGS_RECT_HI;
-        let r = if self.0.groom_rect && room {
-            Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI))
-        } else {
-            Rect::full(w, h)
-        };
-        if room && group == 0 {
+        let r = Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI));
+        if filter_args.len() > FILTER_RECT_HI && group == 0 {
             let [lo, hi] = r.args();
             filter_args.store(FILTER_RECT_LO, lo);
             filter_args.store(FILTER_RECT_HI, hi);
@@ -452,8 +446,7 @@ pub fn load_sh(w: &Words<'_>) -> [[f32; 3]; 9] {
 impl CpuKernel for ShadeKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let f = frame(ctx);
-        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
-        let pixels = w * h;
+        let w = ctx.quantities.width;
         let model: ModelData = read(&ctx.words("models"), self.0.model_index as usize);
         let lw = ctx.words("lights");
         let lights: Vec<LightData> = (0..f.light_count as usize).map(|i| read(&lw, i)).collect();
@@ -463,11 +456,24 @@ impl CpuKernel for ShadeKernel {
         } else {
             0.0
         };
-        let shaded_rect = self.shaded_rect(ctx, group);
-        if !shaded_rect.touches_run(group * SHADE_GROUP, SHADE_GROUP, w) {
-            return;
-        }
+        let rect = self.shaded_rect(ctx, group);
+        let (first, runs) = rect.runs(w);
         let inp = Inputs::load(ctx, &f, &model, &lights, &self.0, delta);
+        // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).
+        for k in (group..runs).step_by(ctx.workgroups.max(1) as usize) {
+            let run = first + k;
+            if rect.touches_run(run * SHADE_GROUP, SHADE_GROUP, w) {
+                self.shade_run(ctx, &inp, run);
+            }
+        }
+    }
+}
+
+impl ShadeKernel {
+    /// Run `run`'s 64 pixels (a workgroup of the WGSL).
+    fn shade_run(&self, ctx: &Ctx<'_>, inp: &Inputs<'_>, run: u32) {
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let pixels = w * h;
         let (g, out) = (ctx.words("gbuffer"), ctx.words("shaded"));
         let layers = super::gbuffer_layers(&g, &out, pixels);
         let mut hair = false;
@@ -479,7 +485,7 @@ impl CpuKernel for ShadeKernel {
             out.store(2 * slot as usize, r[0]);
             out.store(2 * slot as usize + 1, r[1]);
         };
-        for i in group * SHADE_GROUP..((group + 1) * SHADE_GROUP).min(pixels) {
+        for i in run * SHADE_GROUP..((run + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
             let cons = if payload(1, i) != EMPTY { CONS_HIT } else { 0 };
             for layer in 0..layers {
@@ -493,12 +499,12 @@ impl CpuKernel for ShadeKernel {
                     continue;
                 }
                 hair = true;
-                let c = shade_sample(&inp, &unpack(p), x, y);
+                let c = shade_sample(inp, &unpack(p), x, y);
                 store(layer * pixels + i, record(c, (p >> 32) as u32, HIT | cons));
             }
         }
         if hair || !self.0.hair_tiles {
-            tiles::list(&ctx.words("filter_args"), &ctx.words("filter_tiles"), group);
+            tiles::list(&ctx.words("filter_args"), &ctx.words("filter_tiles"), run);
         }
     }
 }

@@ -7,7 +7,9 @@
 //! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
 //! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
 //! drawn, Σ N, Σ N_LOD, and the drawn bundles' screen rectangle,
-//! [`super::super::rect`]). A frustum-culled bundle draws nothing (its
+//! [`super::super::rect`], and the dispatch over its runs of pixels). With
+//! `groom_rect` off (ours, on by default) the rectangle is the whole screen.
+//! A frustum-culled bundle draws nothing (its
 //! `bundle_lod` count is 0) but its N_LOD counts in β = Σ N_LOD / Σ N of
 //! Eq. 8, over the bundles the decision was for (not another groom's): β is
 //! the fraction of strands the LOD removed, which culling must not change.
@@ -15,18 +17,35 @@
 //! scans their sums in workgroup memory (shaders/lipp/lod_scan.wgsl); the
 //! CPU kernel computes the same values sequentially.
 
-use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
+use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, Rect};
 use super::super::{
     ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED,
     LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
 };
-use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
-use crate::params::NoParams;
+use crate::params::PassParams;
 
 /// Threads of the single scan workgroup (WGSL).
 pub const SCAN_GROUP: u32 = 256;
+
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ScanParams {
+    /// Ours: the drawn bundles' screen rectangle ([`super::super::rect`]);
+    /// off, the whole screen, so `lipp.shade` and `lipp.clear_gbuffer`
+    /// cover every pixel.
+    pub groom_rect: bool,
+}
+
+impl Default for ScanParams {
+    fn default() -> Self {
+        Self { groom_rect: true }
+    }
+}
+
+impl PassParams for ScanParams {}
 
 crate::gpu_block! {
     /// `ScanParams` in shaders/lipp/lod_scan.wgsl.
@@ -36,11 +55,11 @@ crate::gpu_block! {
         /// Scene quantities: the screen.
         width: u32,
         height: u32,
-        _pad0: u32,
+        groom_rect: u32,
     }
 }
 
-pub static LOD_SCAN: PassKind<NoParams, ScanGpu> = PassKind {
+pub static LOD_SCAN: PassKind<ScanParams, ScanGpu> = PassKind {
     kind: "lipp.lod_scan",
     summary: "prefix sum of the LOD's strand counts into first strands; the rasterizer's indirect dispatch and β of Eq. 8",
     source: "Lipp §3.2",
@@ -53,17 +72,17 @@ pub static LOD_SCAN: PassKind<NoParams, ScanGpu> = PassKind {
     workgroup_size: SCAN_GROUP,
     dispatch: Dispatch::Fixed(1),
     shader: Shader::compute("lipp/lod_scan.wgsl", "scan"),
-    kernel: |_| Box::new(ScanKernel),
-    gpu: |_, q| ScanGpu {
+    kernel: |p| Box::new(ScanKernel(*p)),
+    gpu: |p, q| ScanGpu {
         bundles: count(q.bundles),
         width: q.width,
         height: q.height,
-        ..ScanGpu::default()
+        groom_rect: flag(p.groom_rect),
     },
     raster: None,
 };
 
-struct ScanKernel;
+struct ScanKernel(ScanParams);
 
 impl CpuKernel for ScanKernel {
     fn run_workgroup(&self, _group: u32, ctx: &Ctx<'_>) {
@@ -103,11 +122,20 @@ impl CpuKernel for ScanKernel {
         // β of Lipp Eq. 8 is word 5 / word 4.
         args.store(ARGS_ALL, full);
         args.store(ARGS_KEPT, kept);
-        // The screen rectangle of the bundles drawn (rect.rs), if there is room.
+        // The screen rectangle of the bundles drawn (rect.rs) and the
+        // dispatch over its runs, if there is room.
+        if !self.0.groom_rect {
+            groom = Rect::full(w, h);
+        }
         if args.len() > ARGS_RECT_HI {
             let [lo, hi] = groom.args();
             args.store(ARGS_RECT_LO, lo);
             args.store(ARGS_RECT_HI, hi);
+        }
+        if args.len() > ARGS_RUNS + 2 {
+            for (i, n) in groom.run_dispatch(w).into_iter().enumerate() {
+                args.store(ARGS_RUNS + i, n);
+            }
         }
     }
 }
@@ -151,8 +179,8 @@ mod tests {
         h.buffer("hairmesh.bundles", bundles)
             .buffer("lod_choices", choices)
             .buffer("bundle_lod", vec![0; 4 * counts.len()])
-            .buffer("raster_args", vec![0; 8]);
-        h.run(&ScanKernel, 1, SCAN_GROUP);
+            .buffer("raster_args", vec![0; 11]);
+        h.run(&ScanKernel(ScanParams::default()), 1, SCAN_GROUP);
         let lod = h.read("bundle_lod");
         let firsts: Vec<u32> = lod.chunks(4).map(|w| w[2]).collect();
         assert_eq!(firsts, [0, 10, 10, 10, 15]);
@@ -172,5 +200,17 @@ mod tests {
                 y1: 72
             }
         );
+        // Runs of 64 pixels from (8, 24) to (47, 71) on a 640-wide screen:
+        // 24 * 10 + 0 to 71 * 10 + 0.
+        assert_eq!(&args[ARGS_RUNS..], &[471, 1, 1]);
+        // Off, the whole screen: 640 * 480 / 64 runs.
+        h.buffer("raster_args", vec![0; 11]);
+        h.run(&ScanKernel(ScanParams { groom_rect: false }), 1, SCAN_GROUP);
+        let args = h.read("raster_args");
+        assert_eq!(
+            Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]),
+            Rect::full(640, 480)
+        );
+        assert_eq!(&args[ARGS_RUNS..], &[4800, 1, 1]);
     }
 }
