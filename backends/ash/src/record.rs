@@ -123,13 +123,10 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
         lanes[l].passes.push(p);
         lane_of[p] = l;
     }
-    let points = cross_points(plan, &lanes, &lane_of);
+    let when = expected(plan, &lane_of, lanes.len());
+    let points = cross_points(plan, &lanes, &lane_of, &when);
     for (l, lane) in lanes.iter_mut().enumerate() {
-        let order: Vec<usize> = lane
-            .passes
-            .iter()
-            .map(|&p| plan.position(p).unwrap_or(usize::MAX))
-            .collect();
+        let order: Vec<When> = lane.passes.iter().map(|&p| when[p]).collect();
         lane.batches = batches(l, &order, &points);
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(lane.pool.raw())
@@ -145,6 +142,45 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
     Ok(Lanes { lanes, lane_of })
 }
 
+/// When a pass is expected to run: its position in the plan's order, and
+/// its step in a schedule where every pass takes one step and the queues run
+/// side by side, a wait starting no earlier than the step after its signal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct When {
+    order: usize,
+    step: usize,
+}
+
+impl When {
+    /// Whether a pass expected at `self` is done before one at `first` starts.
+    fn before(self, first: When) -> bool {
+        self.order < first.order && self.step < first.step
+    }
+}
+
+/// [`When`] of every pass (indexed by pass id), `lane_of` giving its lane.
+fn expected(plan: &Plan, lane_of: &[usize], lanes: usize) -> Vec<When> {
+    let mut when = vec![
+        When {
+            order: usize::MAX,
+            step: usize::MAX
+        };
+        lane_of.len()
+    ];
+    let mut next = vec![0usize; lanes];
+    for (order, &p) in plan.order.iter().enumerate() {
+        let l = lane_of[p];
+        let waits = plan
+            .sync_points
+            .iter()
+            .filter(|s| s.before == p && lane_of[s.after] != l);
+        let step = waits.fold(next[l], |t, s| t.max(when[s.after].step.saturating_add(1)));
+        when[p] = When { order, step };
+        next[l] = step + 1;
+    }
+    when
+}
+
 /// A cross-queue sync point of the plan in backend lanes.
 #[derive(Debug, Clone, Copy)]
 struct Point {
@@ -152,11 +188,11 @@ struct Point {
     signal: (usize, usize),
     /// Waiting lane and the position of the pass that waits.
     wait: (usize, usize),
-    /// The signalling pass's position in the plan's order.
-    signal_order: usize,
+    /// When the signalling pass is expected to run.
+    signal_when: When,
 }
 
-fn cross_points(plan: &Plan, lanes: &[Lane], lane_of: &[usize]) -> Vec<Point> {
+fn cross_points(plan: &Plan, lanes: &[Lane], lane_of: &[usize], when: &[When]) -> Vec<Point> {
     plan.sync_points
         .iter()
         .filter(|s| lane_of[s.after] != lane_of[s.before])
@@ -165,28 +201,32 @@ fn cross_points(plan: &Plan, lanes: &[Lane], lane_of: &[usize]) -> Vec<Point> {
             Point {
                 signal: (la, lanes[la].position(s.after).unwrap_or(0)),
                 wait: (lb, lanes[lb].position(s.before).unwrap_or(0)),
-                signal_order: plan.position(s.after).unwrap_or(usize::MAX),
+                signal_when: when[s.after],
             }
         })
         .collect()
 }
 
-/// Lane `l`'s passes (`order[k]`: the plan position of its `k`th) cut into
+/// Lane `l`'s passes (`order[k]`: when its `k`th is expected) cut into
 /// batches: a batch ends after a pass another lane waits for, and before a
 /// pass that waits, unless that wait can move up to the batch's start:
 /// Vulkan waits at submission boundaries only, and each boundary costs the
 /// queue time (10-20 us on the H100). A wait moves up when its signalling
-/// pass comes before the batch's first pass in the plan's order, which
-/// expects it done by then (Kulikov: the skin shadows' wait for the head's
-/// depth joins the batch after skinning). Waiting earlier is always safe.
-fn batches(l: usize, order: &[usize], points: &[Point]) -> Vec<Batch> {
+/// pass is expected done before the batch's first pass ([`When::before`]):
+/// it comes earlier in the plan's order, and at an earlier step (Kulikov:
+/// the skin shadows' wait for the head's depth joins the batch after
+/// skinning). The steps keep a long chain on the other queue that the plan
+/// merely lists first (Lipp's deep opacity maps, declared before the
+/// per-groom passes) from holding up the passes that do not need it.
+/// Waiting earlier is always safe.
+fn batches(l: usize, order: &[When], points: &[Point]) -> Vec<Batch> {
     let n = order.len();
     let waits_at = |i: usize| points.iter().filter(move |pt| pt.wait == (l, i));
     let mut out = Vec::new();
     let mut start = 0;
     for i in 0..n {
         let signals = points.iter().any(|pt| pt.signal == (l, i));
-        let next_waits_late = waits_at(i + 1).any(|pt| pt.signal_order > order[start]);
+        let next_waits_late = waits_at(i + 1).any(|pt| !pt.signal_when.before(order[start]));
         if signals || next_waits_late || i + 1 == n {
             let mut waits: Vec<(usize, u64)> = Vec::new();
             for pt in (start..=i).flat_map(waits_at) {
@@ -556,20 +596,24 @@ unsafe fn record_raster(
 
 #[cfg(test)]
 mod tests {
-    use super::{Point, batches};
+    use super::{Point, When, batches};
 
-    fn point(signal: (usize, usize), wait: (usize, usize), signal_order: usize) -> Point {
+    fn at(order: usize, step: usize) -> When {
+        When { order, step }
+    }
+
+    fn point(signal: (usize, usize), wait: (usize, usize), signal_when: When) -> Point {
         Point {
             signal,
             wait,
-            signal_order,
+            signal_when,
         }
     }
 
     /// A batch as (first, last, waits).
     type Range = (usize, usize, Vec<(usize, u64)>);
 
-    fn ranges(l: usize, order: &[usize], points: &[Point]) -> Vec<Range> {
+    fn ranges(l: usize, order: &[When], points: &[Point]) -> Vec<Range> {
         batches(l, order, points)
             .into_iter()
             .map(|b| (b.first, b.last, b.waits))
@@ -577,24 +621,32 @@ mod tests {
     }
 
     #[test]
-    fn a_wait_cuts_the_lane_unless_its_signal_comes_first_in_plan_order() {
-        // Lane 1 at plan positions 0, 1, 6, 7, 8, 9; it signals after its
-        // position 1, and its position 4 waits for lane 0's position 2.
-        let order = [0, 1, 6, 7, 8, 9];
-        let signal = point((1, 1), (0, 3), 1);
-        // Lane 0's pass at plan position 5 comes before the batch's first
-        // (6): the wait joins the batch that starts after the signal.
-        let early = [signal, point((0, 2), (1, 4), 5)];
+    fn a_wait_cuts_the_lane_unless_its_signal_is_expected_done_first() {
+        // Lane 1 at plan positions 0, 1, 6, 7, 8, 9 and steps 0 to 5; it
+        // signals after its position 1, and its position 4 waits for lane
+        // 0's position 2.
+        let order: Vec<When> = [0, 1, 6, 7, 8, 9]
+            .iter()
+            .enumerate()
+            .map(|(k, &o)| at(o, k))
+            .collect();
+        let signal = point((1, 1), (0, 3), at(1, 1));
+        // Lane 0's pass at plan position 5, step 1, comes before the batch's
+        // first (6, step 2): the wait joins the batch that starts after the
+        // signal.
+        let early = [signal, point((0, 2), (1, 4), at(5, 1))];
         assert_eq!(
             ranges(1, &order, &early),
             vec![(0, 1, vec![]), (2, 5, vec![(0, 3)])]
         );
         // At plan position 7 it may not be done when the batch starts: the
         // lane is cut before the waiting pass.
-        let late = [signal, point((0, 2), (1, 4), 7)];
-        assert_eq!(
-            ranges(1, &order, &late),
-            vec![(0, 1, vec![]), (2, 3, vec![]), (4, 5, vec![(0, 3)])]
-        );
+        let late = [signal, point((0, 2), (1, 4), at(7, 1))];
+        let cut = vec![(0, 1, vec![]), (2, 3, vec![]), (4, 5, vec![(0, 3)])];
+        assert_eq!(ranges(1, &order, &late), cut);
+        // Listed first but at the end of a longer chain (step 2, as the
+        // batch's first): cut as well.
+        let long = [signal, point((0, 2), (1, 4), at(5, 2))];
+        assert_eq!(ranges(1, &order, &long), cut);
     }
 }
