@@ -55,14 +55,58 @@ fn dom_amount(st: Strand) -> u32 {
     return u32(floor(dom_params.strand_opacity * thinning * OPACITY_SCALE + 0.5));
 }
 
-fn dom_segment_depth(a: ControlPoint, b: ControlPoint, l: u32, lf: LightFrame) {
+// Ours: a strand of at most MAX_SHARED segments, one a lane and the rest
+// of the 32 lanes idle, deals each segment's columns out to several lanes.
+// A far view's camera-bound shadow LOD keeps few control points, whose
+// segments cross tens of texels of the map, and a lane walking each alone
+// set the passes' time. The same texels are written, and their atomics
+// commute, so the maps are the same; the CPU kernel walks each segment
+// whole.
+const MAX_SHARED: u32 = 16u;
+var<workgroup> shared_a: array<vec3<f32>, RASTER_GROUP>;
+var<workgroup> shared_b: array<vec3<f32>, RASTER_GROUP>;
+
+// A lane's part of the walk: the segment from a to b, its columns from the
+// `first`th on, every `step`th.
+struct Share {
+    a: vec3<f32>,
+    b: vec3<f32>,
+    first: u32,
+    step: u32,
+}
+
+// Whether strand `st` deals its segments out: one a lane (C <= 33), at
+// most MAX_SHARED. The same for the whole workgroup.
+fn shares(st: Strand) -> bool {
+    return st.c >= 2u && st.c - 1u <= MAX_SHARED && (st.c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP == 1u;
+}
+
+// With `shares`: lane j walks segment j % S, columns j / S, j / S + k, ...
+// for k = 32 / S (S the segments); a lane past S * k walks nothing (step
+// 0). Every lane calls it: it has a barrier.
+fn share_segments(st: Strand, strip: Strip, lane: u32) -> Share {
+    let share = shares(st);
+    if share && lane + 1u < st.c {
+        shared_a[lane] = strip_point(strip, 0u).pos;
+        shared_b[lane] = strip_point(strip, 1u).pos;
+    }
+    workgroupBarrier();
+    let segs = max(st.c, 2u) - 1u;
+    let k = RASTER_GROUP / segs;
+    if !share || lane >= segs * k {
+        return Share(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
+    }
+    return Share(shared_a[lane % segs], shared_b[lane % segs], lane / segs, k);
+}
+
+fn dom_segment_depth(a: vec3<f32>, b: vec3<f32>, l: u32, lf: LightFrame, first: u32, step: u32) {
     let res = dom_params.resolution;
     {
-        let pa = dom_end(lf, a.pos, res);
-        let pb = dom_end(lf, b.pos, res);
+        let pa = dom_end(lf, a, res);
+        let pb = dom_end(lf, b, res);
         let cols = walk_columns(pa, pb, res);
         let x_major = cols.z != 0.0;
-        for (var col = cols.x; col <= cols.y; col += 1.0) {
+        for (var col = cols.x + f32(first); col <= cols.y; col += f32(step)) {
             let span = walk_column(pa, pb, x_major, col);
             let z = span.z;
             if !(z >= 0.0 && z <= 1.0) {
@@ -81,14 +125,14 @@ fn dom_segment_depth(a: ControlPoint, b: ControlPoint, l: u32, lf: LightFrame) {
     }
 }
 
-fn dom_segment_opacity(a: ControlPoint, b: ControlPoint, amount: u32, l: u32, lf: LightFrame) {
+fn dom_segment_opacity(a: vec3<f32>, b: vec3<f32>, amount: u32, l: u32, lf: LightFrame, first: u32, step: u32) {
     let res = dom_params.resolution;
     {
-        let pa = dom_end(lf, a.pos, res);
-        let pb = dom_end(lf, b.pos, res);
+        let pa = dom_end(lf, a, res);
+        let pb = dom_end(lf, b, res);
         let cols = walk_columns(pa, pb, res);
         let x_major = cols.z != 0.0;
-        for (var col = cols.x; col <= cols.y; col += 1.0) {
+        for (var col = cols.x + f32(first); col <= cols.y; col += f32(step)) {
             let span = walk_column(pa, pb, x_major, col);
             let z = span.z;
             if !(z >= 0.0 && z <= 1.0) {
@@ -128,11 +172,18 @@ fn dom_depth_pass(
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
+        let share = share_segments(st, strip, lane);
         // Each light's view once per strand, the strip's segments in it.
         for (var li = 0u; li < lights_n; li++) {
             let lf = light_frame(li);
+            if shares(st) {
+                if share.step > 0u {
+                    dom_segment_depth(share.a, share.b, li, lf, share.first, share.step);
+                }
+                continue;
+            }
             for (var m = 0u; m < strip_segments(strip); m++) {
-                dom_segment_depth(strip_point(strip, m), strip_point(strip, m + 1u), li, lf);
+                dom_segment_depth(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, li, lf, 0u, 1u);
             }
         }
         workgroupBarrier();
@@ -157,11 +208,18 @@ fn dom_opacity_pass(
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
+        let share = share_segments(st, strip, lane);
         let amount = dom_amount(st);
         for (var li = 0u; li < lights_n; li++) {
             let lf = light_frame(li);
+            if shares(st) {
+                if share.step > 0u {
+                    dom_segment_opacity(share.a, share.b, amount, li, lf, share.first, share.step);
+                }
+                continue;
+            }
             for (var m = 0u; m < strip_segments(strip); m++) {
-                dom_segment_opacity(strip_point(strip, m), strip_point(strip, m + 1u), amount, li, lf);
+                dom_segment_opacity(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, amount, li, lf, 0u, 1u);
             }
         }
         workgroupBarrier();

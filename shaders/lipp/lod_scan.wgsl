@@ -15,6 +15,38 @@ struct ScanParams {
     height: u32,
     // Ours: off, the rectangle is the whole screen (scan.rs).
     groom_rect: u32,
+    // The groom scanned (the per-model block), or ALL_MODELS.
+    model: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// lod::ALL_MODELS.
+const ALL_MODELS: u32 = 0xFFFFFFFFu;
+
+// The first of the first `count` bundles whose groom is at least `m`
+// (upload.rs packs grooms' bundles together, in model order).
+fn first_of_groom(count: u32, m: u32) -> u32 {
+    var lo = 0u;
+    var hi = count;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if hairmesh_bundles[mid * BUNDLE_WORDS + 3u] < m {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// lipp::groom_bundles: [first, end) of this groom's bundles.
+fn groom_bundles(count: u32) -> vec2<u32> {
+    if params.model == ALL_MODELS {
+        return vec2<u32>(0u, count);
+    }
+    return vec2<u32>(first_of_groom(count, params.model), first_of_groom(count, params.model + 1u));
 }
 
 @group(0) @binding(0) var<uniform> params: ScanParams;
@@ -40,9 +72,11 @@ fn drawn(b: u32) -> u32 {
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) lane: u32) {
     let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), min(arrayLength(&lod_choices), arrayLength(&bundle_lod)) / LOD_WORDS);
-    let per = (count + SCAN_GROUP - 1u) / SCAN_GROUP;
-    let begin = min(lane * per, count);
-    let end = min(begin + per, count);
+    // Each lane owns a run of this groom's bundles.
+    let range = groom_bundles(count);
+    let per = (range.y - range.x + SCAN_GROUP - 1u) / SCAN_GROUP;
+    let begin = min(range.x + lane * per, range.y);
+    let end = min(begin + per, range.y);
     if lane == 0u {
         atomicStore(&groom_rect[0], 0xFFFFFFFFu);
         atomicStore(&groom_rect[1], 0xFFFFFFFFu);
@@ -103,8 +137,21 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         bundle_lod[o + 3u] = lod_choices[o + 3u];
         first += n;
     }
+    // Every other groom's bundle: no strands, its first strand where the
+    // running sum is (the rasterizer's search skips it).
+    let total = sums[SCAN_GROUP - 1u];
+    let per_all = (count + SCAN_GROUP - 1u) / SCAN_GROUP;
+    for (var b = lane * per_all; b < min(lane * per_all + per_all, count); b++) {
+        if b >= range.x && b < range.y {
+            continue;
+        }
+        let o = b * LOD_WORDS;
+        bundle_lod[o] = 0u;
+        bundle_lod[o + 1u] = 0u;
+        bundle_lod[o + 2u] = select(total, 0u, b < range.x);
+        bundle_lod[o + 3u] = LOD_OTHER_GROOM;
+    }
     if lane == SCAN_GROUP - 1u {
-        let total = sums[SCAN_GROUP - 1u];
         raster_args[0] = min(total, MAX_GROUPS_X);
         raster_args[1] = 1u;
         raster_args[2] = 1u;

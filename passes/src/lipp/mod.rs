@@ -211,6 +211,31 @@ pub fn gbuffer_layers(gbuffer: &Words<'_>, shaded: &Words<'_>, pixels: u32) -> u
     (gbuffer.len().min(shaded.len()) / (2 * p)).max(2) as u32
 }
 
+/// The bundles of groom `model` among the first `count` (all of them for
+/// `None`): upload.rs packs each groom's bundles together, grooms in model
+/// order, so a binary search over the records' model word finds them.
+pub fn groom_bundles(
+    bundles: &Words<'_>,
+    count: usize,
+    model: Option<u32>,
+) -> std::ops::Range<usize> {
+    let Some(m) = model else { return 0..count };
+    let model_of = |b: usize| BundleRecord::load(bundles, b).model;
+    let first = |below: &dyn Fn(u32) -> bool| {
+        let (mut lo, mut hi) = (0usize, count);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if below(model_of(mid)) {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    first(&|x| x < m)..first(&|x| x <= m)
+}
+
 /// Number of bundles actually packed (the buffer may be larger).
 pub fn bundle_count(ctx: &Ctx<'_>) -> usize {
     ctx.quantities.bundles as usize

@@ -62,7 +62,7 @@ pub const LOD_GROUP: u32 = 64;
 pub const LOD_BUNDLES: u32 = 4;
 
 /// `LodParams.model` in WGSL when the pass decides for every groom.
-const ALL_MODELS: u32 = u32::MAX;
+pub(crate) const ALL_MODELS: u32 = u32::MAX;
 
 crate::string_enum! {
     /// Whose view Eq. 2-5 measure a bundle in.

@@ -20,8 +20,9 @@
 use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, Rect};
 use super::super::{
     ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED,
-    LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
+    LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count, groom_bundles,
 };
+use super::ALL_MODELS;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
@@ -37,15 +38,26 @@ pub struct ScanParams {
     /// off, the whole screen, so `lipp.shade` and `lipp.clear_gbuffer`
     /// cover every pixel.
     pub groom_rect: bool,
+    /// Only this groom's bundles (the per-model block sets `model_index`);
+    /// `None`: all. The scan walks that groom's bundles only (ours: the
+    /// crowd's 28 grooms each scanned all 28,000 bundles), and gives every
+    /// other bundle no strands.
+    #[serde(rename = "model_index", deserialize_with = "crate::params::some")]
+    pub model: Option<u32>,
 }
 
 impl Default for ScanParams {
     fn default() -> Self {
-        Self { groom_rect: true }
+        Self {
+            groom_rect: true,
+            model: None,
+        }
     }
 }
 
-impl PassParams for ScanParams {}
+impl PassParams for ScanParams {
+    const READS_MODEL_INDEX: bool = true;
+}
 
 crate::gpu_block! {
     /// `ScanParams` in shaders/lipp/lod_scan.wgsl.
@@ -56,6 +68,11 @@ crate::gpu_block! {
         width: u32,
         height: u32,
         groom_rect: u32,
+        /// The groom scanned, or ALL_MODELS.
+        model: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
     }
 }
 
@@ -78,6 +95,8 @@ pub static LOD_SCAN: PassKind<ScanParams, ScanGpu> = PassKind {
         width: q.width,
         height: q.height,
         groom_rect: flag(p.groom_rect),
+        model: p.model.unwrap_or(ALL_MODELS),
+        ..ScanGpu::default()
     },
     raster: None,
 };
@@ -98,7 +117,21 @@ impl CpuKernel for ScanKernel {
         let (mut total, mut full, mut kept) = (0u32, 0u32, 0u32);
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let mut groom = Rect::EMPTY;
+        let range = groom_bundles(&bundles, count, self.0.model);
         for b in 0..count {
+            if !range.contains(&b) {
+                // Another groom's: no strands, its first strand where the
+                // running sum is (the rasterizer's search skips it).
+                let first_strand = if b < range.start { 0 } else { total };
+                let other = BundleLod {
+                    strands: 0,
+                    control_points: 0,
+                    first_strand,
+                    flags: LOD_OTHER_GROOM,
+                };
+                other.store(&out, b);
+                continue;
+            }
             let mut lod = BundleLod::load(&choices, b);
             if lod.flags & LOD_OTHER_GROOM == 0 {
                 full = full.wrapping_add(BundleRecord::load(&bundles, b).strands);
@@ -205,12 +238,61 @@ mod tests {
         assert_eq!(&args[ARGS_RUNS..], &[471, 1, 1]);
         // Off, the whole screen: 640 * 480 / 64 runs.
         h.buffer("raster_args", vec![0; 11]);
-        h.run(&ScanKernel(ScanParams { groom_rect: false }), 1, SCAN_GROUP);
+        let off = ScanParams {
+            groom_rect: false,
+            ..ScanParams::default()
+        };
+        h.run(&ScanKernel(off), 1, SCAN_GROUP);
         let args = h.read("raster_args");
         assert_eq!(
             Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]),
             Rect::full(640, 480)
         );
         assert_eq!(&args[ARGS_RUNS..], &[4800, 1, 1]);
+    }
+
+    /// Three grooms' bundles (models 0, 0, 1, 1, 1, 2), scanned for groom
+    /// 1: its bundles get the running sum, every other one no strands and
+    /// the first strand before or after them.
+    #[test]
+    fn a_grooms_scan_walks_its_own_bundles_only() {
+        let models = [0u32, 0, 1, 1, 1, 2];
+        let (mut bundles, mut choices) = (Vec::new(), Vec::new());
+        for (b, &model) in models.iter().enumerate() {
+            let rec = BundleRecord {
+                strands: 10,
+                model,
+                ..Default::default()
+            };
+            bundles.extend(rec.words());
+            let flags = if model == 1 { 0 } else { LOD_OTHER_GROOM };
+            choices.extend([if model == 1 { b as u32 } else { 0 }, 9, 0, flags]);
+        }
+        let mut h = Harness::new(Quantities {
+            bundles: models.len() as u64,
+            width: 64,
+            height: 64,
+            ..Default::default()
+        });
+        h.buffer("hairmesh.bundles", bundles)
+            .buffer("lod_choices", choices)
+            .buffer("bundle_lod", vec![7; 4 * models.len()])
+            .buffer("raster_args", vec![0; 11]);
+        let params = ScanParams {
+            model: Some(1),
+            ..ScanParams::default()
+        };
+        h.run(&ScanKernel(params), 1, SCAN_GROUP);
+        let lod = h.read("bundle_lod");
+        let rows: Vec<&[u32]> = lod.chunks(4).collect();
+        let other = |first: u32| vec![0, 0, first, LOD_OTHER_GROOM];
+        assert_eq!(rows[0], other(0));
+        assert_eq!(rows[1], other(0));
+        assert_eq!(rows[2], [2, 9, 0, 0]);
+        assert_eq!(rows[3], [3, 9, 2, 0]);
+        assert_eq!(rows[4], [4, 9, 5, 0]);
+        assert_eq!(rows[5], other(9));
+        // Drawn 9 of the groom's 30 strands.
+        assert_eq!(&h.read("raster_args")[..6], &[9, 1, 1, 9, 30, 9]);
     }
 }
