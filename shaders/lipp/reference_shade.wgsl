@@ -10,7 +10,7 @@
 #define DOM_DEPTH_BINDING 7
 #define DOM_LAYERS_BINDING 8
 #define ENV_PREFILTERED_BINDING 10
-#import strandgraph::lipp_shading::{ShadeParams, Shading, shading_of, shade_point, depth_correction}
+#import strandgraph::lipp_shading::{ShadeParams, Shading, shading_of, shade_point, depth_correction, share_light_frames}
 #import strandgraph::half::pack_radiance
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
@@ -40,6 +40,8 @@ fn shade_slot(slot: u32, s: Shading, delta: f32) {
 
 @compute @workgroup_size(256)
 fn reference_shade(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    share_light_frames(lane);
+    workgroupBarrier();
     var delta = 0.0;
     if params.lod_depth_correction != 0u {
         delta = depth_correction(raster_args[5], raster_args[4]);

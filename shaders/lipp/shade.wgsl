@@ -17,7 +17,7 @@
 #define ENV_PREFILTERED_BINDING 10
 #import strandgraph::lipp_dom::frame
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
-#import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction}
+#import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction, share_light_frames}
 #import strandgraph::lipp_shaded::{shaded_record, HIT, CONS_HIT}
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, touches_run}
 
@@ -65,6 +65,8 @@ fn shade(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
+    share_light_frames(lane);
+    workgroupBarrier();
     let rect = shaded_rect(wg.x, lane);
     let runs = rect_runs(rect, params.width);
     // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).

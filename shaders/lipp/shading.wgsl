@@ -19,7 +19,7 @@
 #import strandgraph::lipp_dom
 #import strandgraph::lipp_dom::{frame, models, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::hash::pcg
-#import strandgraph::lipp::{light_project, unit, safe_normalize, PI}
+#import strandgraph::lipp::{LightFrame, light_project, unit, safe_normalize, PI}
 #import strandgraph::chiang::{chiang}
 #import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
@@ -90,6 +90,19 @@ fn depth_correction(drawn: u32, all: u32) -> f32 {
     return -log(f32(min(drawn, all)) / f32(all));
 }
 
+// dom::light_frames of the lights with maps, once per workgroup: each is a
+// loop over every model's bounds, which per sample and light (40 models in
+// the crowd) cost more than the rest of the lookup.
+var<workgroup> dom_frames: array<LightFrame, 4>;
+
+// Lanes 0 to 3 compute the frames; every caller puts a workgroupBarrier
+// between this and its first shading.
+fn share_light_frames(lane: u32) {
+    if lane < min(frame.light_count, 4u) {
+        dom_frames[lane] = light_frame(lane);
+    }
+}
+
 // shade::Dom::transmittance.
 fn dom_transmittance(s: Shading, l: u32, pos: vec3<f32>, delta: f32) -> f32 {
     let res = s.map_resolution;
@@ -98,7 +111,7 @@ fn dom_transmittance(s: Shading, l: u32, pos: vec3<f32>, delta: f32) -> f32 {
     if l >= min(min(frame.light_count, 4u), arrayLength(&dom_depth) / max(plane, 1u)) {
         return 1.0;
     }
-    let lf = light_frame(l);
+    let lf = dom_frames[l];
     let q = light_project(lf, pos);
     let x = floor(q.x * f32(res));
     let y = floor(q.y * f32(res));
