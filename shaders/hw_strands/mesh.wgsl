@@ -26,7 +26,7 @@ enable wgpu_mesh_shader;
 #import strandgraph::lipp::{LOD_WORDS, RASTER_GROUP, MAX_CONTROL_POINTS}
 #import strandgraph::hw_strands_segment::segment_bits
 #import strandgraph::hw_strands_quad::{QuadVertex, quad_corner_clipped, write_sample}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, ControlPoint, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, ControlPoint, load_strand, bundle_range, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments}
 
 struct MeshParams {
     // Quad width in pixels (lipp.raster's centre_diameter).
@@ -72,7 +72,9 @@ var<workgroup> mesh_out: MeshOutput;
 fn ts_main(@builtin(workgroup_id) wg: vec3<u32>) -> @builtin(mesh_task_size) vec3<u32> {
     let b = wg.x;
     let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    if b >= count {
+    // Only the drawn groom's bundles have this frame's records (lipp.lod_scan).
+    let range = bundle_range(count);
+    if b < range.x || b >= range.y {
         return vec3<u32>(0u, 1u, 1u);
     }
     let strands = bundle_lod[b * LOD_WORDS];

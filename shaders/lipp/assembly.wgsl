@@ -132,10 +132,20 @@ fn eval_cp(b: Bundle, id: vec3<f32>, k: u32, c: u32, styling: bool) -> ControlPo
 fn snap(v: f32) -> f32 {
     return floor(v * SNAP + 0.5) / SNAP;
 }
-// The last bundle whose first strand is at most s (lipp::bundle_of_strand).
-fn bundle_of_strand(count: u32, s: u32) -> u32 {
-    var lo = 0u;
-    var hi = count;
+// lipp::bundle_range: the scanned groom's bundles [lo, hi), at most count.
+fn bundle_range(count: u32) -> vec2<u32> {
+    if arrayLength(&raster_args) <= 12u {
+        return vec2<u32>(0u, count);
+    }
+    let hi = min(raster_args[12], count);
+    return vec2<u32>(min(raster_args[11], hi), hi);
+}
+
+// The last bundle whose first strand is at most s among `bundles`
+// (lipp::bundle_of_strand).
+fn bundle_of_strand(bundles: vec2<u32>, s: u32) -> u32 {
+    var lo = bundles.x;
+    var hi = bundles.y;
     while lo < hi {
         let mid = (lo + hi) / 2u;
         if bundle_lod[mid * LOD_WORDS + 2u] <= s {
@@ -144,7 +154,7 @@ fn bundle_of_strand(count: u32, s: u32) -> u32 {
             hi = mid;
         }
     }
-    return max(lo, 1u) - 1u;
+    return max(max(lo, 1u) - 1u, bundles.x);
 }
 
 // One strand's assembly state (Code 1), shared by the raster and the DOM entries.
@@ -162,7 +172,7 @@ struct Strand {
 }
 
 fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
-    let bi = bundle_of_strand(count, s);
+    let bi = bundle_of_strand(bundle_range(count), s);
     let drawn = max(bundle_lod[bi * LOD_WORDS], 1u);
     let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
     let b = load_bundle(bi);

@@ -25,30 +25,6 @@ struct ScanParams {
 // lod::ALL_MODELS.
 const ALL_MODELS: u32 = 0xFFFFFFFFu;
 
-// The first of the first `count` bundles whose groom is at least `m`
-// (upload.rs packs grooms' bundles together, in model order).
-fn first_of_groom(count: u32, m: u32) -> u32 {
-    var lo = 0u;
-    var hi = count;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if hairmesh_bundles[mid * BUNDLE_WORDS + 3u] < m {
-            lo = mid + 1u;
-        } else {
-            hi = mid;
-        }
-    }
-    return lo;
-}
-
-// lipp::groom_bundles: [first, end) of this groom's bundles.
-fn groom_bundles(count: u32) -> vec2<u32> {
-    if params.model == ALL_MODELS {
-        return vec2<u32>(0u, count);
-    }
-    return vec2<u32>(first_of_groom(count, params.model), first_of_groom(count, params.model + 1u));
-}
-
 @group(0) @binding(0) var<uniform> params: ScanParams;
 @group(0) @binding(1) var<storage, read> hairmesh_bundles: array<u32>;
 @group(0) @binding(2) var<storage, read> lod_choices: array<u32>;
@@ -64,6 +40,64 @@ var<workgroup> kept_sums: array<u32, SCAN_GROUP>;
 // The drawn bundles' screen rectangle (rect.rs): min x0, y0 and max x1, y1.
 var<workgroup> groom_rect: array<atomic<u32>, 4>;
 
+// lipp::ARGS_BUNDLES_LO/HI.
+const ARGS_BUNDLES_LO: u32 = 11u;
+const ARGS_BUNDLES_HI: u32 = 12u;
+
+// Bundles whose groom is below the scanned one, and at most it, counted in
+// two rounds by the whole workgroup (upload.rs packs grooms' bundles
+// together, in model order, so each count is where a run starts).
+var<workgroup> below: array<atomic<u32>, 2>;
+
+fn model_of(b: u32) -> u32 {
+    return hairmesh_bundles[b * BUNDLE_WORDS + 3u];
+}
+
+// lipp::groom_bundles: [first, end) of the groom's bundles. Round one finds
+// the chunk of SCAN_GROUP bundles each boundary lies in, round two the
+// bundle. Every lane calls it (it has barriers).
+fn groom_bundles(count: u32, lane: u32) -> vec2<u32> {
+    let m = params.model;
+    let chunk = max((count + SCAN_GROUP - 1u) / SCAN_GROUP, 1u);
+    if lane < 2u {
+        atomicStore(&below[lane], 0u);
+    }
+    workgroupBarrier();
+    // Chunks whose first bundle lies before each boundary.
+    if lane * chunk < count {
+        let g = model_of(lane * chunk);
+        if lane > 0u && g < m {
+            atomicAdd(&below[0], 1u);
+        }
+        if lane > 0u && g <= m {
+            atomicAdd(&below[1], 1u);
+        }
+    }
+    workgroupBarrier();
+    let start = vec2<u32>(atomicLoad(&below[0]), atomicLoad(&below[1])) * chunk;
+    workgroupBarrier();
+    if lane < 2u {
+        atomicStore(&below[lane], 0u);
+    }
+    workgroupBarrier();
+    // Within each boundary's chunk.
+    for (var i = lane; i < chunk; i += SCAN_GROUP) {
+        if start.x + i < count && model_of(start.x + i) < m {
+            atomicAdd(&below[0], 1u);
+        }
+        if start.y + i < count && model_of(start.y + i) <= m {
+            atomicAdd(&below[1], 1u);
+        }
+    }
+    workgroupBarrier();
+    let r = min(start + vec2<u32>(atomicLoad(&below[0]), atomicLoad(&below[1])), vec2<u32>(count));
+    workgroupBarrier();
+    if params.model == ALL_MODELS || arrayLength(&raster_args) <= ARGS_BUNDLES_HI {
+        return vec2<u32>(0u, count);
+    }
+    return r;
+}
+
 // scan.rs: a frustum-culled bundle draws none of the strands it keeps.
 fn drawn(b: u32) -> u32 {
     return select(lod_choices[b * LOD_WORDS], 0u, (lod_choices[b * LOD_WORDS + 3u] & LOD_CULLED) != 0u);
@@ -73,7 +107,7 @@ fn drawn(b: u32) -> u32 {
 fn scan(@builtin(local_invocation_index) lane: u32) {
     let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), min(arrayLength(&lod_choices), arrayLength(&bundle_lod)) / LOD_WORDS);
     // Each lane owns a run of this groom's bundles.
-    let range = groom_bundles(count);
+    let range = groom_bundles(count, lane);
     let per = (range.y - range.x + SCAN_GROUP - 1u) / SCAN_GROUP;
     let begin = min(range.x + lane * per, range.y);
     let end = min(begin + per, range.y);
@@ -137,21 +171,8 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         bundle_lod[o + 3u] = lod_choices[o + 3u];
         first += n;
     }
-    // Every other groom's bundle: no strands, its first strand where the
-    // running sum is (the rasterizer's search skips it).
-    let total = sums[SCAN_GROUP - 1u];
-    let per_all = (count + SCAN_GROUP - 1u) / SCAN_GROUP;
-    for (var b = lane * per_all; b < min(lane * per_all + per_all, count); b++) {
-        if b >= range.x && b < range.y {
-            continue;
-        }
-        let o = b * LOD_WORDS;
-        bundle_lod[o] = 0u;
-        bundle_lod[o + 1u] = 0u;
-        bundle_lod[o + 2u] = select(total, 0u, b < range.x);
-        bundle_lod[o + 3u] = LOD_OTHER_GROOM;
-    }
     if lane == SCAN_GROUP - 1u {
+        let total = sums[SCAN_GROUP - 1u];
         raster_args[0] = min(total, MAX_GROUPS_X);
         raster_args[1] = 1u;
         raster_args[2] = 1u;
@@ -172,6 +193,10 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
             let a = rect_args(groom);
             raster_args[ARGS_RECT_LO] = a.x;
             raster_args[ARGS_RECT_HI] = a.y;
+        }
+        if arrayLength(&raster_args) > ARGS_BUNDLES_HI {
+            raster_args[ARGS_BUNDLES_LO] = range.x;
+            raster_args[ARGS_BUNDLES_HI] = range.y;
         }
         if arrayLength(&raster_args) > ARGS_RUNS + 2u {
             raster_args[ARGS_RUNS] = min(rect_runs(groom, params.width).y, MAX_GROUPS_X);

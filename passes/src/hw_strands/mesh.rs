@@ -170,7 +170,10 @@ impl MeshKernel {
         let strands = Strands::load(ctx);
         let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
         // Launch order: bundle by bundle, strand by strand.
-        (0..strands.count)
+        // Only the drawn groom's bundles have this frame's records.
+        strands
+            .range
+            .clone()
             .into_par_iter()
             .flat_map_iter(|b| {
                 let lod = BundleLod::load(&strands.lods, b);

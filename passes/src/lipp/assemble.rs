@@ -13,7 +13,7 @@ use super::strand::{
 };
 use super::{
     BundleLod, BundleRecord, LOD_WORDS, MAX_CONTROL_POINTS, RASTER_GROUP, bundle_count,
-    bundle_of_strand,
+    bundle_of_strand, bundle_range,
 };
 use crate::kernel::{Ctx, Words};
 
@@ -50,26 +50,27 @@ pub struct Strands<'a> {
     pub layers: Words<'a>,
     /// Strands the LOD keeps, numbered across bundles.
     pub total: u32,
-    /// Bundles with an LOD record.
-    pub count: usize,
+    /// The bundles the drawn strands lie in (`raster_args`, [`bundle_range`]).
+    pub range: std::ops::Range<usize>,
 }
 
 impl<'a> Strands<'a> {
     pub fn load(ctx: &Ctx<'a>) -> Self {
-        let lods = ctx.words("bundle_lod");
+        let (lods, args) = (ctx.words("bundle_lod"), ctx.words("raster_args"));
+        let count = bundle_count(ctx).min(lods.len() / LOD_WORDS);
         Self {
-            count: bundle_count(ctx).min(lods.len() / LOD_WORDS),
+            range: bundle_range(&args, count),
             lods,
             bundles: ctx.words("hairmesh.bundles"),
             layers: ctx.words("hairmesh.layers"),
-            total: ctx.words("raster_args").load(3),
+            total: args.load(3),
         }
     }
 
     /// Kept strand `s`: its bundle's LOD and record, and its index `k` in
     /// the bundle.
     pub fn strand(&self, s: u32) -> (BundleLod, BundleRecord, u32) {
-        let b = bundle_of_strand(|i| self.lods.load(i * LOD_WORDS + 2), self.count, s);
+        let b = bundle_of_strand(|i| self.lods.load(i * LOD_WORDS + 2), self.range.clone(), s);
         let lod = BundleLod::load(&self.lods, b);
         let k = s - lod.first_strand;
         (lod, BundleRecord::load(&self.bundles, b), k)

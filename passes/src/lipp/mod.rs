@@ -166,6 +166,21 @@ pub const LOD_OTHER_GROOM: u32 = 2;
 pub const ARGS_DRAWN: usize = 3;
 pub const ARGS_ALL: usize = 4;
 pub const ARGS_KEPT: usize = 5;
+/// `raster_args` words 11 and 12: the bundles [lo, hi) of the groom the scan
+/// was for, where every drawn strand's bundle lies ([`bundle_range`]); the
+/// scan writes no other bundle's `bundle_lod` record.
+pub const ARGS_BUNDLES_LO: usize = 11;
+pub const ARGS_BUNDLES_HI: usize = 12;
+
+/// The bundles `args` (a `raster_args`) says the drawn strands lie in, at
+/// most the first `count`; all of them in a `raster_args` with no room.
+pub fn bundle_range(args: &Words<'_>, count: usize) -> std::ops::Range<usize> {
+    if args.len() <= ARGS_BUNDLES_HI {
+        return 0..count;
+    }
+    let hi = (args.load(ARGS_BUNDLES_HI) as usize).min(count);
+    (args.load(ARGS_BUNDLES_LO) as usize).min(hi)..hi
+}
 
 impl BundleLod {
     pub fn load(w: &Words<'_>, b: usize) -> Self {
@@ -188,10 +203,15 @@ impl BundleLod {
 
 /// The bundle owning drawn strand `s`: the last bundle whose first strand is
 /// at most `s` (bundles with no strands share their successor's first strand,
-/// so they are skipped). `lods` is sorted by `first_strand`.
-pub fn bundle_of_strand(first_strand: impl Fn(usize) -> u32, bundles: usize, s: u32) -> usize {
+/// so they are skipped), among `bundles`, sorted by `first_strand`.
+pub fn bundle_of_strand(
+    first_strand: impl Fn(usize) -> u32,
+    bundles: std::ops::Range<usize>,
+    s: u32,
+) -> usize {
     // upper_bound over first_strand, minus one.
-    let (mut lo, mut hi) = (0usize, bundles);
+    let floor = bundles.start;
+    let (mut lo, mut hi) = (bundles.start, bundles.end);
     while lo < hi {
         let mid = (lo + hi) / 2;
         if first_strand(mid) <= s {
@@ -200,7 +220,7 @@ pub fn bundle_of_strand(first_strand: impl Fn(usize) -> u32, bundles: usize, s: 
             hi = mid;
         }
     }
-    lo.saturating_sub(1)
+    lo.saturating_sub(1).max(floor)
 }
 
 /// G-buffer layers the graph gave (2: centre and conservative; N for the
@@ -329,10 +349,12 @@ mod tests {
         // Bundles: 3 strands, 0 (culled), 2, 0 -> firsts 0, 3, 3, 5.
         let firsts = [0u32, 3, 3, 5];
         let f = |i: usize| firsts[i];
-        assert_eq!(bundle_of_strand(f, 4, 0), 0);
-        assert_eq!(bundle_of_strand(f, 4, 2), 0);
-        assert_eq!(bundle_of_strand(f, 4, 3), 2);
-        assert_eq!(bundle_of_strand(f, 4, 4), 2);
+        assert_eq!(bundle_of_strand(f, 0..4, 0), 0);
+        assert_eq!(bundle_of_strand(f, 0..4, 2), 0);
+        assert_eq!(bundle_of_strand(f, 0..4, 3), 2);
+        assert_eq!(bundle_of_strand(f, 0..4, 4), 2);
+        // Within a groom's bundles 2..4: strand 4 of firsts 3, 5.
+        assert_eq!(bundle_of_strand(f, 2..4, 4), 2);
     }
 
     #[test]

@@ -19,8 +19,9 @@
 
 use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, Rect};
 use super::super::{
-    ARGS_ALL, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod, BundleRecord, LOD_CULLED,
-    LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count, groom_bundles,
+    ARGS_ALL, ARGS_BUNDLES_HI, ARGS_BUNDLES_LO, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod,
+    BundleRecord, LOD_CULLED, LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
+    groom_bundles,
 };
 use super::ALL_MODELS;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -40,8 +41,11 @@ pub struct ScanParams {
     pub groom_rect: bool,
     /// Only this groom's bundles (the per-model block sets `model_index`);
     /// `None`: all. The scan walks that groom's bundles only (ours: the
-    /// crowd's 28 grooms each scanned all 28,000 bundles), and gives every
-    /// other bundle no strands.
+    /// crowd's 28 grooms each scanned all 28,000 bundles) and tells the
+    /// rasterizer where they are (`raster_args` words
+    /// [`ARGS_BUNDLES_LO`], [`ARGS_BUNDLES_HI`]), which then looks no
+    /// further; other bundles' `bundle_lod` records are left as they were.
+    /// A `raster_args` with no room for the range gets every bundle's.
     #[serde(rename = "model_index", deserialize_with = "crate::params::some")]
     pub model: Option<u32>,
 }
@@ -117,21 +121,14 @@ impl CpuKernel for ScanKernel {
         let (mut total, mut full, mut kept) = (0u32, 0u32, 0u32);
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
         let mut groom = Rect::EMPTY;
-        let range = groom_bundles(&bundles, count, self.0.model);
-        for b in 0..count {
-            if !range.contains(&b) {
-                // Another groom's: no strands, its first strand where the
-                // running sum is (the rasterizer's search skips it).
-                let first_strand = if b < range.start { 0 } else { total };
-                let other = BundleLod {
-                    strands: 0,
-                    control_points: 0,
-                    first_strand,
-                    flags: LOD_OTHER_GROOM,
-                };
-                other.store(&out, b);
-                continue;
-            }
+        let args = ctx.words("raster_args");
+        let room = args.len() > ARGS_BUNDLES_HI;
+        let range = if room {
+            groom_bundles(&bundles, count, self.0.model)
+        } else {
+            0..count
+        };
+        for b in range.clone() {
             let mut lod = BundleLod::load(&choices, b);
             if lod.flags & LOD_OTHER_GROOM == 0 {
                 full = full.wrapping_add(BundleRecord::load(&bundles, b).strands);
@@ -147,7 +144,6 @@ impl CpuKernel for ScanKernel {
             total = total.wrapping_add(lod.strands);
             lod.store(&out, b);
         }
-        let args = ctx.words("raster_args");
         args.store(0, total.min(MAX_GROUPS_X));
         args.store(1, 1);
         args.store(2, 1);
@@ -169,6 +165,10 @@ impl CpuKernel for ScanKernel {
             for (i, n) in groom.run_dispatch(w).into_iter().enumerate() {
                 args.store(ARGS_RUNS + i, n);
             }
+        }
+        if room {
+            args.store(ARGS_BUNDLES_LO, range.start as u32);
+            args.store(ARGS_BUNDLES_HI, range.end as u32);
         }
     }
 }
@@ -252,8 +252,8 @@ mod tests {
     }
 
     /// Three grooms' bundles (models 0, 0, 1, 1, 1, 2), scanned for groom
-    /// 1: its bundles get the running sum, every other one no strands and
-    /// the first strand before or after them.
+    /// 1: its bundles get the running sum, the others stay as they were,
+    /// and `raster_args` says where the groom's are.
     #[test]
     fn a_grooms_scan_walks_its_own_bundles_only() {
         let models = [0u32, 0, 1, 1, 1, 2];
@@ -277,7 +277,7 @@ mod tests {
         h.buffer("hairmesh.bundles", bundles)
             .buffer("lod_choices", choices)
             .buffer("bundle_lod", vec![7; 4 * models.len()])
-            .buffer("raster_args", vec![0; 11]);
+            .buffer("raster_args", vec![0; 13]);
         let params = ScanParams {
             model: Some(1),
             ..ScanParams::default()
@@ -285,14 +285,16 @@ mod tests {
         h.run(&ScanKernel(params), 1, SCAN_GROUP);
         let lod = h.read("bundle_lod");
         let rows: Vec<&[u32]> = lod.chunks(4).collect();
-        let other = |first: u32| vec![0, 0, first, LOD_OTHER_GROOM];
-        assert_eq!(rows[0], other(0));
-        assert_eq!(rows[1], other(0));
+        let other = [7u32; 4];
+        assert_eq!(rows[0], other);
+        assert_eq!(rows[1], other);
         assert_eq!(rows[2], [2, 9, 0, 0]);
         assert_eq!(rows[3], [3, 9, 2, 0]);
         assert_eq!(rows[4], [4, 9, 5, 0]);
-        assert_eq!(rows[5], other(9));
-        // Drawn 9 of the groom's 30 strands.
-        assert_eq!(&h.read("raster_args")[..6], &[9, 1, 1, 9, 30, 9]);
+        assert_eq!(rows[5], other);
+        // Drawn 9 of the groom's 30 strands, in bundles 2..5.
+        let args = h.read("raster_args");
+        assert_eq!(&args[..6], &[9, 1, 1, 9, 30, 9]);
+        assert_eq!(&args[ARGS_BUNDLES_LO..], &[2, 5]);
     }
 }
