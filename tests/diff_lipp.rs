@@ -21,7 +21,7 @@
 //! No device or no validation layer is a failure, not a skip.
 
 use std::path::PathBuf;
-use strandgraph::frame::{Prepared, prepare};
+use strandgraph::frame::prepare;
 use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 use strandgraph_passes::lipp::{ARGS_BUNDLES_HI, ARGS_BUNDLES_LO};
 

@@ -303,7 +303,14 @@ pub fn delta_table(
             .and_then(|l| l.iter().find(|p| p["pass"] == pass))
             .and_then(|p| p["median_ms"].as_f64())
     };
-    let passes = passes_of([&a, &b].into_iter());
+    // One row a pass: a pass whose kind changed names both.
+    let mut passes: Vec<(String, String)> = Vec::new();
+    for (p, k) in passes_of([&a, &b].into_iter()) {
+        match passes.iter_mut().find(|(q, _)| *q == p) {
+            Some((_, kinds)) => *kinds = format!("{kinds} → `{k}`"),
+            None => passes.push((p, format!("`{k}`"))),
+        }
+    }
     let ms = |v: Option<f64>| v.map_or("–".into(), |m| format!("{m:.3}"));
     let mut md = format!(
         "{variant}, {view}, {dev_a}; ms, median per pass:\n\n| pass | kind | before | after | change |\n|---|---|---:|---:|---:|\n"
@@ -313,7 +320,7 @@ pub fn delta_table(
     let timed_at_bounds = [&a, &b].iter().any(|c| bounds(c).is_some());
     for (pass, kind, x, y) in passes
         .iter()
-        .map(|(p, k)| (p.as_str(), format!("`{k}`"), median(&a, p), median(&b, p)))
+        .map(|(p, k)| (p.as_str(), k.clone(), median(&a, p), median(&b, p)))
         .chain([("**frame**", String::new(), frame(&a), frame(&b))])
         .chain(timed_at_bounds.then(|| {
             let label = "**frame, timed at its bounds**";
@@ -374,6 +381,14 @@ mod tests {
         let mut other = after.clone();
         other["devices"][0]["device"] = serde_json::json!("another GPU");
         assert!(delta_table(&sample(), &other, "K: all", "close").is_err());
+        // A pass whose kind changed is one row naming both kinds.
+        after["cells"][0]["passes"][0]["kind"] = serde_json::json!("k.raster2");
+        let md = delta_table(&sample(), &after, "K: all", "close").unwrap();
+        assert!(
+            md.contains("| raster | `k.raster` → `k.raster2` | 1.250 | 0.625 | -50% |"),
+            "{md}"
+        );
+        assert_eq!(md.matches("| raster |").count(), 1, "{md}");
     }
 
     #[test]
