@@ -75,10 +75,10 @@ struct Share {
     step: u32,
 }
 
-// Whether strand `st` deals its segments out: one a lane (C <= 33), at
-// most MAX_SHARED. The same for the whole workgroup.
+// Whether strand `st` deals its segments out: at most MAX_SHARED of them,
+// so one a lane (pass_two). The same for the whole workgroup.
 fn shares(st: Strand) -> bool {
-    return st.c >= 2u && st.c - 1u <= MAX_SHARED && (st.c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP == 1u;
+    return st.c >= 2u && st.c - 1u <= MAX_SHARED;
 }
 
 // With `shares`: lane j walks segment j % S, columns j / S, j / S + k, ...

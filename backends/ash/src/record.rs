@@ -176,7 +176,7 @@ fn expected(plan: &Plan, lane_of: &[usize], lanes: usize) -> Vec<When> {
             .filter(|s| s.before == p && lane_of[s.after] != l);
         let step = waits.fold(next[l], |t, s| t.max(when[s.after].step.saturating_add(1)));
         when[p] = When { order, step };
-        next[l] = step + 1;
+        next[l] = step.saturating_add(1);
     }
     when
 }

@@ -7,8 +7,9 @@
 //! first strand: this pass copies `lod_choices` into `bundle_lod` with word 2
 //! the running sum, and writes `raster_args` = (min(drawn, 65535), 1, 1,
 //! drawn, Σ N, Σ N_LOD, and the drawn bundles' screen rectangle,
-//! [`super::super::rect`], and the dispatch over its runs of pixels). With
-//! `groom_rect` off (ours, on by default) the rectangle is the whole screen.
+//! [`super::super::rect`], the dispatch over its runs of pixels, and the
+//! bundles of the groom scanned, [`ARGS_BUNDLES_LO`]). With `groom_rect`
+//! off (ours, on by default) the rectangle is the whole screen.
 //! A frustum-culled bundle draws nothing (its
 //! `bundle_lod` count is 0) but its N_LOD counts in β = Σ N_LOD / Σ N of
 //! Eq. 8, over the bundles the decision was for (not another groom's): β is
