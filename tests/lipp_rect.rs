@@ -150,3 +150,40 @@ fn the_rectangle_changes_no_pixel_of_two_grooms_drawn_one_after_the_other() {
     let differ = a.iter().zip(&b).filter(|(x, y)| x != y).count();
     assert_eq!(differ, 0, "{differ} words of the output differ");
 }
+
+/// A graph whose `raster_args` has no room for the runs' dispatch that
+/// `lipp.clear_gbuffer` and `lipp.shade` read (words 8-10) is an error
+/// naming the pass and the buffer, not a read past its end.
+#[test]
+fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("scenes/graphs/lipp.ron")).unwrap();
+    let small = text.replace(
+        r#"Buffer(name: "raster_args", size: Bytes(52))"#,
+        r#"Buffer(name: "raster_args", size: Bytes(32))"#,
+    );
+    assert_ne!(small, text, "lipp.ron declares raster_args as 52 bytes");
+    let dir = std::env::temp_dir().join(format!("lipp_rect_small_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let graph = dir.join("lipp_small.ron");
+    std::fs::write(&graph, small).unwrap();
+    let p = prepare_with(
+        &root.join("scenes/distances/far.ron"),
+        Some(&graph),
+        Some((64, 36)),
+        &[],
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let e = CpuBackend::default()
+        .execute(&p.plan, &p.instance, &p.upload)
+        .err()
+        .expect("a dispatch past the end of raster_args");
+    let message = e.to_string();
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(
+        message.contains("clear_gbuffer")
+            && message.contains("`raster_args`")
+            && message.contains("44 bytes"),
+        "{message}"
+    );
+}

@@ -76,6 +76,20 @@ impl Dispatch {
         }
     }
 
+    /// An indirect dispatch reads three words of `binding` from `word` on:
+    /// an error unless its `words` hold them (a graph's buffer too small
+    /// for the pass that dispatches from it, which Vulkan would not catch).
+    pub fn check_indirect(binding: &str, word: usize, words: u64) -> Result<(), String> {
+        if word as u64 + 3 <= words {
+            return Ok(());
+        }
+        Err(format!(
+            "the indirect dispatch reads words {word}..{} of `{binding}`, which holds {words}: give it at least {} bytes",
+            word + 3,
+            4 * (word + 3)
+        ))
+    }
+
     /// The workgroups that cover `words` at `words_per_group` each, capped
     /// at [`MAX_COVER_GROUPS`]; a kernel dispatched so strides by the
     /// dispatched count (a 2.7 GB buffer needs 164,022 groups of 4,096
@@ -342,6 +356,12 @@ mod tests {
             word: 0,
         };
         assert_eq!(indirect.direct_groups(&q, 1000), None);
+        assert!(Dispatch::check_indirect("args", 8, 11).is_ok());
+        let e = Dispatch::check_indirect("raster_args", 8, 8).unwrap_err();
+        assert!(
+            e.contains("words 8..11 of `raster_args`") && e.contains("44 bytes"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -374,6 +374,7 @@ fn launches(
                 .find(|(n, _, _)| n == binding)
                 .map(|(_, r, _)| *r)
                 .ok_or_else(|| err(format!("indirect `{binding}` is not bound")))?;
+            Dispatch::check_indirect(binding, word, words_of(r)).map_err(err)?;
             Launch::Indirect(r, word as u64 * 4)
         }
         (None, _) => unreachable!("only indirect dispatches have no direct count"),

@@ -30,6 +30,8 @@ pub enum CpuError {
         value: u64,
         seconds: u64,
     },
+    #[error("pass `{pass}`: {message}")]
+    Dispatch { pass: String, message: String },
     #[error("pass `{pass}`: kernel panicked: {message}")]
     KernelPanic { pass: String, message: String },
     #[error(
@@ -332,7 +334,15 @@ impl CpuBackend {
             Some(n) => u32::try_from(n).unwrap_or(u32::MAX),
             None => match dispatch {
                 Dispatch::Indirect { binding, word } => {
-                    bindings.get(binding).map_or(0, |w| w.load(word))
+                    let w = bindings.get(binding);
+                    let words = w.map_or(0, |w| w.len() as u64);
+                    Dispatch::check_indirect(binding, word, words).map_err(|message| {
+                        CpuError::Dispatch {
+                            pass: pass.name.clone(),
+                            message,
+                        }
+                    })?;
+                    w.map_or(0, |w| w.load(word))
                 }
                 _ => unreachable!("only indirect dispatches have no direct count"),
             },

@@ -297,6 +297,7 @@ fn launch(cx: &PassContext<'_>) -> Result<Launch, WgpuError> {
                     .ok_or_else(|| {
                         cx.error(format!("indirect `{binding}` is not a bound buffer"))
                     })?;
+                Dispatch::check_indirect(binding, word, cx.words_of(r)).map_err(|e| cx.error(e))?;
                 Launch::Indirect(r, word as u64 * 4)
             }
             (None, _) => unreachable!("only indirect dispatches have no direct count"),
