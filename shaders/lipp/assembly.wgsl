@@ -14,7 +14,7 @@
 #define_import_path strandgraph::lipp_assembly
 
 #import strandgraph::hash::pcg
-#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, bilinear, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, bilinear, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI, ARGS_BUNDLES_LO, ARGS_BUNDLES_HI}
 
 @group(0) @binding(2) var<storage, read> raster_args: array<u32>;
 @group(0) @binding(3) var<storage, read> bundle_lod: array<u32>;
@@ -134,11 +134,11 @@ fn snap(v: f32) -> f32 {
 }
 // lipp::bundle_range: the scanned groom's bundles [lo, hi), at most count.
 fn bundle_range(count: u32) -> vec2<u32> {
-    if arrayLength(&raster_args) <= 12u {
+    if arrayLength(&raster_args) <= ARGS_BUNDLES_HI {
         return vec2<u32>(0u, count);
     }
-    let hi = min(raster_args[12], count);
-    return vec2<u32>(min(raster_args[11], hi), hi);
+    let hi = min(raster_args[ARGS_BUNDLES_HI], count);
+    return vec2<u32>(min(raster_args[ARGS_BUNDLES_LO], hi), hi);
 }
 
 // The last bundle whose first strand is at most s among `bundles`

@@ -16,6 +16,9 @@ const MAX_CONTROL_POINTS: u32 = 129u;
 const MAX_GROUPS_X: u32 = 65535u;
 const LOD_CULLED: u32 = 1u;
 const LOD_OTHER_GROOM: u32 = 2u;
+// lipp::ARGS_BUNDLES_LO/HI: raster_args' words holding the scanned groom's bundles.
+const ARGS_BUNDLES_LO: u32 = 11u;
+const ARGS_BUNDLES_HI: u32 = 12u;
 // payload::DEPTH_MAX, the sub-pixel snap grid.
 const DEPTH_MAX: f32 = 16777215.0;
 // payload::INV_DEPTH_MAX: 1 / DEPTH_MAX rounded once to f32 (0x33800001).

@@ -5,7 +5,7 @@
 // (Hillis and Steele), then each lane writes its run.
 
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, ARGS_RUNS, rect_union, rect_is_empty, unpack_tiles, rect_args, rect_runs}
-#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED}
+#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED, ARGS_BUNDLES_LO, ARGS_BUNDLES_HI}
 
 struct ScanParams {
     // Scene quantity: bundles packed.
@@ -39,10 +39,6 @@ var<workgroup> full_sums: array<u32, SCAN_GROUP>;
 var<workgroup> kept_sums: array<u32, SCAN_GROUP>;
 // The drawn bundles' screen rectangle (rect.rs): min x0, y0 and max x1, y1.
 var<workgroup> groom_rect: array<atomic<u32>, 4>;
-
-// lipp::ARGS_BUNDLES_LO/HI.
-const ARGS_BUNDLES_LO: u32 = 11u;
-const ARGS_BUNDLES_HI: u32 = 12u;
 
 // Bundles whose groom is below the scanned one, and at most it, counted in
 // two rounds by the whole workgroup (upload.rs packs grooms' bundles

@@ -58,14 +58,9 @@ impl CpuKernel for ClearKernel {
         let pixels = (w * h).max(1);
         let (args, g) = (ctx.words("raster_args"), ctx.words("gbuffer"));
         let rect = Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI));
-        let (first, runs) = rect.runs(w);
         let layers = (g.len() / (2 * pixels as usize)) as u32;
         let empty = [EMPTY as u32, (EMPTY >> 32) as u32];
-        for k in (group..runs).step_by(ctx.workgroups.max(1) as usize) {
-            let run = first + k;
-            if !rect.touches_run(run * TILE, TILE, w) {
-                continue;
-            }
+        for run in rect.runs_of_group(w, group, ctx.workgroups) {
             for layer in 0..layers {
                 for i in run * TILE..((run + 1) * TILE).min(pixels) {
                     let slot = 2 * (layer * pixels + i) as usize;

@@ -201,6 +201,21 @@ impl BundleLod {
     }
 }
 
+/// The first index of `range` where `below` stops holding (it holds on a
+/// prefix of the range): a binary search over records read one at a time.
+fn partition_point(range: std::ops::Range<usize>, below: impl Fn(usize) -> bool) -> usize {
+    let (mut lo, mut hi) = (range.start, range.end);
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        if below(mid) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
 /// The bundle owning drawn strand `s`: the last bundle whose first strand is
 /// at most `s` (bundles with no strands share their successor's first strand,
 /// so they are skipped), among `bundles`, sorted by `first_strand`.
@@ -209,18 +224,10 @@ pub fn bundle_of_strand(
     bundles: std::ops::Range<usize>,
     s: u32,
 ) -> usize {
-    // upper_bound over first_strand, minus one.
     let floor = bundles.start;
-    let (mut lo, mut hi) = (bundles.start, bundles.end);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if first_strand(mid) <= s {
-            lo = mid + 1;
-        } else {
-            hi = mid;
-        }
-    }
-    lo.saturating_sub(1).max(floor)
+    partition_point(bundles, |b| first_strand(b) <= s)
+        .saturating_sub(1)
+        .max(floor)
 }
 
 /// G-buffer layers the graph gave (2: centre and conservative; N for the
@@ -241,19 +248,7 @@ pub fn groom_bundles(
 ) -> std::ops::Range<usize> {
     let Some(m) = model else { return 0..count };
     let model_of = |b: usize| BundleRecord::load(bundles, b).model;
-    let first = |below: &dyn Fn(u32) -> bool| {
-        let (mut lo, mut hi) = (0usize, count);
-        while lo < hi {
-            let mid = (lo + hi) / 2;
-            if below(model_of(mid)) {
-                lo = mid + 1;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
-    };
-    first(&|x| x < m)..first(&|x| x <= m)
+    partition_point(0..count, |b| model_of(b) < m)..partition_point(0..count, |b| model_of(b) <= m)
 }
 
 /// Number of bundles actually packed (the buffer may be larger).

@@ -154,6 +154,18 @@ impl Rect {
         (first, last - first + 1)
     }
 
+    /// The runs workgroup `group` of the [`Rect::run_dispatch`] of
+    /// `workgroups` takes (striding past 65,535), those that touch the
+    /// rectangle: what `lipp.shade` and `lipp.clear_gbuffer` each work on.
+    pub fn runs_of_group(&self, w: u32, group: u32, workgroups: u32) -> impl Iterator<Item = u32> {
+        let (first, runs) = self.runs(w);
+        let rect = *self;
+        (group..runs)
+            .step_by(workgroups.max(1) as usize)
+            .map(move |k| first + k)
+            .filter(move |&run| rect.touches_run(run * TILE, TILE, w))
+    }
+
     /// `raster_args` words [`ARGS_RUNS`]..: a workgroup per run of
     /// [`Rect::runs`], at most [`MAX_GROUPS_X`].
     pub fn run_dispatch(&self, w: u32) -> [u32; 3] {

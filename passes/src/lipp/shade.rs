@@ -457,14 +457,9 @@ impl CpuKernel for ShadeKernel {
             0.0
         };
         let rect = self.shaded_rect(ctx, group);
-        let (first, runs) = rect.runs(w);
         let inp = Inputs::load(ctx, &f, &model, &lights, &self.0, delta);
-        // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).
-        for k in (group..runs).step_by(ctx.workgroups.max(1) as usize) {
-            let run = first + k;
-            if rect.touches_run(run * SHADE_GROUP, SHADE_GROUP, w) {
-                self.shade_run(ctx, &inp, run);
-            }
+        for run in rect.runs_of_group(w, group, ctx.workgroups) {
+            self.shade_run(ctx, &inp, run);
         }
     }
 }
