@@ -28,8 +28,6 @@ const EMPTY: u32 = 0xFFFFFFFFu;
 const COVERAGE_SCALE: f32 = 1024.0;
 // Ordered visibility layers.
 const LAYERS: u32 = 3u;
-// Hi-Z block edge (kulikov::depth_downsample::FACTOR).
-const HIZ_FACTOR: u32 = 16u;
 // Density grid words per model (48^3, one per voxel) and the fixed-point
 // unit of projected area (kulikov::density::{GRID_WORDS, AREA_UNIT}).
 const GRID_WORDS: u32 = 110592u;

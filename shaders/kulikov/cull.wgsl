@@ -13,7 +13,8 @@
 #import strandgraph::kulikov_segments::{frame, models, lod_models, nth_drawn}
 #import strandgraph::layout::ModelData
 #import strandgraph::clip::{transform, clip_to_screen, near_clip}
-#import strandgraph::kulikov::{DrawnSegment, screen_bin, HIZ_FACTOR}
+#import strandgraph::kulikov::{DrawnSegment, screen_bin}
+#import strandgraph::hiz::hiz_farthest
 #import strandgraph::subgroup::elected
 
 struct CullParams {
@@ -98,21 +99,9 @@ fn test(seg: DrawnSegment, c0_in: vec4<f32>, c1_in: vec4<f32>) -> Verdict {
         u32(clamp(max(s0.x, s1.x), 0.0, w - 1.0)),
         u32(clamp(max(s0.y, s1.y), 0.0, h - 1.0)),
     );
-    if params.occlusion != 0u {
-        let t = bounds / HIZ_FACTOR;
-        // Long segments span many blocks; testing them is not worth the reads.
-        if (t.z - t.x + 1u) * (t.w - t.y + 1u) <= 16u {
-            let nearest = min(s0.z, s1.z);
-            var farthest = 0.0;
-            for (var ty = t.y; ty <= t.w; ty++) {
-                for (var tx = t.x; tx <= t.z; tx++) {
-                    farthest = max(farthest, textureLoad(hiz, vec2<u32>(tx, ty), 0).x);
-                }
-            }
-            if nearest > farthest {
-                return out;
-            }
-        }
+    // hiz_farthest: long segments span many blocks and are not tested.
+    if params.occlusion != 0u && min(s0.z, s1.z) > hiz_farthest(hiz, bounds) {
+        return out;
     }
     out.visible = true;
     out.bounds = bounds;

@@ -2,7 +2,7 @@
 // Port of passes/src/kulikov/depth_downsample.rs: one workgroup per block,
 // one lane per texel, the maximum an atomicMax on the depth bits.
 
-#import strandgraph::kulikov::HIZ_FACTOR
+#import strandgraph::hiz::HIZ_FACTOR
 
 // The screen size the CPU kernel reads from the scene quantities.
 struct DepthDownsampleParams {

@@ -16,6 +16,7 @@
 #import strandgraph::hash::pcg
 #import strandgraph::clip::{transform, clip_to_screen, near_clip, clip_at, clip_at3}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
+#import strandgraph::hiz::hiz_farthest
 #import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
@@ -36,8 +37,10 @@ struct RasterParams {
     // Ours: the tangent packed once per segment (raster::segment_payload);
     // it selects the entry point (`raster` or `raster_sample_payload`).
     segment_payload: u32,
-    _pad1: u32,
-    _pad2: u32,
+    // Ours: segments behind the scene's Hi-Z are not walked
+    // (raster::occlusion_cull).
+    occlusion_cull: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
@@ -45,6 +48,8 @@ struct RasterParams {
 // Earlier grooms' depth (f32 bits), written by their filter passes.
 @group(0) @binding(7) var<storage, read> hair_depth: array<u32>;
 @group(0) @binding(8) var<storage, read_write> gbuffer: array<atomic<u64>>;
+// The farthest scene depth of each 16x16 block (kulikov.depth_downsample).
+@group(0) @binding(9) var hiz: texture_2d<f32>;
 
 struct End {
     x: f32,
@@ -255,12 +260,30 @@ fn draw_segment_msaa(a: End, b: End, bits: vec2<u32>, per_sample: bool) {
     }
 }
 
+// Target::hidden (raster::occlusion_cull): whether every pixel segment
+// (a, b) can write lies behind the scene. The walk's rows reach a pixel past
+// the segment's box, hence the box grown by one.
+fn hidden(a: End, b: End) -> bool {
+    let w = f32(params.width) - 1.0;
+    let h = f32(params.height) - 1.0;
+    let bounds = vec4<u32>(
+        u32(clamp(min(a.x, b.x) - 1.0, 0.0, w)),
+        u32(clamp(min(a.y, b.y) - 1.0, 0.0, h)),
+        u32(clamp(max(a.x, b.x) + 1.0, 0.0, w)),
+        u32(clamp(max(a.y, b.y) + 1.0, 0.0, h)),
+    );
+    return min(a.z, b.z) >= hiz_farthest(hiz, bounds);
+}
+
 fn draw(a: ControlPoint, ta: vec3<f32>, b: ControlPoint, tb: vec3<f32>, bits: vec2<u32>, per_sample: bool) {
     let part = near_clip(transform(frame.view_proj, vec4<f32>(a.pos, 1.0)),
         transform(frame.view_proj, vec4<f32>(b.pos, 1.0)), frame.near);
     if part.valid {
         let pa = project_end(part.a, part.ta, a, ta, b, tb);
         let pb = project_end(part.b, part.tb, a, ta, b, tb);
+        if params.occlusion_cull != 0u && hidden(pa, pb) {
+            return;
+        }
         if params.msaa > 1u {
             draw_segment_msaa(pa, pb, bits, per_sample);
         } else {

@@ -94,6 +94,9 @@ pub struct Counters {
     pub pixels_written: AtomicU64,
     /// Out-of-range accesses (should stay 0).
     pub out_of_bounds: AtomicU64,
+    /// Work a kernel's own test skipped (`lipp.raster`'s occlusion-culled
+    /// segments).
+    pub culled: AtomicU64,
 }
 
 /// A plain snapshot of [`Counters`].
@@ -104,6 +107,7 @@ pub struct CounterValues {
     pub atomics: u64,
     pub pixels_written: u64,
     pub out_of_bounds: u64,
+    pub culled: u64,
 }
 
 impl CounterValues {
@@ -121,6 +125,7 @@ impl Counters {
             atomics: self.atomics.load(Relaxed),
             pixels_written: self.pixels_written.load(Relaxed),
             out_of_bounds: self.out_of_bounds.load(Relaxed),
+            culled: self.culled.load(Relaxed),
         }
     }
     /// Adds a workgroup's local tallies (one contended add per counter per workgroup).
@@ -129,6 +134,7 @@ impl Counters {
         self.total_lanes.fetch_add(local.total_lanes, Relaxed);
         self.atomics.fetch_add(local.atomics, Relaxed);
         self.pixels_written.fetch_add(local.pixels_written, Relaxed);
+        self.culled.fetch_add(local.culled, Relaxed);
     }
 }
 

@@ -238,25 +238,11 @@ impl CullKernel {
             clampx(s0[0].max(s1[0])),
             clampy(s0[1].max(s1[1])),
         ];
+        // Long segments span many blocks and are not tested (`farthest`).
         if self.0.occlusion {
-            let f16 = super::depth_downsample::FACTOR;
-            let hw = (w as u32).div_ceil(f16);
-            let (tx0, ty0, tx1, ty1) = (
-                bounds[0] / f16,
-                bounds[1] / f16,
-                bounds[2] / f16,
-                bounds[3] / f16,
-            );
-            // Long segments span many blocks; testing them is not worth the reads.
-            if (tx1 - tx0 + 1) * (ty1 - ty0 + 1) <= 16 {
-                let nearest = s0[2].min(s1[2]);
-                let farthest = (ty0..=ty1)
-                    .flat_map(|ty| (tx0..=tx1).map(move |tx| (ty * hw + tx) as usize))
-                    .map(|i| hiz.load_f32(i))
-                    .fold(0.0f32, f32::max);
-                if nearest > farthest {
-                    return None;
-                }
+            let farthest = super::depth_downsample::farthest(hiz, w as u32, bounds);
+            if farthest.is_some_and(|far| s0[2].min(s1[2]) > far) {
+                return None;
             }
         }
         Some((bounds, screen_bin(w, h, s0, s1)))

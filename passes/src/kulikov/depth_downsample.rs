@@ -11,12 +11,15 @@
 
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
-use crate::kernel::Ctx;
+use crate::kernel::{Ctx, Words};
 use crate::params::NoParams;
 use strandgraph_graph::schema::Quantity;
 
 /// Block edge in pixels.
 pub const FACTOR: u32 = 16;
+/// A box over more blocks than this is not tested against the Hi-Z
+/// ([`farthest`]): long segments are not worth the reads.
+pub const MAX_BLOCKS: u32 = 16;
 /// One lane per texel of a block.
 const GROUP: u32 = FACTOR * FACTOR;
 
@@ -68,4 +71,21 @@ impl CpuKernel for DownsampleKernel {
         }
         hiz.store(group as usize, far);
     }
+}
+
+/// The farthest depth in `hiz` (a screen `width` pixels wide) over the
+/// blocks that pixel box `bounds` (x0, y0, x1, y1, inclusive, on screen)
+/// touches; `None` when it touches more than [`MAX_BLOCKS`]. The test
+/// `kulikov.cull` and `lipp.raster` share (shaders/common/hiz.wgsl).
+pub fn farthest(hiz: &Words<'_>, width: u32, bounds: [u32; 4]) -> Option<f32> {
+    let [tx0, ty0, tx1, ty1] = bounds.map(|b| b / FACTOR);
+    if (tx1 - tx0 + 1) * (ty1 - ty0 + 1) > MAX_BLOCKS {
+        return None;
+    }
+    let hw = width.div_ceil(FACTOR);
+    let far = (ty0..=ty1)
+        .flat_map(|ty| (tx0..=tx1).map(move |tx| (ty * hw + tx) as usize))
+        .map(|i| hiz.load_f32(i))
+        .fold(0.0f32, f32::max);
+    Some(far)
 }

@@ -78,6 +78,7 @@ pub(crate) fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
         .buffer("bundle_lod", vec![0; 8])
         .buffer("raster_args", vec![0; 8])
         .buffer("scene.depth", vec![1.0f32.to_bits(); (W * H) as usize])
+        .buffer("hiz", vec![1.0f32.to_bits(); hiz_blocks()])
         .buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
     let lod = LOD
         .cpu_kernel(&ron::from_str(r#"{"enabled": false}"#).unwrap())
@@ -89,6 +90,10 @@ pub(crate) fn harness(raster: &str, subgroup: u32) -> (Harness, u32) {
     let k = crate::PassDef::cpu_kernel(&RASTER, &ron::from_str(raster).unwrap()).unwrap();
     h.run(k.as_ref(), groups, RASTER_GROUP);
     (h, groups)
+}
+
+fn hiz_blocks() -> usize {
+    (W.div_ceil(16) * H.div_ceil(16)) as usize
 }
 
 fn payloads(h: &Harness) -> Vec<u64> {
@@ -191,6 +196,39 @@ fn depth_test_against_the_scene_rejects_hidden_strands() {
     let c = h.run(k.as_ref(), groups, RASTER_GROUP);
     assert_eq!(c.pixels_written, 0);
     assert!(payloads(&h).iter().all(|&x| x == EMPTY));
+}
+
+#[test]
+fn occlusion_culling_skips_hidden_segments_and_changes_nothing() {
+    use crate::kulikov::depth_downsample::DEPTH_DOWNSAMPLE;
+    let (mut h, _) = harness("{}", 32);
+    // A wall over the left half at the strands' median depth.
+    let mut depths: Vec<f32> = payloads(&h)
+        .iter()
+        .filter(|&&x| x != EMPTY)
+        .map(|&x| unpack(x).depth)
+        .collect();
+    depths.sort_by(f32::total_cmp);
+    let wall = depths[depths.len() / 2];
+    let scene = (0..W * H).map(|i| if i % W < W / 2 { wall } else { 1.0 });
+    h.buffer("scene.depth", scene.map(f32::to_bits).collect());
+    let downsample = DEPTH_DOWNSAMPLE.cpu_kernel(&ron::Value::Unit).unwrap();
+    h.run(downsample.as_ref(), hiz_blocks() as u32, 256);
+    let groups = h.read("raster_args")[0];
+    let mut draw = |params: &str| {
+        h.buffer("gbuffer", vec![u32::MAX; (4 * W * H) as usize]);
+        let k = crate::PassDef::cpu_kernel(&RASTER, &ron::from_str(params).unwrap()).unwrap();
+        let c = h.run(k.as_ref(), groups, RASTER_GROUP);
+        (payloads(&h), c.culled, c.atomics)
+    };
+    let (culled, n, atomics) = draw("{}");
+    let (walked, none, all_atomics) = draw(r#"{"occlusion_cull": false}"#);
+    assert_eq!(none, 0);
+    assert!(n > 0, "no segment was culled");
+    assert!(culled == walked, "culling changed the G-buffer");
+    // Culled segments are the ones whose samples the depth test rejects.
+    assert_eq!(atomics, all_atomics);
+    assert!(culled.iter().any(|&x| x != EMPTY));
 }
 
 #[test]
