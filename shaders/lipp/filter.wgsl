@@ -35,6 +35,8 @@ struct FilterParams {
     model_index: u32,
     // Ours: a tap reads the neighbour's centre-layer record (shaded.rs).
     packed_taps: u32,
+    // Ours: pixels; only taps this near the tangent's line (0: every tap).
+    band: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -114,6 +116,22 @@ fn screen_tangent(x: u32, y: u32, s: Sample) -> vec2<f32> {
     return n.xy;
 }
 
+// filter::band_span: the taps dx of window row dy within params.band of the
+// line along unit tangent tp (lo > hi: none).
+fn band_span(dy: f32, tp: vec2<f32>, r: i32) -> vec2<i32> {
+    let c = dy * tp.x;
+    let band = params.band;
+    if band == 0.0 {
+        return vec2<i32>(-r, r);
+    }
+    if abs(tp.y) < 1e-6 {
+        return select(vec2<i32>(1, 0), vec2<i32>(-r, r), abs(c) <= band);
+    }
+    let a = (c - band) / tp.y;
+    let b = (c + band) / tp.y;
+    return vec2<i32>(max(i32(ceil(min(a, b))), -r), min(i32(floor(max(a, b))), r));
+}
+
 // filter::reconstruct: (filtered colour, alpha). With `parts` lanes a
 // pixel (filter_pairs), lane `part` takes every parts-th row of the window
 // and the lanes add their sums (filter.rs, `pairs`).
@@ -137,7 +155,8 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promote
     let z_far = ndc(d_ref + params.depth_threshold);
     let rect = shaded_rect();
     for (var dy = -r + i32(part); dy <= r; dy += i32(parts)) {
-        for (var dx = -r; dx <= r; dx++) {
+        let span = band_span(f32(dy), tp, r);
+        for (var dx = span.x; dx <= span.y; dx++) {
             let qx = i32(x) + dx;
             let qy = i32(y) + dy;
             if qx < rect.x || qy < rect.y || qx >= rect.z || qy >= rect.w {

@@ -331,6 +331,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Ours: every tap of the window, not only the band along the tangent
+    // (passes/src/lipp/filter.rs, `band`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, filter over the whole window",
+        graph: LIPP,
+        overrides: &["filter.band=0.0"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // lipp.shade over every pixel, as the paper's deferred shading, and
     // lipp.clear_gbuffer over the whole G-buffer, rather than the groom's
     // screen rectangle (passes/src/lipp/rect.rs).

@@ -103,6 +103,13 @@ pub struct FilterParams {
     /// The sums are the same up to the order of two additions. Off
     /// (`filter_pixels`), a workgroup of the same 128 lanes takes two tiles.
     pub pairs: bool,
+    /// Ours: pixels; only the window's taps within `band` of the line
+    /// through the pixel along its screen tangent are read (0: every tap,
+    /// as published). Across the strand the spatial Gaussian has
+    /// σ⊥ = radius · s_perp (0.5 px by default), so a tap 2.5 px off the
+    /// line weighs at most e^-25 of one on it; the opacity strip
+    /// (`strip_width`) lies inside the band. At least `strip_width`.
+    pub band: f32,
 }
 
 impl Default for FilterParams {
@@ -125,6 +132,7 @@ impl Default for FilterParams {
             model_index: 0,
             packed_taps: true,
             pairs: true,
+            band: 2.5,
         }
     }
 }
@@ -159,6 +167,15 @@ impl PassParams for FilterParams {
                 return Err(Invalid::new(name, format!("{v} must be positive")));
             }
         }
+        if !(self.band == 0.0 || (self.band.is_finite() && self.band >= self.strip_width)) {
+            return Err(Invalid::new(
+                "band",
+                format!(
+                    "{} is neither 0 (off) nor at least strip_width ({})",
+                    self.band, self.strip_width
+                ),
+            ));
+        }
         Ok(())
     }
 }
@@ -185,6 +202,7 @@ crate::gpu_block! {
         centre_diameter: f32,
         model_index: u32,
         packed_taps: u32,
+        band: f32,
     }
 }
 
@@ -229,9 +247,27 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         centre_diameter: p.centre_diameter,
         model_index: p.model_index,
         packed_taps: flag(p.packed_taps),
+        band: p.band,
     },
     raster: None,
 };
+
+/// The taps `dx` of window row `dy` within `band` pixels of the line along
+/// unit screen tangent `tp` (`FilterParams::band`; 0: the whole row): the
+/// distance of (dx, dy) from it is |dx · ty − dy · tx|.
+pub fn band_span(band: f32, dy: f32, tp: [f32; 2], r: i32) -> (i32, i32) {
+    let c = dy * tp[0];
+    if band == 0.0 {
+        return (-r, r);
+    }
+    if tp[1].abs() < 1e-6 {
+        return if c.abs() <= band { (-r, r) } else { (1, 0) };
+    }
+    let (a, b) = ((c - band) / tp[1], (c + band) / tp[1]);
+    let lo = (a.min(b).ceil() as i32).max(-r);
+    let hi = (a.max(b).floor() as i32).min(r);
+    (lo, hi)
+}
 
 /// Linear view depth of NDC depth `z` (glam's `perspective_rh`, z in [0, 1]).
 pub fn linear_depth(f: &FrameData, z: f32) -> f32 {
@@ -367,7 +403,8 @@ pub fn reconstruct(
     };
     let z_far = ndc_depth(v.f, d_ref + p.depth_threshold);
     for dy in -r..=r {
-        for dx in -r..=r {
+        let (lo, hi) = band_span(p.band, dy as f32, tp, r);
+        for dx in lo..=hi {
             let (qx, qy) = (x as i32 + dx, y as i32 + dy);
             let r = &v.rect;
             if qx < r.x0 as i32 || qy < r.y0 as i32 || qx >= r.x1 as i32 || qy >= r.y1 as i32 {
@@ -600,6 +637,72 @@ mod tests {
         assert!(FILTER.params(&v).is_err());
         let v: ron::Value = ron::from_str(r#"{"centre_diameter": 1.0}"#).unwrap();
         assert!(FILTER.params(&v).is_err());
+        // The band must hold the opacity strip.
+        let v: ron::Value = ron::from_str(r#"{"band": 0.25}"#).unwrap();
+        assert!(FILTER.params(&v).is_err());
+    }
+
+    #[test]
+    fn a_band_row_holds_exactly_the_taps_near_the_line() {
+        let r = 5;
+        for k in 0..720 {
+            let a = k as f32 * std::f32::consts::PI / 360.0;
+            let tp = [a.cos(), a.sin()];
+            for band in [0.5, 1.0, 2.5, 4.0] {
+                for dy in -r..=r {
+                    let (lo, hi) = band_span(band, dy as f32, tp, r);
+                    for dx in -r..=r {
+                        let d = (dx as f32 * tp[1] - dy as f32 * tp[0]).abs();
+                        // Taps on the band's edge may go either way.
+                        if (d - band).abs() > 1e-4 {
+                            assert_eq!(
+                                lo <= dx && dx <= hi,
+                                d < band,
+                                "{tp:?} band {band} ({dx}, {dy})"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(band_span(0.0, 3.0, [0.6, 0.8], r), (-r, r));
+    }
+
+    #[test]
+    fn the_band_leaves_opacity_as_it_was_and_colour_within_a_rounding() {
+        let (mut g, mut sh) = (Vec::new(), Vec::new());
+        let (f, w, h) = scene(&mut g, &mut sh);
+        let oob = AtomicU64::new(0);
+        let v = test_view(&f, &g, &sh, &oob);
+        // Largest colour difference and pixels changed, band against none.
+        let compare = |band: FilterParams| {
+            let whole = FilterParams { band: 0.0, ..band };
+            let (mut worst, mut differ) = (0.0f32, 0);
+            for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
+                let (a, b) = (
+                    filter_pixel(&band, &v, x, y),
+                    filter_pixel(&whole, &v, x, y),
+                );
+                assert_eq!(a.is_some(), b.is_some());
+                let (Some(a), Some(b)) = (a, b) else { continue };
+                assert_eq!(a.alpha, b.alpha, "pixel ({x}, {y})");
+                for k in 0..3 {
+                    worst = worst.max((a.color[k] - b.color[k]).abs());
+                }
+                differ += usize::from(a.color != b.color);
+            }
+            (worst, differ)
+        };
+        // Taps off the band weigh e^-25 or less of the pixel's own.
+        let (worst, _) = compare(FilterParams::default());
+        assert!(worst < 1e-5, "{worst}");
+        // Across a wider Gaussian they would count: the band does leave
+        // them out.
+        let (_, differ) = compare(FilterParams {
+            s_perp: 0.5,
+            ..FilterParams::default()
+        });
+        assert!(differ > 0, "the band read every tap");
     }
 
     /// A 96×64 frame of random samples in a 20 cm depth range (a quarter
