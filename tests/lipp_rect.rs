@@ -187,3 +187,41 @@ fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
         "{message}"
     );
 }
+
+/// A graph whose `filter_args` has no room for the shaded rectangle that
+/// `lipp.shade` writes and `lipp.filter` reads (words 4-5) is an error
+/// naming the pass and the buffer: the filter would otherwise take the
+/// whole screen as shaded and read stale records outside the rectangle.
+#[test]
+fn a_filter_args_without_room_for_the_rectangle_is_an_error() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("scenes/graphs/lipp.ron")).unwrap();
+    let small = text.replace(
+        r#"Buffer(name: "filter_args", size: Bytes(24))"#,
+        r#"Buffer(name: "filter_args", size: Bytes(16))"#,
+    );
+    assert_ne!(small, text, "lipp.ron declares filter_args as 24 bytes");
+    let dir = std::env::temp_dir().join(format!("lipp_rect_filter_args_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let graph = dir.join("lipp_small.ron");
+    std::fs::write(&graph, small).unwrap();
+    let p = prepare_with(
+        &root.join("scenes/distances/far.ron"),
+        Some(&graph),
+        Some((64, 36)),
+        &[],
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    let e = CpuBackend::default()
+        .execute(&p.plan, &p.instance, &p.upload)
+        .err()
+        .expect("a filter_args too small for the rectangle");
+    let message = e.to_string();
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(
+        message.contains("`shade`")
+            && message.contains("`filter_args`")
+            && message.contains("24 bytes"),
+        "{message}"
+    );
+}

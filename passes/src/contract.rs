@@ -15,6 +15,12 @@ use strandgraph_graph::schema::{AccessMode, Quantity};
 pub struct Binding {
     pub name: &'static str,
     pub mode: AccessMode,
+    /// Words the pass reads or writes at fixed places of the resource
+    /// (say, arguments past an indirect dispatch's); 0: none. A graph whose
+    /// resource is smaller is an error ([`Binding::check_size`]), not an
+    /// access past its end, which neither Vulkan nor WGSL's clamping would
+    /// report.
+    pub min_words: u32,
 }
 
 impl Binding {
@@ -22,19 +28,41 @@ impl Binding {
         Self {
             name,
             mode: AccessMode::Read,
+            min_words: 0,
         }
     }
     pub const fn write(name: &'static str) -> Self {
         Self {
             name,
             mode: AccessMode::Write,
+            min_words: 0,
         }
     }
     pub const fn atomic(name: &'static str) -> Self {
         Self {
             name,
             mode: AccessMode::Atomic,
+            min_words: 0,
         }
+    }
+    /// This binding with at least `words` words.
+    pub const fn at_least(self, words: u32) -> Self {
+        Self {
+            min_words: words,
+            ..self
+        }
+    }
+    /// An error unless the bound resource's `words` hold [`Self::min_words`].
+    pub fn check_size(&self, words: u64) -> Result<(), String> {
+        if words >= u64::from(self.min_words) {
+            return Ok(());
+        }
+        Err(format!(
+            "the pass uses words 0..{} of `{}`, which holds {words}: give it at least {} bytes",
+            self.min_words,
+            self.name,
+            4 * u64::from(self.min_words)
+        ))
     }
 }
 
@@ -356,6 +384,13 @@ mod tests {
             word: 0,
         };
         assert_eq!(indirect.direct_groups(&q, 1000), None);
+        assert!(Binding::read("args").at_least(6).check_size(6).is_ok());
+        let e = Binding::read("filter_args")
+            .at_least(6)
+            .check_size(4)
+            .unwrap_err();
+        assert!(e.contains("`filter_args`") && e.contains("24 bytes"), "{e}");
+        assert!(Binding::read("args").check_size(0).is_ok());
         assert!(Dispatch::check_indirect("args", 8, 11).is_ok());
         let e = Dispatch::check_indirect("raster_args", 8, 8).unwrap_err();
         assert!(

@@ -89,14 +89,17 @@ impl PassDef for Mix {
             Binding {
                 name: "a",
                 mode: Read,
+                min_words: 0,
             },
             Binding {
                 name: "b",
                 mode: Read,
+                min_words: 0,
             },
             Binding {
                 name: "out",
                 mode: Write,
+                min_words: 0,
             },
         ])
     }
@@ -136,10 +139,12 @@ impl PassDef for Sum {
             Binding {
                 name: "c",
                 mode: Read,
+                min_words: 0,
             },
             Binding {
                 name: "total",
                 mode: Atomic,
+                min_words: 0,
             },
         ])
     }

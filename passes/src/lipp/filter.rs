@@ -218,7 +218,8 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         Binding::write("hair_depth"),
         Binding::read("models"),
         Binding::read("filter_tiles"),
-        Binding::read("filter_args"),
+        // The dispatch (words 0-3) and the shaded rectangle (rect.rs).
+        Binding::read("filter_args").at_least(super::rect::FILTER_RECT_HI as u32 + 1),
     ]),
     workgroup_size: FILTER_GROUP,
     // A workgroup per tile lipp.shade listed (super::tiles).

@@ -193,7 +193,8 @@ pub static SHADE: PassKind<ShadeParams, ShadeGpu> = PassKind {
         Binding::write("shaded"),
         Binding::read("env.prefiltered"),
         Binding::write("filter_tiles"),
-        Binding::atomic("filter_args"),
+        // The filter's dispatch and the shaded rectangle (rect.rs).
+        Binding::atomic("filter_args").at_least(super::rect::FILTER_RECT_HI as u32 + 1),
     ]),
     // Threads: two a pixel, one per layer (shaders/lipp/shade.wgsl).
     workgroup_size: 2 * SHADE_GROUP,
