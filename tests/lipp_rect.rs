@@ -151,22 +151,19 @@ fn the_rectangle_changes_no_pixel_of_two_grooms_drawn_one_after_the_other() {
     assert_eq!(differ, 0, "{differ} words of the output differ");
 }
 
-/// A graph whose `raster_args` has no room for the runs' dispatch that
-/// `lipp.clear_gbuffer` and `lipp.shade` read (words 8-10) is an error
-/// naming the pass and the buffer, not a read past its end.
-#[test]
-fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
+/// The error the CPU backend gives for `lipp.ron` with `declared`
+/// replaced by `small`, rendering the far view at 64×36.
+fn error_with(declared: &str, small: &str) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(root.join("scenes/graphs/lipp.ron")).unwrap();
-    let small = text.replace(
-        r#"Buffer(name: "raster_args", size: Bytes(52))"#,
-        r#"Buffer(name: "raster_args", size: Bytes(32))"#,
-    );
-    assert_ne!(small, text, "lipp.ron declares raster_args as 52 bytes");
+    let changed = text.replace(declared, small);
+    assert_ne!(changed, text, "lipp.ron declares {declared}");
     let dir = std::env::temp_dir().join(format!("lipp_rect_small_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let graph = dir.join("lipp_small.ron");
-    std::fs::write(&graph, small).unwrap();
+    // One file per change: the tests run in parallel.
+    let tag: String = small.chars().filter(char::is_ascii_alphanumeric).collect();
+    let graph = dir.join(format!("lipp_{tag}.ron"));
+    std::fs::write(&graph, changed).unwrap();
     let p = prepare_with(
         &root.join("scenes/distances/far.ron"),
         Some(&graph),
@@ -177,9 +174,20 @@ fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
     let e = CpuBackend::default()
         .execute(&p.plan, &p.instance, &p.upload)
         .err()
-        .expect("a dispatch past the end of raster_args");
-    let message = e.to_string();
-    std::fs::remove_dir_all(&dir).ok();
+        .unwrap_or_else(|| panic!("no error with {small}"));
+    std::fs::remove_file(&graph).ok();
+    e.to_string()
+}
+
+/// A graph whose `raster_args` has no room for the runs' dispatch that
+/// `lipp.clear_gbuffer` and `lipp.shade` read (words 8-10) is an error
+/// naming the pass and the buffer, not a read past its end.
+#[test]
+fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
+    let message = error_with(
+        r#"Buffer(name: "raster_args", size: Bytes(52))"#,
+        r#"Buffer(name: "raster_args", size: Bytes(32))"#,
+    );
     assert!(
         message.contains("clear_gbuffer")
             && message.contains("`raster_args`")
@@ -194,30 +202,10 @@ fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
 /// whole screen as shaded and read stale records outside the rectangle.
 #[test]
 fn a_filter_args_without_room_for_the_rectangle_is_an_error() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("scenes/graphs/lipp.ron")).unwrap();
-    let small = text.replace(
+    let message = error_with(
         r#"Buffer(name: "filter_args", size: Bytes(24))"#,
         r#"Buffer(name: "filter_args", size: Bytes(16))"#,
     );
-    assert_ne!(small, text, "lipp.ron declares filter_args as 24 bytes");
-    let dir = std::env::temp_dir().join(format!("lipp_rect_filter_args_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let graph = dir.join("lipp_small.ron");
-    std::fs::write(&graph, small).unwrap();
-    let p = prepare_with(
-        &root.join("scenes/distances/far.ron"),
-        Some(&graph),
-        Some((64, 36)),
-        &[],
-    )
-    .unwrap_or_else(|e| panic!("{e:?}"));
-    let e = CpuBackend::default()
-        .execute(&p.plan, &p.instance, &p.upload)
-        .err()
-        .expect("a filter_args too small for the rectangle");
-    let message = e.to_string();
-    std::fs::remove_dir_all(&dir).ok();
     assert!(
         message.contains("`shade`")
             && message.contains("`filter_args`")
