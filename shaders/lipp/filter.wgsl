@@ -81,11 +81,9 @@ fn tap(q: u32) -> vec2<u32> {
 }
 
 // filter::shaded_rect: the pixels lipp.shade wrote records for this frame
-// (lipp::rect); taps outside it read no hair.
+// (lipp::rect; filter_args holds them: the binding declares its size); taps
+// outside it read no hair.
 fn shaded_rect() -> vec4<i32> {
-    if arrayLength(&filter_args) <= FILTER_RECT_HI {
-        return vec4<i32>(0, 0, i32(params.width), i32(params.height));
-    }
     return vec4<i32>(rect_from_args(filter_args[FILTER_RECT_LO], filter_args[FILTER_RECT_HI]));
 }
 

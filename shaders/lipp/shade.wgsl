@@ -48,7 +48,7 @@ fn shade_sample(sm: Sample, x: u32, y: u32) -> vec3<f32> {
 // workgroup 0 tells lipp.filter.
 fn shaded_rect(wg: u32, lane: u32) -> vec4<u32> {
     let r = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
-    if arrayLength(&filter_args) > FILTER_RECT_HI && wg == 0u && lane == 0u {
+    if wg == 0u && lane == 0u {
         let a = rect_args(r);
         atomicStore(&filter_args[FILTER_RECT_LO], a.x);
         atomicStore(&filter_args[FILTER_RECT_HI], a.y);

@@ -575,12 +575,9 @@ pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Ha
 }
 
 /// The pixels `lipp.shade` wrote records for this frame (`filter_args`
-/// words [`FILTER_RECT_LO`], [`FILTER_RECT_HI`]; the whole screen without
-/// room for them): outside, a tap reads no hair ([`super::rect`]).
-pub fn shaded_rect(args: &Words<'_>, w: u32, h: u32) -> Rect {
-    if args.len() <= FILTER_RECT_HI {
-        return Rect::full(w, h);
-    }
+/// words [`FILTER_RECT_LO`], [`FILTER_RECT_HI`], which the binding's
+/// declared size guarantees): outside, a tap reads no hair ([`super::rect`]).
+pub fn shaded_rect(args: &Words<'_>) -> Rect {
     Rect::from_args(args.load(FILTER_RECT_LO), args.load(FILTER_RECT_HI))
 }
 
@@ -601,7 +598,7 @@ impl CpuKernel for FilterKernel {
             shaded,
             thickness: read::<ModelData>(&ctx.words("models"), self.0.model_index as usize)
                 .thickness,
-            rect: shaded_rect(&args, w, h),
+            rect: shaded_rect(&args),
         };
         let (out, depth) = (ctx.words("output"), ctx.words("hair_depth"));
         let count = tiles::listed(&args, &tiles);

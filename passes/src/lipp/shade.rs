@@ -421,13 +421,12 @@ struct ShadeKernel(ShadeParams);
 impl ShadeKernel {
     /// The pixels this pass shades ([`super::rect`]): the groom's screen
     /// rectangle, which `lipp.lod_scan` wrote with the dispatch over its
-    /// runs. Workgroup 0 tells `lipp.filter`, if `filter_args` has room
-    /// (`filter_args` needs 24 bytes: the filter reads a smaller one as
-    /// the whole screen shaded).
+    /// runs. Workgroup 0 tells `lipp.filter` (`filter_args` holds the
+    /// words: the binding declares its size).
     fn shaded_rect(&self, ctx: &Ctx<'_>, group: u32) -> Rect {
         let (args, filter_args) = (ctx.words("raster_args"), ctx.words("filter_args"));
         let r = Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI));
-        if filter_args.len() > FILTER_RECT_HI && group == 0 {
+        if group == 0 {
             let [lo, hi] = r.args();
             filter_args.store(FILTER_RECT_LO, lo);
             filter_args.store(FILTER_RECT_HI, hi);
