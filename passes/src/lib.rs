@@ -51,6 +51,7 @@ pub static PASSES: &[&dyn PassDef] = &[
     &common::clear::CLEAR,
     &opaque_mesh::visibility::VISIBILITY,
     &opaque_mesh::depth_resolve::DEPTH_RESOLVE,
+    &opaque_mesh::depth_resolve::DEPTH_HIZ,
     &opaque_mesh::opaque::OPAQUE,
     &opaque_mesh::depth_attachment::DEPTH_ATTACHMENT,
     // Kulikov 2025, SIGGRAPH Advances: Indiana Jones strand hair.

@@ -4,13 +4,22 @@
 //! `scene.depth`, an `R32Float` screen image of NDC depth z/w (glam
 //! `perspective_rh`: 0 at the near plane, 1 at the far plane): the high half
 //! of each pixel's `scene.visibility` word, or 1.0 where no triangle is.
+//!
+//! `scene.depth_hiz` (ours) also writes `hiz`, the farthest depth of each
+//! 16×16 block that `kulikov.depth_downsample` would make from
+//! `scene.depth`: one workgroup per block resolves the block's pixels and
+//! reduces them. A graph that culls against the Hi-Z saves a pass, its
+//! barrier and its second read of the screen (the Lipp graphs;
+//! `kulikov.ron` keeps the two passes on its async queue).
 
 use super::visibility::unpack;
 use super::{PIXEL_GROUP, pixel_dispatch};
-use crate::contract::{Binding, CpuKernel, Shader};
+use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
+use crate::kulikov::depth_downsample::FACTOR;
 use crate::params::NoParams;
+use strandgraph_graph::schema::Quantity;
 
 crate::gpu_block! {
     /// `DepthResolveParams` in shaders/opaque_mesh/depth_resolve.wgsl.
@@ -39,6 +48,29 @@ pub static DEPTH_RESOLVE: PassKind<NoParams, DepthResolveGpu> = PassKind {
     raster: None,
 };
 
+pub static DEPTH_HIZ: PassKind<NoParams, DepthResolveGpu> = PassKind {
+    kind: "scene.depth_hiz",
+    summary: "scene depth from the visibility buffer and its 16x16 farthest-depth Hi-Z, in one pass",
+    source: "strandgraph; the Hi-Z of Kulikov 2025, 'Culling'",
+    bindings: Some(&[
+        Binding::read("scene.visibility"),
+        Binding::write("scene.depth"),
+        Binding::write("hiz"),
+    ]),
+    workgroup_size: FACTOR * FACTOR,
+    dispatch: Dispatch::PerElement {
+        quantity: Quantity::Tiles(FACTOR),
+        per_group: 1,
+    },
+    shader: Shader::compute("opaque_mesh/depth_resolve.wgsl", "resolve_hiz"),
+    kernel: |_| Box::new(ResolveHizKernel),
+    gpu: |_, q| DepthResolveGpu {
+        width: q.width,
+        height: q.height,
+    },
+    raster: None,
+};
+
 /// NDC depth of a visibility word: the far plane where it is empty.
 pub fn depth(word: u64) -> f32 {
     unpack(word).map_or(1.0, |(_, z)| z)
@@ -55,6 +87,35 @@ impl CpuKernel for ResolveKernel {
         for i in first..(first + PIXEL_GROUP as usize).min(pixels) {
             out.store_f32(i, depth(vis.load_u64(i)));
         }
+    }
+}
+
+struct ResolveHizKernel;
+
+impl CpuKernel for ResolveHizKernel {
+    fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
+        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
+        let hw = w.div_ceil(FACTOR);
+        if group >= hw * h.div_ceil(FACTOR) {
+            return;
+        }
+        let (vis, out, hiz) = (
+            ctx.words("scene.visibility"),
+            ctx.words("scene.depth"),
+            ctx.words("hiz"),
+        );
+        let (bx, by) = (group % hw * FACTOR, group / hw * FACTOR);
+        // kulikov.depth_downsample's maximum on the bits, sign cleared.
+        let mut far = 0u32;
+        for y in by..(by + FACTOR).min(h) {
+            for x in bx..(bx + FACTOR).min(w) {
+                let i = (y * w + x) as usize;
+                let z = depth(vis.load_u64(i));
+                out.store_f32(i, z);
+                far = far.max(z.to_bits() & 0x7FFF_FFFF);
+            }
+        }
+        hiz.store(group as usize, far);
     }
 }
 
@@ -81,5 +142,34 @@ mod tests {
         }
         assert!(z.iter().any(|&d| d != 1.0f32.to_bits()));
         assert!(z.iter().any(|&d| d == 1.0f32.to_bits()));
+    }
+
+    /// The fused pass writes what `scene.depth_resolve` then
+    /// `kulikov.depth_downsample` write, on a screen whose edges cut
+    /// blocks (97 x 61 is not a multiple of 16).
+    #[test]
+    fn depth_hiz_is_the_resolve_then_the_downsample() {
+        use crate::kulikov::depth_downsample::DEPTH_DOWNSAMPLE;
+        let f = frame(Vec3::new(0.0, 0.0, 0.3), Vec3::ZERO, 35.0, 97, 61);
+        // 7 x 4 blocks.
+        let with_hiz = || {
+            let mut hs = harness(f, &head(), &[]);
+            hs.buffer("hiz", vec![0; 7 * 4]);
+            hs
+        };
+        let (two, one) = (with_hiz(), with_hiz());
+        for hs in [&two, &one] {
+            run(hs, &VISIBILITY);
+        }
+        run(&two, &DEPTH_RESOLVE);
+        run(&two, &DEPTH_DOWNSAMPLE);
+        run(&one, &DEPTH_HIZ);
+        assert_eq!(one.out_of_bounds(), 0);
+        assert_eq!(one.read("scene.depth"), two.read("scene.depth"));
+        let hiz = one.read("hiz");
+        assert_eq!(hiz, two.read("hiz"));
+        // Blocks the head fills, and the background.
+        assert!(hiz.iter().any(|&d| d != 1.0f32.to_bits()));
+        assert!(hiz.iter().any(|&d| d == 1.0f32.to_bits()));
     }
 }
