@@ -2,7 +2,7 @@
 // Port of passes/src/kulikov/depth_downsample.rs: one workgroup per block,
 // one lane per texel, the maximum an atomicMax on the depth bits.
 
-#import strandgraph::hiz::HIZ_FACTOR
+#import strandgraph::hiz::{hiz_block, hiz_block_pixel, hiz_bits}
 
 // The screen size the CPU kernel reads from the scene quantities.
 struct DepthDownsampleParams {
@@ -22,19 +22,13 @@ fn downsample(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_in
         atomicStore(&farthest, 0u);
     }
     workgroupBarrier();
-    let hw = (params.width + HIZ_FACTOR - 1u) / HIZ_FACTOR;
-    let bx = wg.x % hw * HIZ_FACTOR;
-    let by = wg.x / hw * HIZ_FACTOR;
-    let x = bx + lane % HIZ_FACTOR;
-    let y = by + lane / HIZ_FACTOR;
-    if x < params.width && y < params.height {
-        // Depths are in [0, 1]; clearing the sign keeps a -0.0 from winning.
-        let bits = bitcast<u32>(textureLoad(scene_depth, vec2<u32>(x, y), 0).x) & 0x7FFFFFFFu;
-        atomicMax(&farthest, bits);
+    let p = hiz_block_pixel(wg.x, lane, params.width);
+    if p.x < params.width && p.y < params.height {
+        atomicMax(&farthest, hiz_bits(textureLoad(scene_depth, p, 0).x));
     }
     workgroupBarrier();
     if lane == 0u {
         let far = bitcast<f32>(atomicLoad(&farthest));
-        textureStore(hiz, vec2<u32>(wg.x % hw, wg.x / hw), vec4<f32>(far, 0.0, 0.0, 1.0));
+        textureStore(hiz, hiz_block(wg.x, params.width), vec4<f32>(far, 0.0, 0.0, 1.0));
     }
 }

@@ -10,7 +10,7 @@
 // pairs, low word first), 2 = scene.depth (R32Float storage image),
 // 3 = hiz (R32Float storage image, scene.depth_hiz only).
 
-#import strandgraph::hiz::HIZ_FACTOR
+#import strandgraph::hiz::{hiz_block, hiz_block_pixel, hiz_bits}
 
 struct DepthResolveParams {
     width: u32,
@@ -46,17 +46,14 @@ fn resolve_hiz(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_i
         atomicStore(&farthest, 0u);
     }
     workgroupBarrier();
-    let hw = (params.width + HIZ_FACTOR - 1u) / HIZ_FACTOR;
-    let x = wg.x % hw * HIZ_FACTOR + lane % HIZ_FACTOR;
-    let y = wg.x / hw * HIZ_FACTOR + lane / HIZ_FACTOR;
-    if x < params.width && y < params.height {
-        let z = resolved(y * params.width + x);
-        textureStore(scene_depth, vec2<u32>(x, y), vec4<f32>(z, 0.0, 0.0, 1.0));
-        // Depths are in [0, 1]; clearing the sign keeps a -0.0 from winning.
-        atomicMax(&farthest, bitcast<u32>(z) & 0x7FFFFFFFu);
+    let p = hiz_block_pixel(wg.x, lane, params.width);
+    if p.x < params.width && p.y < params.height {
+        let z = resolved(p.y * params.width + p.x);
+        textureStore(scene_depth, p, vec4<f32>(z, 0.0, 0.0, 1.0));
+        atomicMax(&farthest, hiz_bits(z));
     }
     workgroupBarrier();
     if lane == 0u {
-        textureStore(hiz, vec2<u32>(wg.x % hw, wg.x / hw), vec4<f32>(bitcast<f32>(atomicLoad(&farthest)), 0.0, 0.0, 1.0));
+        textureStore(hiz, hiz_block(wg.x, params.width), vec4<f32>(bitcast<f32>(atomicLoad(&farthest)), 0.0, 0.0, 1.0));
     }
 }

@@ -55,22 +55,38 @@ struct DownsampleKernel;
 impl CpuKernel for DownsampleKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let (w, h) = (ctx.quantities.width, ctx.quantities.height);
-        let hw = w.div_ceil(FACTOR);
-        if group >= hw * h.div_ceil(FACTOR) {
+        let Some(pixels) = block_pixels(group, w, h) else {
             return;
-        }
+        };
         let (depth, hiz) = (ctx.words("scene.depth"), ctx.words("hiz"));
-        let (bx, by) = (group % hw * FACTOR, group / hw * FACTOR);
-        // The lanes' atomicMax on the bits, with the sign bit cleared as the
-        // WGSL does (a -0.0 must not order above every depth).
-        let mut far = 0u32;
-        for y in by..(by + FACTOR).min(h) {
-            for x in bx..(bx + FACTOR).min(w) {
-                far = far.max(depth.load((y * w + x) as usize) & 0x7FFF_FFFF);
-            }
-        }
+        // The lanes' atomicMax on the bits.
+        let far = pixels
+            .map(|(x, y)| depth_bits(depth.load_f32((y * w + x) as usize)))
+            .max()
+            .unwrap_or(0);
         hiz.store(group as usize, far);
     }
+}
+
+/// The pixels of Hi-Z block `block` of a `w`×`h` screen, the blocks
+/// numbered row by row; `None` past the last block (shaders/common/hiz.wgsl,
+/// `hiz_block_pixel`).
+pub fn block_pixels(block: u32, w: u32, h: u32) -> Option<impl Iterator<Item = (u32, u32)>> {
+    let blocks_x = w.div_ceil(FACTOR);
+    if block >= blocks_x * h.div_ceil(FACTOR) {
+        return None;
+    }
+    let (bx, by) = (block % blocks_x * FACTOR, block / blocks_x * FACTOR);
+    Some(
+        (by..(by + FACTOR).min(h))
+            .flat_map(move |y| (bx..(bx + FACTOR).min(w)).map(move |x| (x, y))),
+    )
+}
+
+/// A depth's bits, ordered as the depths (`hiz_bits`): depths are in
+/// [0, 1], and clearing the sign keeps a -0.0 from ordering above them all.
+pub fn depth_bits(z: f32) -> u32 {
+    z.to_bits() & 0x7FFF_FFFF
 }
 
 /// The farthest depth in `hiz` (a screen `width` pixels wide) over the

@@ -17,7 +17,7 @@ use super::{PIXEL_GROUP, pixel_dispatch};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
-use crate::kulikov::depth_downsample::FACTOR;
+use crate::kulikov::depth_downsample::{FACTOR, block_pixels, depth_bits};
 use crate::params::NoParams;
 use strandgraph_graph::schema::Quantity;
 
@@ -94,26 +94,22 @@ struct ResolveHizKernel;
 
 impl CpuKernel for ResolveHizKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let (w, h) = (ctx.quantities.width, ctx.quantities.height);
-        let hw = w.div_ceil(FACTOR);
-        if group >= hw * h.div_ceil(FACTOR) {
+        let w = ctx.quantities.width;
+        let Some(pixels) = block_pixels(group, w, ctx.quantities.height) else {
             return;
-        }
+        };
         let (vis, out, hiz) = (
             ctx.words("scene.visibility"),
             ctx.words("scene.depth"),
             ctx.words("hiz"),
         );
-        let (bx, by) = (group % hw * FACTOR, group / hw * FACTOR);
-        // kulikov.depth_downsample's maximum on the bits, sign cleared.
+        // kulikov.depth_downsample's maximum of the block.
         let mut far = 0u32;
-        for y in by..(by + FACTOR).min(h) {
-            for x in bx..(bx + FACTOR).min(w) {
-                let i = (y * w + x) as usize;
-                let z = depth(vis.load_u64(i));
-                out.store_f32(i, z);
-                far = far.max(z.to_bits() & 0x7FFF_FFFF);
-            }
+        for (x, y) in pixels {
+            let i = (y * w + x) as usize;
+            let z = depth(vis.load_u64(i));
+            out.store_f32(i, z);
+            far = far.max(depth_bits(z));
         }
         hiz.store(group as usize, far);
     }
