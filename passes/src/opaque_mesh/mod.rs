@@ -4,7 +4,8 @@
 //! - `scene.visibility` rasterizes every triangle once, in a compute shader,
 //!   into a 64-bit visibility buffer (depth and triangle index per pixel);
 //! - `scene.depth_resolve` turns it into `scene.depth`, the depth image the
-//!   hair pipelines cull and depth-test against;
+//!   hair pipelines cull and depth-test against (`scene.depth_hiz` also
+//!   writes its 16×16 farthest-depth Hi-Z in the same pass);
 //! - `scene.opaque` shades each covered pixel's triangle once;
 //! - `scene.depth_attachment` copies `scene.depth` into a depth attachment
 //!   for hair drawn through the hardware rasterizer.
