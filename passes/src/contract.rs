@@ -184,6 +184,16 @@ pub trait PassDef: Send + Sync {
     /// The bindings, or `None` when the pass binds whatever the graph gives it
     /// (`common.clear` clears every resource it writes).
     fn bindings(&self) -> Option<&'static [Binding]>;
+    /// An error unless each declared binding's resource holds the words it
+    /// needs ([`Binding::check_size`]); `words(name)` is what the backend
+    /// bound to `name`, 0 if nothing. Every backend calls it when it plans
+    /// the pass.
+    fn check_binding_sizes(&self, words: &dyn Fn(&str) -> u64) -> Result<(), String> {
+        self.bindings()
+            .unwrap_or(&[])
+            .iter()
+            .try_for_each(|b| b.check_size(words(b.name)))
+    }
     fn workgroup_size(&self) -> u32;
     fn dispatch(&self) -> Dispatch;
     fn shader(&self) -> Shader;

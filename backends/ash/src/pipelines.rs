@@ -353,11 +353,11 @@ fn launches(
         }
         return Ok((launches, sets));
     }
-    for b in prep.def.bindings().unwrap_or(&[]) {
-        let r = prep.bindings.iter().find(|(n, _, _)| n == b.name);
-        b.check_size(r.map_or(0, |(_, r, _)| words_of(*r)))
-            .map_err(err)?;
-    }
+    let words = |name: &str| {
+        let r = prep.bindings.iter().find(|(n, _, _)| n == name);
+        r.map_or(0, |(_, r, _)| words_of(*r))
+    };
+    prep.def.check_binding_sizes(&words).map_err(err)?;
     let is_buffer = |r: usize| matches!(cx.memory.res[r], Some(Res::Buffer { .. }));
     let most = prep
         .bindings

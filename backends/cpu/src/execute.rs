@@ -328,13 +328,12 @@ impl CpuBackend {
                 )
             })
             .collect();
-        for b in prep.def.bindings().unwrap_or(&[]) {
-            let words = bindings.get(b.name).map_or(0, |w| w.len() as u64);
-            b.check_size(words).map_err(|message| CpuError::Dispatch {
+        prep.def
+            .check_binding_sizes(&|name| bindings.get(name).map_or(0, |w| w.len() as u64))
+            .map_err(|message| CpuError::Dispatch {
                 pass: pass.name.clone(),
                 message,
             })?;
-        }
         let dispatch = prep.def.dispatch();
         let most = bindings.values().map(Words::len).max().unwrap_or(0) as u64;
         let groups = match dispatch.direct_groups(&instance.quantities, most) {

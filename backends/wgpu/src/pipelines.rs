@@ -275,11 +275,14 @@ fn build_compute(
 
 fn launch(cx: &PassContext<'_>) -> Result<Launch, WgpuError> {
     let bindings = &cx.prep.bindings;
-    for b in cx.prep.def.bindings().unwrap_or(&[]) {
-        let r = bindings.iter().find(|(n, _)| n == b.name).map(|(_, r)| *r);
-        let words = r.map_or(0, |r| cx.words_of(r));
-        b.check_size(words).map_err(|e| cx.error(e))?;
-    }
+    let words = |name: &str| {
+        let r = bindings.iter().find(|(n, _)| n == name);
+        r.map_or(0, |(_, r)| cx.words_of(*r))
+    };
+    cx.prep
+        .def
+        .check_binding_sizes(&words)
+        .map_err(|e| cx.error(e))?;
     let most = bindings
         .iter()
         .filter(|(_, r)| cx.is_buffer(*r))
