@@ -44,6 +44,11 @@ declare -A colour=(
   [Long]="1.3 0.1" [Straight]="7.0 0.0" [Wavy]="0.6 0.2" [Curly]="3.0 0.05"
   [Bob]="0.25 0.1" [Short]="4.0 0.0" [Ponytail]="1.0 0.7" [Bun]="2.0 0.1"
 )
+# Lipp's LOD strength λ (Eq. 2) per groom, as the paper tunes it per hairstyle:
+# about 0.5 m over the style's strand length, so that a short groom's small
+# bundles are thinned as the long hair's are at the same distance (at λ 1 a
+# brow's bundle a few pixels across keeps a few per cent of its strands).
+declare -A lambda=([Short]=14.0)
 # view: orbit distance, pitch
 declare -A view=([close]="0.95 0.0" [mid]="2.2 4.0" [far]="8.0 8.0")
 pipelines=(kulikov lipp scheuermann hw_strands)
@@ -73,7 +78,7 @@ Scene(
             parent: "head",
             hair_mesh: (bundles: 768, layers: 8),
             material: (melanin: $melanin, redness: $redness, roughness: 0.28),
-            lod: (enabled: true, shuffle_seed: 101, min_fraction: 0.05),
+            lod: (enabled: true, shuffle_seed: 101, min_fraction: 0.05, lambda: ${lambda[$style]:-1.0}),
         ),
         (
             name: "eyebrows",
@@ -82,6 +87,7 @@ Scene(
             hair_mesh: (bundles: 48, layers: 4),
             material: (melanin: $melanin, redness: $redness, roughness: 0.35),
             facial_hair: true,
+            lod: (lambda: 45.0),
         ),
         (
             name: "eyelashes",
@@ -90,6 +96,7 @@ Scene(
             hair_mesh: (bundles: 24, layers: 4),
             material: (melanin: 3.0, roughness: 0.35),
             facial_hair: true,
+            lod: (lambda: 55.0),
         ),
     ],
     graph: "../../../scenes/graphs/kulikov.ron",
