@@ -7,8 +7,14 @@
 //!   previously rendered grooms are rejected early": no beard sample lies
 //!   behind the hair depth the first groom's filter wrote, and the beard's
 //!   raster writes fewer pixels than with that depth switched off.
+//!
+//! And every groom of the showcase, its beard, brows and lashes too, keeps
+//! most of its strands under Lipp's LOD at the showcase's close-up: the
+//! scenes give short grooms their own λ (Eq. 2). At λ 1 the beard kept a
+//! few per cent of them and Lipp's picture showed none.
 
 use std::path::Path;
+use strandgraph::agree::capture;
 use strandgraph::frame::{Prepared, override_param, prepare};
 use strandgraph_cpu::{CpuBackend, Frame};
 use strandgraph_passes::lipp::payload::{EMPTY, from_words, unpack};
@@ -114,4 +120,41 @@ fn grooms_are_drawn_in_turn_with_their_materials_and_the_depth_between_them() {
         "beard pixels written: {beard} with the hair's depth, {unoccluded} without ({covered} hair-depth pixels)"
     );
     assert!(beard < unoccluded, "{beard} vs {unoccluded}");
+}
+
+/// Per groom drawn by `scene` through `lipp.ron`: (strands drawn, strands
+/// of the groom), from the `raster_args` each groom's raster ran with
+/// (words 3 and 4, lipp.lod_scan's).
+fn strands_drawn(scene: &str, (w, h): (u32, u32)) -> Vec<(u32, u32)> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let graph = root.join("scenes/graphs/lipp.ron");
+    let p = prepare(&root.join(scene), Some(&graph), Some((w, h)))
+        .unwrap_or_else(|e| panic!("{scene}: {e:?}"));
+    let mut out = Vec::new();
+    for c in capture(&p).unwrap_or_else(|e| panic!("{scene}: {e:?}")) {
+        if p.plan.graph.passes[c.pass].kind != "lipp.raster" {
+            continue;
+        }
+        let args = c.bindings.iter().find(|(n, _)| n == "raster_args");
+        let args = &args
+            .unwrap_or_else(|| panic!("raster without raster_args"))
+            .1;
+        out.push((args[3], args[4]));
+    }
+    out
+}
+
+#[test]
+fn the_showcases_short_grooms_keep_most_of_their_strands_under_lipps_lod() {
+    let grooms = strands_drawn("scenes/showcase.ron", (320, 180));
+    // Hair, eyebrows, eyelashes, beard (the scene's order).
+    assert_eq!(grooms.len(), 4, "{grooms:?}");
+    for (i, &(drawn, all)) in grooms.iter().enumerate() {
+        assert!(all > 0, "groom {i} has no strands: {grooms:?}");
+        let kept = f64::from(drawn) / f64::from(all);
+        assert!(
+            kept >= 0.5,
+            "groom {i} draws {drawn} of {all} strands: {grooms:?}"
+        );
+    }
 }
