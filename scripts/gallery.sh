@@ -44,10 +44,8 @@ declare -A colour=(
   [Long]="1.3 0.1" [Straight]="7.0 0.0" [Wavy]="0.6 0.2" [Curly]="3.0 0.05"
   [Bob]="0.25 0.1" [Short]="4.0 0.0" [Ponytail]="1.0 0.7" [Bun]="2.0 0.1"
 )
-# Lipp's LOD strength λ (Eq. 2) per groom, as the paper tunes it per hairstyle:
-# about 0.5 m over the style's strand length, so that a short groom's small
-# bundles are thinned as the long hair's are at the same distance (at λ 1 a
-# brow's bundle a few pixels across keeps a few per cent of its strands).
+# Lipp's λ per groom, about 0.5 m over the style's strand length (README,
+# "Level of detail is per groom"); 1.0 for the styles not listed.
 declare -A lambda=([Short]=14.0)
 # view: orbit distance, pitch
 declare -A view=([close]="0.95 0.0" [mid]="2.2 4.0" [far]="8.0 8.0")
