@@ -298,11 +298,34 @@ fn strip_tangent_at(first: u32, c: u32, m: u32, have: u32, p0: ControlPoint, p1:
 }
 
 fn pass_two(st: Strand, l: Lanes) -> Strip {
+    return pass_two_round(st, l, 0u, 4u);
+}
+
+// strand::strip_len: S = ceil((C - 1) / 32) points a lane (Code 1), at most
+// `max_strip`.
+fn strip_len(c: u32, max_strip: u32) -> u32 {
+    return min((c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP, max_strip);
+}
+
+// strand::strip_rounds: the rounds of strips of strip_len(c, max_strip)
+// points that cover C points (1 when max_strip is 4: every C <= 129).
+fn strip_rounds(c: u32, max_strip: u32) -> u32 {
+    let span = RASTER_GROUP * strip_len(c, max_strip);
+    return (c - 1u + span - 1u) / span;
+}
+
+// pass_two for round `round` of strips of at most `max_strip` (a constant
+// of each caller: 1, 2 or 4) points: lane l's points start at
+// (round * 32 + l) * S. A smaller max_strip keeps fewer points live in
+// registers (lipp.raster's strip_rounds); the first lane of a round
+// evaluates its predecessor and the last its successor itself, as a lane
+// without a shuffle partner does.
+fn pass_two_round(st: Strand, l: Lanes, round: u32, max_strip: u32) -> Strip {
     let b = st.bundle;
     let id = st.id;
     let c = st.c;
-    let strip = (c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP;
-    let first = l.lane * strip;
+    let strip = strip_len(c, max_strip);
+    let first = (round * RASTER_GROUP + l.lane) * strip;
     let have = min(select(0u, c - first, first < c), strip);
     let none = ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
     var p0 = none;
@@ -312,13 +335,15 @@ fn pass_two(st: Strand, l: Lanes) -> Strip {
     if have > 0u {
         p0 = eval_cp(b, id, first, c, st.styling);
     }
-    if have > 1u {
+    // `max_strip > k` is a constant: the slots past it stay `none`, and
+    // hold no registers.
+    if max_strip > 1u && have > 1u {
         p1 = eval_cp(b, id, first + 1u, c, st.styling);
     }
-    if have > 2u {
+    if max_strip > 2u && have > 2u {
         p2 = eval_cp(b, id, first + 2u, c, st.styling);
     }
-    if have > 3u {
+    if max_strip > 3u && have > 3u {
         p3 = eval_cp(b, id, first + 3u, c, st.styling);
     }
     let first_cp = p0;
@@ -358,13 +383,13 @@ fn pass_two(st: Strand, l: Lanes) -> Strip {
     if have > 0u {
         t0 = strip_tangent_at(first, c, 0u, have, p0, p1, p2, p3, before, after);
     }
-    if have > 1u {
+    if max_strip > 1u && have > 1u {
         t1 = strip_tangent_at(first, c, 1u, have, p0, p1, p2, p3, before, after);
     }
-    if have > 2u {
+    if max_strip > 2u && have > 2u {
         t2 = strip_tangent_at(first, c, 2u, have, p0, p1, p2, p3, before, after);
     }
-    if have > 3u {
+    if max_strip > 3u && have > 3u {
         t3 = strip_tangent_at(first, c, 3u, have, p0, p1, p2, p3, before, after);
     }
     // The next lane's first tangent (Code 1 line 46).

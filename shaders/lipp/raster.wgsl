@@ -1,5 +1,6 @@
-// lipp.raster (entries `raster`, and `raster_sample_payload` for
-// segment_payload off): Lipp §3.1 and Appendix B Code 1. One
+// lipp.raster (entries `raster`, `raster_sample_payload` for
+// segment_payload off, and each with `_code1_strips` for strip_rounds
+// off): Lipp §3.1 and Appendix B Code 1. One
 // 32-lane workgroup per strand (indirect; workgroups stride over strands
 // beyond 65535), the strand assembled cooperatively (assembly.wgsl, shared
 // with the deep opacity maps in dom_maps.wgsl), then DDA rasterization into
@@ -17,7 +18,7 @@
 #import strandgraph::clip::{transform, clip_to_screen, near_clip, clip_at, clip_at3}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 #import strandgraph::hiz::hiz_farthest
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, pass_two_round, strip_rounds, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -298,8 +299,9 @@ fn pick_bits(a: vec2<u32>, b: vec2<u32>, c: vec2<u32>, d: vec2<u32>, m: u32) -> 
 }
 
 // The strands of this workgroup; `per_sample`: the tangent packed per
-// sample (raster::segment_payload off).
-fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, per_sample: bool) {
+// sample (raster::segment_payload off); `max_strip`: points a lane holds,
+// 1 in rounds (raster::strip_rounds) or 4, Code 1's single round.
+fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, per_sample: bool, max_strip: u32) {
     let total = raster_args[3];
     let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
@@ -308,22 +310,43 @@ fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, p
         let st = load_strand(count, s, params.styling != 0u);
         pass_one(st, l);
         workgroupBarrier();
-        let strip = pass_two(st, l);
-        // Every segment's payload bits before the walk: past this point the
-        // shipped entry needs no tangent, and their registers are free.
-        let bits_a = strip_bits(strip, 0u, st.uv, per_sample);
-        let bits_b = strip_bits(strip, 1u, st.uv, per_sample);
-        let bits_c = strip_bits(strip, 2u, st.uv, per_sample);
-        let bits_d = strip_bits(strip, 3u, st.uv, per_sample);
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            let bits = pick_bits(bits_a, bits_b, bits_c, bits_d, m);
-            draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), bits, per_sample);
+        if max_strip >= 4u {
+            // Code 1: one round covers every C <= 129.
+            raster_strip(pass_two(st, l), st.uv, per_sample, max_strip);
+        } else {
+            for (var round = 0u; round < strip_rounds(st.c, max_strip); round++) {
+                raster_strip(pass_two_round(st, l, round, max_strip), st.uv, per_sample, max_strip);
+            }
         }
         // smLayer is rewritten by the next strand.
         workgroupBarrier();
     }
 }
 
+// A lane's strip of segments.
+fn raster_strip(strip: Strip, uv: vec2<f32>, per_sample: bool, max_strip: u32) {
+    // Every segment's payload bits before the walk: past this point the
+    // shipped entry needs no tangent, and their registers are free. Slots
+    // past `max_strip` (a constant) are never drawn.
+    let bits_a = strip_bits(strip, 0u, uv, per_sample);
+    var bits_b = vec2<u32>(0u);
+    var bits_c = vec2<u32>(0u);
+    var bits_d = vec2<u32>(0u);
+    if max_strip > 1u {
+        bits_b = strip_bits(strip, 1u, uv, per_sample);
+    }
+    if max_strip > 2u {
+        bits_c = strip_bits(strip, 2u, uv, per_sample);
+        bits_d = strip_bits(strip, 3u, uv, per_sample);
+    }
+    for (var m = 0u; m < strip_segments(strip); m++) {
+        let bits = pick_bits(bits_a, bits_b, bits_c, bits_d, m);
+        draw(strip_point(strip, m), strip_tangent(strip, m), strip_point(strip, m + 1u), strip_tangent(strip, m + 1u), bits, per_sample);
+    }
+}
+
+// Entries: segment_payload on / off (raster_sample_payload), each with
+// strip_rounds on (1 point a lane) or off (the `_code1_strips` entries).
 @compute @workgroup_size(32)
 fn raster(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -332,7 +355,7 @@ fn raster(
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
 ) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false);
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false, 1u);
 }
 
 @compute @workgroup_size(32)
@@ -343,5 +366,27 @@ fn raster_sample_payload(
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
 ) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true);
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true, 1u);
+}
+
+@compute @workgroup_size(32)
+fn raster_code1_strips(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false, 4u);
+}
+
+@compute @workgroup_size(32)
+fn raster_sample_payload_code1_strips(
+    @builtin(workgroup_id) wg: vec3<u32>,
+    @builtin(num_workgroups) groups: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_invocation_id) sg_lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
+) {
+    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true, 4u);
 }

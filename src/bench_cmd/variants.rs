@@ -279,6 +279,14 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, Code 1 strips",
+        graph: LIPP,
+        overrides: &["raster.strip_rounds=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // C_max points however fine the groom (passes/src/lipp/lod/mod.rs,
     // `groom_resolution`), in the camera's view and the maps'.
     Variant {

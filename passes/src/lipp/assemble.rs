@@ -28,6 +28,11 @@ pub struct Assembly {
     /// Shuffle neighbours (Code 1) rather than recompute them.
     pub cooperative: bool,
     pub styling: bool,
+    /// Points a lane holds at most (1, 2 or 4): Code 1's strips of
+    /// S = ceil((C − 1) / 32) points, in rounds of at most this many
+    /// ([`strip_len`], [`strip_rounds`]). 4, the default, is one round for
+    /// every C ≤ 129; `lipp.raster`'s `strip_rounds` uses 1.
+    pub max_strip: u32,
 }
 
 impl Assembly {
@@ -37,8 +42,20 @@ impl Assembly {
             width: ctx.subgroup_width.clamp(1, RASTER_GROUP) as usize,
             cooperative,
             styling,
+            max_strip: 4,
         }
     }
+}
+
+/// S = ceil((C − 1) / 32), the points a lane holds in Code 1, at most
+/// `max_strip` (shaders/lipp/assembly.wgsl, `strip_len`).
+pub fn strip_len(c: u32, max_strip: u32) -> u32 {
+    (c - 1).div_ceil(RASTER_GROUP).min(max_strip)
+}
+
+/// The rounds of 32 strips of [`strip_len`] points that cover C points.
+pub fn strip_rounds(c: u32, max_strip: u32) -> u32 {
+    (c - 1).div_ceil(RASTER_GROUP * strip_len(c, max_strip))
 }
 
 /// What Code 1 reads, bound the same way by every pass that assembles
@@ -120,83 +137,119 @@ pub fn assemble(
         };
         sm[iu].tangent = calc_tangent(i, n, prev, mine[iu].pos, next);
     }
-    // Pass 2 (Code 1 lines 30-50): strips of S control points per lane.
+    // Pass 2 (Code 1 lines 30-50): strips of S control points per lane, in
+    // rounds when a lane holds fewer (`max_strip`).
     let c = lod.control_points.clamp(2, MAX_CONTROL_POINTS);
-    let strip = (c - 1).div_ceil(RASTER_GROUP) as usize;
-    let eval = |i: u32| eval_cp(&sm, rec, id, i, c, opts.styling);
-    let firsts: Vec<u32> = (0..lanes).map(|l| (l * strip) as u32).collect();
-    let cps: Vec<Vec<ControlPoint>> = firsts
-        .iter()
-        .map(|&f| {
-            (0..strip as u32)
-                .filter(|m| f + m < c)
-                .map(|m| eval(f + m))
-                .collect()
-        })
-        .collect();
-    let first_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.first().copied()).collect();
-    let last_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.last().copied()).collect();
-    let (prev_sh, next_sh) = (shuffle_up(&last_cp, width), shuffle_down(&first_cp, width));
-    // Neighbour at index i: shuffled when cooperative and available, else evaluated.
-    let fetch = |shuffled: Option<Option<ControlPoint>>, i: u32| match (coop, shuffled) {
-        (true, Some(Some(p))) => p,
-        _ => eval(i),
+    let strip = strip_len(c, opts.max_strip);
+    let rounds = strip_rounds(c, opts.max_strip);
+    let pass = PassTwo {
+        sm: &sm,
+        rec,
+        id,
+        c,
+        strip,
+        opts,
     };
-    let mut tangents: Vec<Vec<[f32; 3]>> = Vec::with_capacity(lanes);
-    let mut nexts: Vec<Option<ControlPoint>> = Vec::with_capacity(lanes);
-    for l in 0..lanes {
-        let (f, v) = (firsts[l], &cps[l]);
-        if v.is_empty() {
-            tangents.push(Vec::new());
-            nexts.push(None);
-            continue;
-        }
-        let prev = (f > 0).then(|| fetch(prev_sh[l], f - 1));
-        let end = f + v.len() as u32;
-        let next = (end < c).then(|| fetch(next_sh[l], end));
-        let t = (0..v.len())
-            .map(|m| {
-                let p = if m > 0 {
-                    v[m - 1].pos
-                } else {
-                    prev.map_or(v[m].pos, |p| p.pos)
-                };
-                let q = if m + 1 < v.len() {
-                    v[m + 1].pos
-                } else {
-                    next.map_or(v[m].pos, |p| p.pos)
-                };
-                calc_tangent(f + m as u32, c, p, v[m].pos, q)
+    let active = (0..rounds).map(|r| pass.round(r, draw)).sum();
+    (active, u64::from(RASTER_GROUP * strip * rounds))
+}
+
+/// Code 1's second pass over one round of strips.
+struct PassTwo<'a> {
+    sm: &'a [LayerPoint],
+    rec: &'a BundleRecord,
+    id: [f32; 3],
+    c: u32,
+    /// Points a lane holds.
+    strip: u32,
+    opts: &'a Assembly,
+}
+
+impl PassTwo<'_> {
+    /// Round `round`: lane l's points start at (round · 32 + l) · S. The
+    /// round's first lane evaluates its predecessor and its last lane its
+    /// successor, as a lane without a shuffle partner does. Returns the
+    /// segments drawn.
+    fn round(&self, round: u32, draw: &mut DrawSegment<'_>) -> u64 {
+        let (coop, width, c) = (self.opts.cooperative, self.opts.width, self.c);
+        let lanes = RASTER_GROUP as usize;
+        let eval = |i: u32| eval_cp(self.sm, self.rec, self.id, i, c, self.opts.styling);
+        let firsts: Vec<u32> = (0..lanes)
+            .map(|l| (round as usize * lanes + l) as u32 * self.strip)
+            .collect();
+        let cps: Vec<Vec<ControlPoint>> = firsts
+            .iter()
+            .map(|&f| {
+                (0..self.strip)
+                    .filter(|m| f + m < c)
+                    .map(|m| eval(f + m))
+                    .collect()
             })
             .collect();
-        tangents.push(t);
-        nexts.push(next);
-    }
-    // The next lane's first tangent (Code 1 line 46).
-    let first_t: Vec<Option<[f32; 3]>> = tangents.iter().map(|t| t.first().copied()).collect();
-    let next_t = shuffle_down(&first_t, width);
-    let mut active = 0u64;
-    for l in 0..lanes {
-        let Some(next) = nexts[l] else {
-            // Only the last strip: its segments end inside the strip.
-            draw_strip(draw, &cps[l], &tangents[l], None, &mut active);
-            continue;
+        let first_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.first().copied()).collect();
+        let last_cp: Vec<Option<ControlPoint>> = cps.iter().map(|v| v.last().copied()).collect();
+        let (prev_sh, next_sh) = (shuffle_up(&last_cp, width), shuffle_down(&first_cp, width));
+        // Neighbour at index i: shuffled when cooperative and available, else evaluated.
+        let fetch = |shuffled: Option<Option<ControlPoint>>, i: u32| match (coop, shuffled) {
+            (true, Some(Some(p))) => p,
+            _ => eval(i),
         };
-        let end = firsts[l] + cps[l].len() as u32;
-        let tn = match (coop, next_t[l]) {
-            (true, Some(Some(t))) => t,
-            _ => {
-                let after = if end + 1 < c {
-                    eval(end + 1).pos
-                } else {
-                    next.pos
-                };
-                calc_tangent(end, c, cps[l][cps[l].len() - 1].pos, next.pos, after)
+        let mut tangents: Vec<Vec<[f32; 3]>> = Vec::with_capacity(lanes);
+        let mut nexts: Vec<Option<ControlPoint>> = Vec::with_capacity(lanes);
+        for l in 0..lanes {
+            let (f, v) = (firsts[l], &cps[l]);
+            if v.is_empty() {
+                tangents.push(Vec::new());
+                nexts.push(None);
+                continue;
             }
-        };
-        draw_strip(draw, &cps[l], &tangents[l], Some((next, tn)), &mut active);
+            let prev = (f > 0).then(|| fetch(prev_sh[l], f - 1));
+            let end = f + v.len() as u32;
+            let next = (end < c).then(|| fetch(next_sh[l], end));
+            let t = (0..v.len())
+                .map(|m| {
+                    let p = if m > 0 {
+                        v[m - 1].pos
+                    } else {
+                        prev.map_or(v[m].pos, |p| p.pos)
+                    };
+                    let q = if m + 1 < v.len() {
+                        v[m + 1].pos
+                    } else {
+                        next.map_or(v[m].pos, |p| p.pos)
+                    };
+                    calc_tangent(f + m as u32, c, p, v[m].pos, q)
+                })
+                .collect();
+            tangents.push(t);
+            nexts.push(next);
+        }
+        // The next lane's first tangent (Code 1 line 46).
+        let first_t: Vec<Option<[f32; 3]>> = tangents.iter().map(|t| t.first().copied()).collect();
+        let next_t = shuffle_down(&first_t, width);
+        let mut active = 0u64;
+        for l in 0..lanes {
+            let Some(next) = nexts[l] else {
+                // Only the last strip: its segments end inside the strip.
+                draw_strip(draw, &cps[l], &tangents[l], None, &mut active);
+                continue;
+            };
+            let end = firsts[l] + cps[l].len() as u32;
+            let tn = match (coop, next_t[l]) {
+                (true, Some(Some(t))) => t,
+                _ => {
+                    let after = if end + 1 < c {
+                        eval(end + 1).pos
+                    } else {
+                        next.pos
+                    };
+                    calc_tangent(end, c, cps[l][cps[l].len() - 1].pos, next.pos, after)
+                }
+            };
+            draw_strip(draw, &cps[l], &tangents[l], Some((next, tn)), &mut active);
+        }
+        active
     }
-    (active, (lanes * strip) as u64)
 }
 
 /// Draws a lane's segments: consecutive strip points, then the segment to

@@ -81,6 +81,15 @@ pub struct RasterParams {
     /// 1920×1080, 44,426 of 108,186 strands are behind the head and body
     /// in every segment, 37% of the pixels the walk visits.
     pub occlusion_cull: bool,
+    /// Ours: a lane holds one of the strand's points at a time, and a
+    /// strand of C points is assembled and drawn in ceil((C − 1) / 32)
+    /// rounds of 32 segments ([`super::assemble::strip_rounds`]), where
+    /// Code 1 gives each lane S = ceil((C − 1) / 32) points, up to 4, at
+    /// once. Each entry point is compiled for its most points a lane, whose
+    /// registers it holds through the walk: on the H200 the raster takes 69
+    /// registers a lane instead of 80, and more of its warps fit on an SM.
+    /// The same segments are drawn, so the G-buffer is the same.
+    pub strip_rounds: bool,
 }
 
 impl Default for RasterParams {
@@ -94,23 +103,37 @@ impl Default for RasterParams {
             model_index: 0,
             segment_payload: true,
             occlusion_cull: true,
+            strip_rounds: true,
         }
+    }
+}
+
+impl RasterParams {
+    /// Points a lane holds at most (`strip_rounds`).
+    pub fn max_strip(&self) -> u32 {
+        if self.strip_rounds { 1 } else { 4 }
     }
 }
 
 impl PassParams for RasterParams {
     const READS_MODEL_INDEX: bool = true;
-    const VARIANT_ENTRIES: &'static [&'static str] = &["raster_sample_payload"];
+    const VARIANT_ENTRIES: &'static [&'static str] = &[
+        "raster_sample_payload",
+        "raster_code1_strips",
+        "raster_sample_payload_code1_strips",
+    ];
 
     /// `segment_payload: false` is an entry point of its own: as a branch in
     /// one kernel, the per-sample side kept both end tangents live through
     /// the walk, 96 registers per lane against 80, and the raster took
-    /// 2.69 ms instead of 2.40 at close on the H100.
+    /// 2.69 ms instead of 2.40 at close on the H100. `strip_rounds: false`
+    /// is one too, for the same reason.
     fn entry(&self, default: &'static str) -> &'static str {
-        if self.segment_payload {
-            default
-        } else {
-            "raster_sample_payload"
+        match (self.segment_payload, self.strip_rounds) {
+            (true, true) => default,
+            (false, true) => "raster_sample_payload",
+            (true, false) => "raster_code1_strips",
+            (false, false) => "raster_sample_payload_code1_strips",
         }
     }
 
@@ -450,7 +473,10 @@ impl CpuKernel for RasterKernel {
             local: &mut local,
         };
         let stride = ctx.workgroups.max(1);
-        let opts = Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling);
+        let opts = Assembly {
+            max_strip: self.0.max_strip(),
+            ..Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling)
+        };
         let mut s = group;
         while s < strands.total {
             let (lod, rec, k) = strands.strand(s);

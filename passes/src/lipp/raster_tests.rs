@@ -137,6 +137,8 @@ fn shuffles_naive_assembly_and_subgroup_width_give_identical_g_buffers() {
         ("{}", 8),
         ("{}", 4),
         (r#"{"cooperative_assembly": false}"#, 32),
+        (r#"{"strip_rounds": false}"#, 32),
+        (r#"{"strip_rounds": false}"#, 8),
     ] {
         let (h, _) = harness(params, width);
         assert!(
@@ -184,7 +186,40 @@ fn the_per_sample_payload_is_an_entry_point_of_its_own() {
         entry(r#"{"segment_payload": false}"#),
         "raster_sample_payload"
     );
-    assert_eq!(RASTER.entries(), ["raster", "raster_sample_payload"]);
+    assert_eq!(entry(r#"{"strip_rounds": false}"#), "raster_code1_strips");
+    assert_eq!(
+        RASTER.entries(),
+        [
+            "raster",
+            "raster_sample_payload",
+            "raster_code1_strips",
+            "raster_sample_payload_code1_strips"
+        ]
+    );
+}
+
+/// The harness's strands keep every point (C = 127, the LOD's C_max), which
+/// one point a lane covers in four rounds, and Code 1's strips of four in
+/// one: the G-buffer test above compares the two.
+#[test]
+fn strip_rounds_cover_every_point() {
+    use crate::lipp::assemble::{strip_len, strip_rounds};
+    let (h, _) = harness("{}", 32);
+    let c = h.read("bundle_lod")[1];
+    assert_eq!(c, 127);
+    assert_eq!((strip_len(c, 1), strip_rounds(c, 1)), (1, 4));
+    assert_eq!((strip_len(c, 2), strip_rounds(c, 2)), (2, 2));
+    assert_eq!((strip_len(c, 4), strip_rounds(c, 4)), (4, 1));
+    for c in 2..=crate::lipp::MAX_CONTROL_POINTS {
+        for max in [1, 2, 4] {
+            let (s, r) = (strip_len(c, max), strip_rounds(c, max));
+            // Every segment a lane's strip, and no round without one.
+            assert!(
+                r * 32 * s >= c - 1 && (r - 1) * 32 * s < c - 1,
+                "C {c}, {max}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -141,6 +141,7 @@ fn the_bundle_box_holds_every_segment_the_rasterizer_draws() {
             width: 32,
             cooperative: true,
             styling: true,
+            max_strip: 4,
         };
         for c in [3, 5, 9, 17, 33, 65, 129] {
             let lod = BundleLod {
