@@ -138,7 +138,9 @@ impl Default for FilterParams {
 }
 
 impl PassParams for FilterParams {
-    const VARIANT_ENTRIES: &'static [&'static str] = &["filter_pairs"];
+    fn variant_entries(_default: &'static str) -> &'static [&'static str] {
+        &["filter_pairs"]
+    }
 
     fn entry(&self, default: &'static str) -> &'static str {
         if self.pairs { "filter_pairs" } else { default }
