@@ -109,7 +109,7 @@ impl<P: PassParams, G: GpuBlock> PassDef for PassKind<P, G> {
     }
     fn entries(&self) -> Vec<&'static str> {
         std::iter::once(self.shader.entry)
-            .chain(P::variant_entries(self.shader.entry).iter().copied())
+            .chain(P::VARIANT_ENTRIES.iter().copied())
             .collect()
     }
     fn check_params(&self, value: &ron::Value) -> Result<(), ParamError> {

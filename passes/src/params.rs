@@ -46,10 +46,8 @@ pub trait PassParams:
     }
 
     /// Entry points besides the kind's [`crate::contract::Shader::entry`]
-    /// (`default`) that [`PassParams::entry`] may choose.
-    fn variant_entries(_default: &'static str) -> &'static [&'static str] {
-        &[]
-    }
+    /// that [`PassParams::entry`] may choose.
+    const VARIANT_ENTRIES: &'static [&'static str] = &[];
 
     /// The entry point for these parameters; `default` is the kind's. A
     /// kind compiles a switch into an entry point of its own where a branch

@@ -1,6 +1,5 @@
 // The deep opacity maps lipp.dom_depth and lipp.dom_opacity (entries
-// `dom_depth_pass`, `dom_opacity_pass`, and each with `_code1_strips` for
-// strip_rounds off; Lipp §3.4, Yuksel and Keyser 2008):
+// `dom_depth_pass`, `dom_opacity_pass`; Lipp §3.4, Yuksel and Keyser 2008):
 // each strand assembled as the raster assembles it (assembly.wgsl), its
 // segments walked through every light's map. Port of passes/src/lipp/dom.rs.
 
@@ -11,7 +10,7 @@
 #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, pass_two_round, strip_rounds, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
 
 // Bindings 0 and 8.. are the DOM entries' own.
 
@@ -155,93 +154,6 @@ fn dom_segment_opacity(a: vec3<f32>, b: vec3<f32>, amount: u32, l: u32, lf: Ligh
     }
 }
 
-// The strands of this workgroup into the first-hit depth maps;
-// `max_strip`: points a lane holds (dom::DomParams::strip_rounds: 1, in
-// rounds; 4: Code 1's single round, compiled as it was without rounds).
-fn dom_depth_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, max_strip: u32) {
-    let total = raster_args[3];
-    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
-    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_depth));
-    let stride = max(groups, 1u);
-    for (var s = wg; s < total; s += stride) {
-        let st = load_strand(count, s, dom_params.styling != 0u);
-        pass_one(st, l);
-        workgroupBarrier();
-        if max_strip >= 4u {
-            dom_depth_strip(st, pass_two(st, l), lane, lights_n);
-        } else {
-            for (var round = 0u; round < strip_rounds(st.c, max_strip); round++) {
-                dom_depth_strip(st, pass_two_round(st, l, round, max_strip), lane, lights_n);
-            }
-        }
-    }
-}
-
-// A lane's strip in each light's view (the light once per strip). Every
-// lane calls it: it has barriers.
-fn dom_depth_strip(st: Strand, strip: Strip, lane: u32, lights_n: u32) {
-    // Shared walks (at most MAX_SHARED segments) take one round.
-    let share = share_segments(st, strip, lane);
-    for (var li = 0u; li < lights_n; li++) {
-        let lf = light_frame(li);
-        if shares(st) {
-            if share.step > 0u {
-                dom_segment_depth(share.a, share.b, li, lf, share.first, share.step);
-            }
-            continue;
-        }
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_depth(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, li, lf, 0u, 1u);
-        }
-    }
-    // smLayer and shared_a / shared_b are rewritten by the next round or
-    // strand.
-    workgroupBarrier();
-}
-
-// The strands of this workgroup into the opacity layers, as
-// dom_depth_strands.
-fn dom_opacity_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, max_strip: u32) {
-    let total = raster_args[3];
-    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
-    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_opacity_pass_dom_depth));
-    let stride = max(groups, 1u);
-    for (var s = wg; s < total; s += stride) {
-        let st = load_strand(count, s, dom_params.styling != 0u);
-        pass_one(st, l);
-        workgroupBarrier();
-        if max_strip >= 4u {
-            dom_opacity_strip(st, pass_two(st, l), lane, lights_n);
-        } else {
-            for (var round = 0u; round < strip_rounds(st.c, max_strip); round++) {
-                dom_opacity_strip(st, pass_two_round(st, l, round, max_strip), lane, lights_n);
-            }
-        }
-    }
-}
-
-// As dom_depth_strip, into the opacity layers.
-fn dom_opacity_strip(st: Strand, strip: Strip, lane: u32, lights_n: u32) {
-    let share = share_segments(st, strip, lane);
-    let amount = dom_amount(st);
-    for (var li = 0u; li < lights_n; li++) {
-        let lf = light_frame(li);
-        if shares(st) {
-            if share.step > 0u {
-                dom_segment_opacity(share.a, share.b, amount, li, lf, share.first, share.step);
-            }
-            continue;
-        }
-        for (var m = 0u; m < strip_segments(strip); m++) {
-            dom_segment_opacity(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, amount, li, lf, 0u, 1u);
-        }
-    }
-    workgroupBarrier();
-}
-
-// Entries: strip_rounds on (1 point a lane), and off (`_code1_strips`).
 @compute @workgroup_size(32)
 fn dom_depth_pass(
     @builtin(workgroup_id) wg: vec3<u32>,
@@ -250,18 +162,32 @@ fn dom_depth_pass(
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
 ) {
-    dom_depth_strands(wg.x, groups.x, lane, sg_lane, sg_size, 1u);
-}
-
-@compute @workgroup_size(32)
-fn dom_depth_pass_code1_strips(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-    @builtin(subgroup_invocation_id) sg_lane: u32,
-    @builtin(subgroup_size) sg_size: u32,
-) {
-    dom_depth_strands(wg.x, groups.x, lane, sg_lane, sg_size, 4u);
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_depth));
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        let share = share_segments(st, strip, lane);
+        // Each light's view once per strand, the strip's segments in it.
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            if shares(st) {
+                if share.step > 0u {
+                    dom_segment_depth(share.a, share.b, li, lf, share.first, share.step);
+                }
+                continue;
+            }
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_depth(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, li, lf, 0u, 1u);
+            }
+        }
+        workgroupBarrier();
+    }
 }
 
 @compute @workgroup_size(32)
@@ -272,16 +198,30 @@ fn dom_opacity_pass(
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
 ) {
-    dom_opacity_strands(wg.x, groups.x, lane, sg_lane, sg_size, 1u);
-}
-
-@compute @workgroup_size(32)
-fn dom_opacity_pass_code1_strips(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-    @builtin(subgroup_invocation_id) sg_lane: u32,
-    @builtin(subgroup_size) sg_size: u32,
-) {
-    dom_opacity_strands(wg.x, groups.x, lane, sg_lane, sg_size, 4u);
+    let total = raster_args[3];
+    let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
+    let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
+    let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_opacity_pass_dom_depth));
+    let stride = max(groups.x, 1u);
+    for (var s = wg.x; s < total; s += stride) {
+        let st = load_strand(count, s, dom_params.styling != 0u);
+        pass_one(st, l);
+        workgroupBarrier();
+        let strip = pass_two(st, l);
+        let share = share_segments(st, strip, lane);
+        let amount = dom_amount(st);
+        for (var li = 0u; li < lights_n; li++) {
+            let lf = light_frame(li);
+            if shares(st) {
+                if share.step > 0u {
+                    dom_segment_opacity(share.a, share.b, amount, li, lf, share.first, share.step);
+                }
+                continue;
+            }
+            for (var m = 0u; m < strip_segments(strip); m++) {
+                dom_segment_opacity(strip_point(strip, m).pos, strip_point(strip, m + 1u).pos, amount, li, lf, 0u, 1u);
+            }
+        }
+        workgroupBarrier();
+    }
 }

@@ -283,11 +283,7 @@ pub const VARIANTS: &[Variant] = &[
         pipeline: "Lipp",
         name: "SWR 1+F+L, Code 1 strips",
         graph: LIPP,
-        overrides: &[
-            "raster.strip_rounds=false",
-            "dom_depth.strip_rounds=false",
-            "dom_opacity.strip_rounds=false",
-        ],
+        overrides: &["raster.strip_rounds=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

@@ -45,15 +45,6 @@ impl Assembly {
             max_strip: 4,
         }
     }
-
-    /// With `rounds` (the passes' `strip_rounds`): one point a lane, in
-    /// rounds; else Code 1's strips (up to four points a lane, one round).
-    pub fn strip_rounds(self, rounds: bool) -> Self {
-        Self {
-            max_strip: if rounds { 1 } else { 4 },
-            ..self
-        }
-    }
 }
 
 /// S = ceil((C − 1) / 32), the points a lane holds in Code 1, at most

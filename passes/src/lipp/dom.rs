@@ -57,12 +57,6 @@ pub struct DomParams {
     pub density_compensation: bool,
     pub cooperative_assembly: bool,
     pub styling: bool,
-    /// Ours: a lane holds one of the strand's points at a time, the strand
-    /// assembled and walked in rounds of 32 segments, where Code 1 gives
-    /// each lane up to 4 at once (`lipp.raster`'s `strip_rounds`). Each
-    /// setting is an entry point of its own, compiled for its most points a
-    /// lane. The same segments are walked, so the maps are the same.
-    pub strip_rounds: bool,
 }
 
 impl Default for DomParams {
@@ -75,29 +69,11 @@ impl Default for DomParams {
             density_compensation: true,
             cooperative_assembly: true,
             styling: true,
-            strip_rounds: true,
         }
     }
 }
 
 impl PassParams for DomParams {
-    fn variant_entries(default: &'static str) -> &'static [&'static str] {
-        match default {
-            "dom_depth_pass" => &["dom_depth_pass_code1_strips"],
-            _ => &["dom_opacity_pass_code1_strips"],
-        }
-    }
-
-    /// `strip_rounds: false` is an entry point of its own: a branch would
-    /// hold Code 1's four points a lane in registers either way.
-    fn entry(&self, default: &'static str) -> &'static str {
-        match (self.strip_rounds, default) {
-            (true, _) => default,
-            (false, "dom_depth_pass") => "dom_depth_pass_code1_strips",
-            (false, _) => "dom_opacity_pass_code1_strips",
-        }
-    }
-
     fn validate(&self) -> Result<(), Invalid> {
         in_range("resolution", self.resolution, 16..=4096)?;
         in_range("layers", self.layers, 1..=8)?;
@@ -426,8 +402,7 @@ impl CpuKernel for DomKernel {
             return;
         }
         let strands = Strands::load(ctx);
-        let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling)
-            .strip_rounds(self.p.strip_rounds);
+        let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
         let stride = ctx.workgroups.max(1);
         let mut s = group;
         while s < strands.total {

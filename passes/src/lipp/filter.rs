@@ -138,9 +138,7 @@ impl Default for FilterParams {
 }
 
 impl PassParams for FilterParams {
-    fn variant_entries(_default: &'static str) -> &'static [&'static str] {
-        &["filter_pairs"]
-    }
+    const VARIANT_ENTRIES: &'static [&'static str] = &["filter_pairs"];
 
     fn entry(&self, default: &'static str) -> &'static str {
         if self.pairs { "filter_pairs" } else { default }

@@ -108,15 +108,20 @@ impl Default for RasterParams {
     }
 }
 
+impl RasterParams {
+    /// Points a lane holds at most (`strip_rounds`).
+    pub fn max_strip(&self) -> u32 {
+        if self.strip_rounds { 1 } else { 4 }
+    }
+}
+
 impl PassParams for RasterParams {
     const READS_MODEL_INDEX: bool = true;
-    fn variant_entries(_default: &'static str) -> &'static [&'static str] {
-        &[
-            "raster_sample_payload",
-            "raster_code1_strips",
-            "raster_sample_payload_code1_strips",
-        ]
-    }
+    const VARIANT_ENTRIES: &'static [&'static str] = &[
+        "raster_sample_payload",
+        "raster_code1_strips",
+        "raster_sample_payload_code1_strips",
+    ];
 
     /// `segment_payload: false` is an entry point of its own: as a branch in
     /// one kernel, the per-sample side kept both end tangents live through
@@ -468,8 +473,10 @@ impl CpuKernel for RasterKernel {
             local: &mut local,
         };
         let stride = ctx.workgroups.max(1);
-        let opts = Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling)
-            .strip_rounds(self.0.strip_rounds);
+        let opts = Assembly {
+            max_strip: self.0.max_strip(),
+            ..Assembly::new(ctx, self.0.cooperative_assembly, self.0.styling)
+        };
         let mut s = group;
         while s < strands.total {
             let (lod, rec, k) = strands.strand(s);

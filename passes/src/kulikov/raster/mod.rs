@@ -76,9 +76,7 @@ impl Default for RasterParams {
 }
 
 impl PassParams for RasterParams {
-    fn variant_entries(_default: &'static str) -> &'static [&'static str] {
-        &["raster_no_stacks"]
-    }
+    const VARIANT_ENTRIES: &'static [&'static str] = &["raster_no_stacks"];
 
     /// Both stacks off is an entry point of its own, with the stacks'
     /// code compiled out: as a uniform branch, their live values cost the
