@@ -181,6 +181,14 @@ fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
     return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling, bi);
 }
 
+// Strand k of bundle bi at C points, its bundle read again, for a round of
+// pass_two_round that keeps nothing of the last one (lipp.raster). The
+// DOM's density compensation (`thinning`) is not needed there.
+fn strand_again(bi: u32, k: u32, c: u32, styling: bool) -> Strand {
+    let b = load_bundle(bi);
+    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, 1.0, styling, bi);
+}
+
 // Whether this lane's shuffle partners are its index neighbours.
 struct Lanes {
     lane: u32,

@@ -12,7 +12,10 @@
 //!    per lane; each lane evaluates its strip once (Hermite subdivision and
 //!    styling), gets the previous lane's last point and the next lane's first
 //!    point and first tangent by shuffles, computes final tangents by finite
-//!    differences and draws its segments (Code 1 lines 31-50).
+//!    differences and draws its segments (Code 1 lines 31-50). With
+//!    `strip_rounds` (ours, the default) a lane holds one point at a time
+//!    and pass 2 runs in rounds of 32 segments, which keeps fewer
+//!    registers live through the walk ([`RasterParams::strip_rounds`]).
 //!
 //! Where a neighbour lies in another subgroup (a subgroup narrower than the
 //! 32-lane workgroup, e.g. lavapipe's 8), the lane evaluates the neighbour
@@ -86,9 +89,12 @@ pub struct RasterParams {
     /// rounds of 32 segments ([`super::assemble::strip_rounds`]), where
     /// Code 1 gives each lane S = ceil((C − 1) / 32) points, up to 4, at
     /// once. Each entry point is compiled for its most points a lane, whose
-    /// registers it holds through the walk: on the H200 the raster takes 69
-    /// registers a lane instead of 80, and more of its warps fit on an SM.
-    /// The same segments are drawn, so the G-buffer is the same.
+    /// registers it holds through the walk, and a round carries nothing of
+    /// the last one: it reads its bundle's record again and recomputes the
+    /// strand's id and (u, v). On the H200 the raster takes 61 registers a
+    /// lane instead of 80, and 32 of its workgroups fit on an SM (the most
+    /// an SM holds) instead of 25. The same segments are drawn, so the
+    /// G-buffer is the same.
     pub strip_rounds: bool,
 }
 
