@@ -301,12 +301,12 @@ fn pick_bits(a: vec2<u32>, b: vec2<u32>, c: vec2<u32>, d: vec2<u32>, m: u32) -> 
 // The strands of this workgroup; `per_sample`: the tangent packed per
 // sample (raster::segment_payload off); `max_strip`: points a lane holds,
 // 1 in rounds (raster::strip_rounds) or 4, Code 1's single round.
-fn raster_strands(wg: u32, groups: u32, lane: u32, sg_lane: u32, sg_size: u32, per_sample: bool, max_strip: u32) {
+fn raster_strands(ids: Ids, per_sample: bool, max_strip: u32) {
     let total = raster_args[3];
     let count = min(params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
-    let l = lanes_of(lane, sg_lane, sg_size, params.cooperative_assembly != 0u);
-    let stride = max(groups, 1u);
-    for (var s = wg; s < total; s += stride) {
+    let l = lanes_of(ids.lane, ids.sg_lane, ids.sg_size, params.cooperative_assembly != 0u);
+    let stride = max(ids.groups.x, 1u);
+    for (var s = ids.wg.x; s < total; s += stride) {
         let st = load_strand(count, s, params.styling != 0u);
         pass_one(st, l);
         workgroupBarrier();
@@ -354,46 +354,30 @@ fn raster_strip(strip: Strip, uv: vec2<f32>, per_sample: bool, max_strip: u32) {
 
 // Entries: segment_payload on / off (raster_sample_payload), each with
 // strip_rounds on (1 point a lane) or off (the `_code1_strips` entries).
-@compute @workgroup_size(32)
-fn raster(
+struct Ids {
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
     @builtin(subgroup_invocation_id) sg_lane: u32,
     @builtin(subgroup_size) sg_size: u32,
-) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false, 1u);
 }
 
 @compute @workgroup_size(32)
-fn raster_sample_payload(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-    @builtin(subgroup_invocation_id) sg_lane: u32,
-    @builtin(subgroup_size) sg_size: u32,
-) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true, 1u);
+fn raster(ids: Ids) {
+    raster_strands(ids, false, 1u);
 }
 
 @compute @workgroup_size(32)
-fn raster_code1_strips(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-    @builtin(subgroup_invocation_id) sg_lane: u32,
-    @builtin(subgroup_size) sg_size: u32,
-) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, false, 4u);
+fn raster_sample_payload(ids: Ids) {
+    raster_strands(ids, true, 1u);
 }
 
 @compute @workgroup_size(32)
-fn raster_sample_payload_code1_strips(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-    @builtin(subgroup_invocation_id) sg_lane: u32,
-    @builtin(subgroup_size) sg_size: u32,
-) {
-    raster_strands(wg.x, groups.x, lane, sg_lane, sg_size, true, 4u);
+fn raster_code1_strips(ids: Ids) {
+    raster_strands(ids, false, 4u);
+}
+
+@compute @workgroup_size(32)
+fn raster_sample_payload_code1_strips(ids: Ids) {
+    raster_strands(ids, true, 4u);
 }
