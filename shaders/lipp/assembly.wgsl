@@ -175,18 +175,18 @@ fn load_strand(count: u32, s: u32, styling: bool) -> Strand {
     let bi = bundle_of_strand(bundle_range(count), s);
     let drawn = max(bundle_lod[bi * LOD_WORDS], 1u);
     let c = clamp(bundle_lod[bi * LOD_WORDS + 1u], 2u, MAX_CONTROL_POINTS);
-    let b = load_bundle(bi);
     let k = s - bundle_lod[bi * LOD_WORDS + 2u];
     let full = hairmesh_bundles[bi * BUNDLE_WORDS + 2u];
-    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, f32(full) / f32(drawn), styling, bi);
+    return strand_at(bi, k, c, f32(full) / f32(drawn), styling);
 }
 
-// Strand k of bundle bi at C points, its bundle read again, for a round of
-// pass_two_round that keeps nothing of the last one (lipp.raster). The
-// DOM's density compensation (`thinning`) is not needed there.
-fn strand_again(bi: u32, k: u32, c: u32, styling: bool) -> Strand {
+// Strand k of bundle bi at C points, from its bundle's record. lipp.raster
+// calls it again each round of pass_two_round, so that a round keeps
+// nothing of the last one; it passes thinning 1.0, which only the DOM's
+// density compensation reads.
+fn strand_at(bi: u32, k: u32, c: u32, thinning: f32, styling: bool) -> Strand {
     let b = load_bundle(bi);
-    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, 1.0, styling, bi);
+    return Strand(b, strand_id(b.seed, k), strand_uv(k), k, c, thinning, styling, bi);
 }
 
 // Whether this lane's shuffle partners are its index neighbours.

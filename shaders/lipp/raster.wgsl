@@ -18,7 +18,7 @@
 #import strandgraph::clip::{transform, clip_to_screen, near_clip, clip_at, clip_at3}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, oct_encode, quantize, depth_bits, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
 #import strandgraph::hiz::hiz_farthest
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, pass_two_round, strip_rounds, strand_again, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, pass_two_round, strip_rounds, strand_at, strip_point, strip_tangent, strip_segments, snap, column_params, walk_column, walk_columns}
 
 // RasterParams (booleans as 0/1).
 struct RasterParams {
@@ -321,7 +321,7 @@ fn raster_strands(ids: Ids, per_sample: bool, max_strip: u32) {
             let k = st.k;
             let c = st.c;
             for (var round = 0u; round < strip_rounds(c, max_strip); round++) {
-                let again = strand_again(bi, k, c, params.styling != 0u);
+                let again = strand_at(bi, k, c, 1.0, params.styling != 0u);
                 raster_strip(pass_two_round(again, l, round, max_strip), again.uv, per_sample, max_strip);
             }
         }
