@@ -6,7 +6,7 @@
 #import strandgraph::layout::{FrameData, ModelData}
 #import strandgraph::clip::transform
 #import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, F32_MIN}
-#import strandgraph::lipp_shaded::{unpack_rgb9e5, record_depth, HIT, CONS_HIT}
+#import strandgraph::lipp_shaded::{unpack_rgb9e5, record_depth, HIT, CONS_HIT, FRONT}
 #import strandgraph::lipp_rect::{FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args}
 
 // FilterParams (booleans as 0/1).
@@ -20,7 +20,6 @@ struct FilterParams {
     sigma_c: f32,
     strip_width: f32,
     depth_threshold: f32,
-    front_threshold: f32,
     // Scene quantities.
     width: u32,
     height: u32,
@@ -300,8 +299,10 @@ fn filter_pixel(i: u32, part: u32, parts: u32) {
         let sa = unpack_payload(a);
         // A flyaway in front of the centre hit is blended over it.
         var front = false;
-        if centre && cons && params.reconnect != 0u {
-            front = lin(sa.depth) <= lin(sg.depth) - params.front_threshold;
+        // lipp.shade's decision (shaded::pixel_flags), which told it to
+        // shade the conservative sample.
+        if params.reconnect != 0u {
+            front = (shaded[i].y & FRONT) != 0u;
         }
         // filter::filter_pixel's reconstructions (the centre sample or a
         // promoted conservative one, §3.3.2, then a flyaway) from one call

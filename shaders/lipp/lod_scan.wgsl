@@ -27,8 +27,9 @@ const ALL_MODELS: u32 = 0xFFFFFFFFu;
 
 @group(0) @binding(0) var<uniform> params: ScanParams;
 @group(0) @binding(1) var<storage, read> hairmesh_bundles: array<u32>;
-@group(0) @binding(2) var<storage, read> lod_choices: array<u32>;
-@group(0) @binding(3) var<storage, read_write> bundle_lod: array<u32>;
+// A bundle's record (LOD_WORDS = 4 words) as one load and one store.
+@group(0) @binding(2) var<storage, read> lod_choices: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read_write> bundle_lod: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> raster_args: array<u32>;
 
 // scan::SCAN_GROUP.
@@ -95,13 +96,13 @@ fn groom_bundles(count: u32, lane: u32) -> vec2<u32> {
 }
 
 // scan.rs: a frustum-culled bundle draws none of the strands it keeps.
-fn drawn(b: u32) -> u32 {
-    return select(lod_choices[b * LOD_WORDS], 0u, (lod_choices[b * LOD_WORDS + 3u] & LOD_CULLED) != 0u);
+fn drawn(c: vec4<u32>) -> u32 {
+    return select(c.x, 0u, (c.w & LOD_CULLED) != 0u);
 }
 
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) lane: u32) {
-    let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), min(arrayLength(&lod_choices), arrayLength(&bundle_lod)) / LOD_WORDS);
+    let count = min(min(params.bundles, arrayLength(&hairmesh_bundles) / BUNDLE_WORDS), min(arrayLength(&lod_choices), arrayLength(&bundle_lod)));
     // Each lane owns a run of this groom's bundles.
     let range = groom_bundles(count, lane);
     let per = (range.y - range.x + SCAN_GROUP - 1u) / SCAN_GROUP;
@@ -119,13 +120,15 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
     var kept = 0u;
     var rect = vec4<u32>(0u);
     for (var b = begin; b < end; b++) {
-        sum += drawn(b);
-        if drawn(b) > 0u {
-            rect = rect_union(rect, unpack_tiles(lod_choices[b * LOD_WORDS + 2u], params.width, params.height));
+        let c = lod_choices[b];
+        let n = drawn(c);
+        sum += n;
+        if n > 0u {
+            rect = rect_union(rect, unpack_tiles(c.z, params.width, params.height));
         }
-        if (lod_choices[b * LOD_WORDS + 3u] & LOD_OTHER_GROOM) == 0u {
+        if (c.w & LOD_OTHER_GROOM) == 0u {
             full += hairmesh_bundles[b * BUNDLE_WORDS + 2u];
-            kept += lod_choices[b * LOD_WORDS];
+            kept += c.x;
         }
     }
     if !rect_is_empty(rect) {
@@ -159,12 +162,9 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
         first = sums[lane - 1u];
     }
     for (var b = begin; b < end; b++) {
-        let o = b * LOD_WORDS;
-        let n = drawn(b);
-        bundle_lod[o] = n;
-        bundle_lod[o + 1u] = lod_choices[o + 1u];
-        bundle_lod[o + 2u] = first;
-        bundle_lod[o + 3u] = lod_choices[o + 3u];
+        let c = lod_choices[b];
+        let n = drawn(c);
+        bundle_lod[b] = vec4<u32>(n, c.y, first, c.w);
         first += n;
     }
     if lane == SCAN_GROUP - 1u {

@@ -18,7 +18,7 @@
 #import strandgraph::lipp_dom::frame
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction, share_light_frames}
-#import strandgraph::lipp_shaded::{shaded_record, HIT, CONS_HIT}
+#import strandgraph::lipp_shaded::{shaded_record, pixel_flags, read_by_filter, HIT}
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, touches_run}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
@@ -92,17 +92,21 @@ fn shade_run(run: u32, lane: u32) {
         let y = i / params.width;
         // lipp::gbuffer_layers: 8 bytes a pixel and layer in both.
         let layers = max(min(arrayLength(&gbuffer), arrayLength(&shaded)) / max(pixels, 1u), 2u);
-        let cons = select(0u, CONS_HIT, !is_empty(gbuffer[pixels + i]));
+        let centre = gbuffer[i];
+        let flags = pixel_flags(frame.near, frame.far, centre, gbuffer[pixels + i], params.front_threshold);
         for (var layer = lane / SHADE_GROUP; layer < layers; layer += 2u) {
             let p = gbuffer[layer * pixels + i];
             // shaded.rs: the centre layer's record for every pixel (the
-            // filter's taps read its flags), the others where a sample is.
+            // filter's taps read its flags), the others where a sample is
+            // (with read_layers_only, where the filter reads its colour).
             if !is_empty(p) {
                 atomicStore(&tile_has_hair, 1u);
-                let c = shade_sample(unpack_payload(p), x, y);
-                shaded[layer * pixels + i] = shaded_record(c, p.y, HIT | cons);
+                if params.read_layers_only == 0u || read_by_filter(layer, layers, !is_empty(centre), flags) {
+                    let c = shade_sample(unpack_payload(p), x, y);
+                    shaded[layer * pixels + i] = shaded_record(c, p.y, HIT | flags);
+                }
             } else if layer == 0u {
-                shaded[i] = shaded_record(vec3<f32>(0.0), 0u, cons);
+                shaded[i] = shaded_record(vec3<f32>(0.0), 0u, flags);
             }
         }
     }

@@ -4,12 +4,14 @@
 // the float's bits, as on the CPU, so both pack the same bits.
 #define_import_path strandgraph::lipp_shaded
 
-#import strandgraph::lipp::INV_DEPTH_MAX
+#import strandgraph::lipp::{INV_DEPTH_MAX, is_empty, linear_depth}
 
 const RGB9E5_MAX: f32 = 65408.0;
-// Word 1's flags: this layer has a sample; the pixel's conservative layer has one.
+// Word 1's flags: this layer has a sample; the pixel's conservative layer
+// has one; it lies in front of the centre one (shaded::FRONT).
 const HIT: u32 = 1u;
 const CONS_HIT: u32 = 2u;
+const FRONT: u32 = 4u;
 
 // shaded::exp2i: 2^k, exactly.
 fn exp2i(k: i32) -> f32 {
@@ -46,4 +48,21 @@ fn shaded_record(color: vec3<f32>, payload_hi: u32, flags: u32) -> vec2<u32> {
 // shaded::depth.
 fn record_depth(word1: u32) -> f32 {
     return f32(word1 >> 8u) * INV_DEPTH_MAX;
+}
+
+// shaded::pixel_flags: CONS_HIT and FRONT from the pixel's two payloads.
+fn pixel_flags(near: f32, far: f32, centre: vec2<u32>, cons: vec2<u32>, front_threshold: f32) -> u32 {
+    if is_empty(cons) {
+        return 0u;
+    }
+    var front = false;
+    if !is_empty(centre) {
+        front = linear_depth(near, far, record_depth(cons.y)) <= linear_depth(near, far, record_depth(centre.y)) - front_threshold;
+    }
+    return CONS_HIT | select(0u, FRONT, front);
+}
+
+// shaded::read_by_filter.
+fn read_by_filter(layer: u32, layers: u32, centre_hit: bool, flags: u32) -> bool {
+    return layer != 1u || layers > 2u || !centre_hit || (flags & FRONT) != 0u;
 }

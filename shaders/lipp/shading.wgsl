@@ -51,7 +51,13 @@ struct ShadeParams {
     slots: u32,
     // lipp.shade: list only the tiles with hair (lipp::tiles).
     hair_tiles: u32,
-    reserved: u32,
+    // lipp.shade: metres a flyaway lies in front (shaded::FRONT), and
+    // whether only the samples lipp.filter reads are shaded (shade.rs).
+    front_threshold: f32,
+    read_layers_only: u32,
+    reserved_a: u32,
+    reserved_b: u32,
+    reserved_c: u32,
 }
 
 // shade::ShadeParams as the shading reads it (booleans as 0/1).

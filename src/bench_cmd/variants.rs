@@ -318,6 +318,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Every conservative sample shaded, not only where lipp.filter reads
+    // its colour (passes/src/lipp/shade.rs, `read_layers_only`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, every sample shaded",
+        graph: LIPP,
+        overrides: &["shade.read_layers_only=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // lipp.filter over every tile lipp.shade ran rather than the tiles with
     // hair it lists (passes/src/lipp/tiles.rs): the tiles in the groom's
     // screen rectangle.

@@ -12,8 +12,9 @@
 //! - strand connection (§3.3.2): conservative-only pixels are *promoted* and
 //!   borrow the filtered colour of centre-hit neighbours, with w_color = 1;
 //!   where a conservative strand lies in front of the centre hit (depth
-//!   mismatch ≥ `front_threshold`), its reconstruction is blended over the
-//!   centre colour and the output opacity is 1;
+//!   mismatch ≥ `lipp.shade`'s `front_threshold`, the records' `FRONT`
+//!   flag), its reconstruction is blended over the centre colour and the
+//!   output opacity is 1;
 //! - alpha (§3.3.3): α_P = H_center / (H_center + H_cons) over the
 //!   tangent-aligned strip of width `strip_width` (Code 2 line 45; the text's
 //!   H_center / H_cons counts the centre hits among the conservative ones).
@@ -34,7 +35,7 @@
 //!   forcing 1.
 //!
 //! Deviations: depths are compared as linear view depth in metres
-//! (`depth_threshold` 0.05, `front_threshold` 0.01). The paper's 1.45e-3 and
+//! (`depth_threshold` 0.05, and `lipp.shade`'s `front_threshold` 0.01). The paper's 1.45e-3 and
 //! 5e-4 are read here as differences of the payload's NDC depth (the only
 //! depth its G-buffer holds): z_ndc = f(z − n) / (z(f − n)) changes by
 //! n f / ((f − n) z²) ≈ n / z² per metre, so with our near plane (0.02 m)
@@ -78,7 +79,6 @@ pub struct FilterParams {
     pub sigma_c: f32,
     pub strip_width: f32,
     pub depth_threshold: f32,
-    pub front_threshold: f32,
     /// MSAA reference resolve: average the N sample layers, α = hits / N
     /// (0: the single-sample filter above).
     pub msaa: u32,
@@ -124,7 +124,6 @@ impl Default for FilterParams {
             sigma_c: 0.9,
             strip_width: 0.5,
             depth_threshold: 0.05,
-            front_threshold: 0.01,
             msaa: 0,
             depth_alpha: 0.5,
             true_width: true,
@@ -192,7 +191,6 @@ crate::gpu_block! {
         sigma_c: f32,
         strip_width: f32,
         depth_threshold: f32,
-        front_threshold: f32,
         /// Scene quantities.
         width: u32,
         height: u32,
@@ -239,7 +237,6 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         sigma_c: p.sigma_c,
         strip_width: p.strip_width,
         depth_threshold: p.depth_threshold,
-        front_threshold: p.front_threshold,
         width: q.width,
         height: q.height,
         msaa: p.msaa,
@@ -327,6 +324,10 @@ impl View<'_> {
     pub fn color(&self, layer: u32, i: u32) -> [f32; 3] {
         let slot = (layer * self.width * self.height + i) as usize;
         shaded::unpack_rgb9e5(self.shaded.load(2 * slot))
+    }
+    /// Pixel i's flags ([`shaded::pixel_flags`]), from its centre record.
+    pub fn flags(&self, i: u32) -> u32 {
+        self.shaded.load(2 * i as usize + 1) & 0xFF
     }
     /// What a tap needs of neighbour `q`: the centre layer's record, whose
     /// colour word is read only once the tap passes its tests. With
@@ -546,10 +547,9 @@ pub fn filter_pixel(p: &FilterParams, v: &View<'_>, x: u32, y: u32) -> Option<Ha
         let sg = unpack(g);
         let cp = v.color(0, i);
         let (c, alpha) = reconstruct(p, v, x, y, &Reference::of(v, x, y, &sg, cp, false));
-        let front = cons && p.reconnect && {
-            let sa = unpack(a);
-            linear_depth(v.f, sa.depth) <= linear_depth(v.f, sg.depth) - p.front_threshold
-        };
+        // lipp.shade's decision (shaded::pixel_flags), which told it to
+        // shade the conservative sample.
+        let front = p.reconnect && v.flags(i) & shaded::FRONT != 0;
         if front {
             // A flyaway in front of the centre hit: its reconstruction over
             // the centre colour, opacity 1 (§3.3.3).
@@ -743,11 +743,7 @@ mod tests {
             records[2 * slot + 1].store(r[1], Relaxed);
         };
         for i in 0..n {
-            let cons = if words[n + i] == EMPTY {
-                0
-            } else {
-                shaded::CONS_HIT
-            };
+            let cons = shaded::pixel_flags(&f, words[i], words[n + i], 0.01);
             for layer in 0..2 {
                 let p = words[layer * n + i];
                 let c = [0, 1, 2]
@@ -858,6 +854,80 @@ mod tests {
         for (x, y) in (0..h).flat_map(|y| (0..w).map(move |x| (x, y))) {
             let got = filter_pixel(&FilterParams::default(), &clipped, x, y);
             assert_eq!(got, expect[(y * w + x) as usize], "pixel ({x}, {y})");
+        }
+        assert_eq!(oob.load(Relaxed), 0);
+    }
+
+    /// With `lipp.shade`'s `read_layers_only`, a conservative record the
+    /// shade skips holds last frame's words: the filter must not read it,
+    /// and must read the flyaways' (the scene has both).
+    #[test]
+    fn the_filter_reads_no_conservative_record_the_shade_skips() {
+        let (mut g, mut sh) = (Vec::new(), Vec::new());
+        let (f, w, h) = scene(&mut g, &mut sh);
+        let n = (w * h) as usize;
+        // A lone flyaway 10 cm in front of its pixel's strand, nothing else
+        // within the window: its reconstruction has no neighbour within the
+        // depth threshold and keeps its own (conservative) colour.
+        let (cx, cy) = (w / 2, h / 2);
+        for (x, y) in (cy - 6..=cy + 6).flat_map(|y| (cx - 6..=cx + 6).map(move |x| (x, y))) {
+            let i = (y * w + x) as usize;
+            for (slot, word) in [(i, 0), (i, 1), (n + i, 0), (n + i, 1)] {
+                g[2 * slot + word].store(u32::MAX, Relaxed);
+            }
+            let empty = shaded::record([0.0; 3], 0, 0);
+            sh[2 * i].store(empty[0], Relaxed);
+            sh[2 * i + 1].store(empty[1], Relaxed);
+        }
+        let i = (cy * w + cx) as usize;
+        let at = |metres: f32| {
+            super::super::payload::pack(&Sample {
+                depth: ndc_depth(&f, metres),
+                tangent: [1.0, 0.0, 0.0],
+                uvw: [0.5; 3],
+                ao: 1.0,
+            })
+        };
+        let (centre, cons) = (at(0.7), at(0.6));
+        let flags = shaded::pixel_flags(&f, centre, cons, 0.01);
+        for (slot, p, c) in [
+            (i, centre, [0.2, 0.1, 0.05]),
+            (n + i, cons, [0.4, 0.3, 0.2]),
+        ] {
+            g[2 * slot].store(p as u32, Relaxed);
+            g[2 * slot + 1].store((p >> 32) as u32, Relaxed);
+            let r = shaded::record(c, (p >> 32) as u32, shaded::HIT | flags);
+            sh[2 * slot].store(r[0], Relaxed);
+            sh[2 * slot + 1].store(r[1], Relaxed);
+        }
+        let oob = AtomicU64::new(0);
+        let filtered = |sh: &[AtomicU32]| -> Vec<Option<Hair>> {
+            let v = test_view(&f, &g, sh, &oob);
+            (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| filter_pixel(&FilterParams::default(), &v, x, y))
+                .collect()
+        };
+        let expect = filtered(&sh);
+        let stale = shaded::record([50.0, 0.0, 0.0], 0, shaded::HIT | shaded::CONS_HIT);
+        let (mut skipped, mut fronts) = (0, 0);
+        for i in 0..n {
+            let word1 = sh[2 * i + 1].load(Relaxed);
+            let (hit, flags) = (word1 & shaded::HIT != 0, word1 & 0xFF);
+            fronts += usize::from(flags & shaded::FRONT != 0);
+            if flags & shaded::CONS_HIT != 0 && !shaded::read_by_filter(1, 2, hit, flags) {
+                sh[2 * (n + i)].store(stale[0], Relaxed);
+                sh[2 * (n + i) + 1].store(stale[1], Relaxed);
+                skipped += 1;
+            }
+        }
+        assert!(
+            skipped > n / 10 && fronts > n / 20,
+            "{skipped} skipped, {fronts} in front"
+        );
+        let got = filtered(&sh);
+        for (k, (a, b)) in got.iter().zip(&expect).enumerate() {
+            assert_eq!(a, b, "pixel ({}, {})", k as u32 % w, k as u32 / w);
         }
         assert_eq!(oob.load(Relaxed), 0);
     }

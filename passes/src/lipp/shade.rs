@@ -52,7 +52,7 @@ use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
 use super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, FILTER_RECT_HI, FILTER_RECT_LO, Rect};
-use super::shaded::{CONS_HIT, HIT, record};
+use super::shaded::{HIT, pixel_flags, read_by_filter, record};
 use super::tiles;
 use super::{ARGS_ALL, ARGS_KEPT, add, dot, frame, normalize, pcg, scale, sub, transform, unit};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
@@ -95,6 +95,16 @@ pub struct ShadeParams {
     /// Ours: list only the tiles with hair for `lipp.filter` ([`super::tiles`]);
     /// off, every tile.
     pub hair_tiles: bool,
+    /// Metres of linear depth a conservative sample must lie in front of
+    /// the centre one to be blended over it by `lipp.filter` as a flyaway
+    /// (§3.3.2; the records' [`super::shaded::FRONT`] flag; filter.rs says why
+    /// metres).
+    pub front_threshold: f32,
+    /// Shade a conservative sample only where `lipp.filter` reads its
+    /// colour ([`read_by_filter`]: no centre sample, or a flyaway
+    /// in front); off, every sample. The issue's "shading only the layers
+    /// the filter reads"; the paper does not say.
+    pub read_layers_only: bool,
 }
 
 impl Default for ShadeParams {
@@ -112,6 +122,8 @@ impl Default for ShadeParams {
             dom_layer_thickness: 0.02,
             model_index: 0,
             hair_tiles: true,
+            front_threshold: 0.01,
+            read_layers_only: true,
         }
     }
 }
@@ -124,6 +136,9 @@ impl PassParams for ShadeParams {
         in_range("dom_layers", self.dom_layers, 1..=8)?;
         if !(self.dom_layer_thickness.is_finite() && self.dom_layer_thickness > 0.0) {
             return Err(Invalid::new("dom_layer_thickness", "must be positive"));
+        }
+        if !(self.front_threshold.is_finite() && self.front_threshold >= 0.0) {
+            return Err(Invalid::new("front_threshold", "must be at least 0"));
         }
         Ok(())
     }
@@ -151,7 +166,13 @@ crate::gpu_block! {
         slots: u32,
         /// `lipp.shade` only: list only the tiles with hair.
         hair_tiles: u32,
-        reserved: u32,
+        /// `lipp.shade` only: [`ShadeParams::front_threshold`].
+        front_threshold: f32,
+        /// `lipp.shade` only: [`ShadeParams::read_layers_only`].
+        read_layers_only: u32,
+        reserved_a: u32,
+        reserved_b: u32,
+        reserved_c: u32,
     }
 }
 
@@ -173,7 +194,11 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         probe_specular: flag(p.probe_specular),
         slots,
         hair_tiles: flag(p.hair_tiles),
-        reserved: 0,
+        front_threshold: p.front_threshold,
+        read_layers_only: flag(p.read_layers_only),
+        reserved_a: 0,
+        reserved_b: 0,
+        reserved_c: 0,
     }
 }
 
@@ -482,20 +507,25 @@ impl ShadeKernel {
         };
         for i in run * SHADE_GROUP..((run + 1) * SHADE_GROUP).min(pixels) {
             let (x, y) = (i % w, i / w);
-            let cons = if payload(1, i) != EMPTY { CONS_HIT } else { 0 };
+            let centre = payload(0, i);
+            let flags = pixel_flags(inp.f, centre, payload(1, i), self.0.front_threshold);
             for layer in 0..layers {
                 let p = payload(layer, i);
                 // The centre layer's record for every pixel (the filter's
                 // taps read its flags), the others where a sample is.
                 if p == EMPTY {
                     if layer == 0 {
-                        store(i, record([0.0; 3], 0, cons));
+                        store(i, record([0.0; 3], 0, flags));
                     }
                     continue;
                 }
                 hair = true;
+                if self.0.read_layers_only && !read_by_filter(layer, layers, centre != EMPTY, flags)
+                {
+                    continue;
+                }
                 let c = shade_sample(inp, &unpack(p), x, y);
-                store(layer * pixels + i, record(c, (p >> 32) as u32, HIT | cons));
+                store(layer * pixels + i, record(c, (p >> 32) as u32, HIT | flags));
             }
         }
         if hair || !self.0.hair_tiles {

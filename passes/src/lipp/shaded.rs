@@ -6,6 +6,7 @@
 //! |------|-------|-----------------------------------------------------|
 //! | 0    | 31..0 | radiance, RGB9E5 (Vulkan's `E5B9G9R9_UFLOAT_PACK32`) |
 //! | 1    | 31..8 | the sample's 24-bit NDC depth (the payload's)       |
+//! | 1    | 2     | the pixel's conservative sample is in front (below) |
 //! | 1    | 1     | the pixel's conservative layer has a sample         |
 //! | 1    | 0     | this layer has a sample                             |
 //!
@@ -24,6 +25,10 @@
 //! exponent is read from the float's bits rather than `log2`, so CPU and
 //! WGSL pack the same bits.
 
+use super::filter::linear_depth;
+use super::payload::EMPTY;
+use crate::layout::FrameData;
+
 /// Mantissa bits (N) and exponent bias (B) of RGB9E5.
 const MANTISSA: i32 = 9;
 const BIAS: i32 = 15;
@@ -33,6 +38,12 @@ pub const RGB9E5_MAX: f32 = 65_408.0;
 /// Word 1's flags.
 pub const HIT: u32 = 1;
 pub const CONS_HIT: u32 = 2;
+/// The pixel has both samples and the conservative one lies at least
+/// `lipp.shade`'s `front_threshold` (metres, linear depth) in front of the
+/// centre one: a flyaway, whose reconstruction `lipp.filter` blends over
+/// the centre colour (Lipp §3.3.2). The shade decides it because it then
+/// knows which layers the filter reads ([`read_by_filter`]).
+pub const FRONT: u32 = 4;
 
 /// 2^k as an f32, exactly (k in −126..=127).
 fn exp2i(k: i32) -> f32 {
@@ -76,6 +87,28 @@ pub fn depth(word1: u32) -> f32 {
     (word1 >> 8) as f32 * super::payload::INV_DEPTH_MAX
 }
 
+/// The pixel's flags in every record of it: [`CONS_HIT`] and [`FRONT`],
+/// from its centre and conservative payloads.
+pub fn pixel_flags(f: &FrameData, centre: u64, cons: u64, front_threshold: f32) -> u32 {
+    if cons == EMPTY {
+        return 0;
+    }
+    let front = centre != EMPTY && {
+        let d = |p: u64| linear_depth(f, depth((p >> 32) as u32));
+        d(cons) <= d(centre) - front_threshold
+    };
+    CONS_HIT | if front { FRONT } else { 0 }
+}
+
+/// Whether `lipp.filter` reads the colour of sample layer `layer` of
+/// `layers` at a pixel with `flags` whose centre layer has a sample or not
+/// (filter::filter_pixel): a conservative sample only where it is promoted
+/// (no centre sample, §3.3.2) or lies in front; every sample of the MSAA
+/// reference's layers.
+pub fn read_by_filter(layer: u32, layers: u32, centre_hit: bool, flags: u32) -> bool {
+    layer != 1 || layers > 2 || !centre_hit || flags & FRONT != 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,6 +145,34 @@ mod tests {
             unpack_rgb9e5(pack_rgb9e5([-1.0, f32::NAN, 1e9])),
             [0.0, 0.0, RGB9E5_MAX]
         );
+    }
+
+    /// A conservative sample 1 cm (the default threshold) or more in front
+    /// of the centre one is a flyaway; nearer, behind or alone it is not.
+    #[test]
+    fn front_is_set_by_the_linear_depth_gap() {
+        use super::super::filter::ndc_depth;
+        use super::super::payload::{Sample, pack};
+        let f = super::super::raster::tests::frame();
+        let at = |metres: f32| {
+            pack(&Sample {
+                depth: ndc_depth(&f, metres),
+                tangent: [1.0, 0.0, 0.0],
+                uvw: [0.5; 3],
+                ao: 1.0,
+            })
+        };
+        let flags = |centre, cons| pixel_flags(&f, centre, cons, 0.01);
+        assert_eq!(flags(at(0.7), at(0.68)), CONS_HIT | FRONT);
+        assert_eq!(flags(at(0.7), at(0.695)), CONS_HIT);
+        assert_eq!(flags(at(0.7), at(0.75)), CONS_HIT);
+        assert_eq!(flags(EMPTY, at(0.5)), CONS_HIT);
+        assert_eq!(flags(at(0.7), EMPTY), 0);
+        // The filter reads a conservative colour where promoted or in front.
+        assert!(read_by_filter(1, 2, false, CONS_HIT));
+        assert!(read_by_filter(1, 2, true, CONS_HIT | FRONT));
+        assert!(!read_by_filter(1, 2, true, CONS_HIT));
+        assert!(read_by_filter(1, 4, true, CONS_HIT) && read_by_filter(0, 2, true, 0));
     }
 
     #[test]
