@@ -100,10 +100,10 @@ pub struct ShadeParams {
     /// (§3.3.2; the records' [`super::shaded::FRONT`] flag; filter.rs says why
     /// metres).
     pub front_threshold: f32,
-    /// Shade a conservative sample only where `lipp.filter` reads its
-    /// colour ([`read_by_filter`]: no centre sample, or a flyaway
-    /// in front); off, every sample. The issue's "shading only the layers
-    /// the filter reads"; the paper does not say.
+    /// Ours (the paper does not say which samples it shades): shade a
+    /// conservative sample only where `lipp.filter` reads its colour
+    /// ([`read_by_filter`]: no centre sample, or a flyaway in front); off,
+    /// every sample. The pictures are the same.
     pub read_layers_only: bool,
 }
 

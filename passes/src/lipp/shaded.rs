@@ -6,7 +6,7 @@
 //! |------|-------|-----------------------------------------------------|
 //! | 0    | 31..0 | radiance, RGB9E5 (Vulkan's `E5B9G9R9_UFLOAT_PACK32`) |
 //! | 1    | 31..8 | the sample's 24-bit NDC depth (the payload's)       |
-//! | 1    | 2     | the pixel's conservative sample is in front (below) |
+//! | 1    | 2     | a flyaway: the conservative sample lies in front    |
 //! | 1    | 1     | the pixel's conservative layer has a sample         |
 //! | 1    | 0     | this layer has a sample                             |
 //!
