@@ -5,7 +5,7 @@
 // (Hillis and Steele), then each lane writes its run.
 
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, ARGS_RUNS, rect_union, rect_is_empty, unpack_tiles, rect_args, rect_runs}
-#import strandgraph::lipp::{BUNDLE_WORDS, LOD_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED, ARGS_BUNDLES_LO, ARGS_BUNDLES_HI}
+#import strandgraph::lipp::{BUNDLE_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED, ARGS_BUNDLES_LO, ARGS_BUNDLES_HI}
 
 struct ScanParams {
     // Scene quantity: bundles packed.
@@ -27,7 +27,7 @@ const ALL_MODELS: u32 = 0xFFFFFFFFu;
 
 @group(0) @binding(0) var<uniform> params: ScanParams;
 @group(0) @binding(1) var<storage, read> hairmesh_bundles: array<u32>;
-// A bundle's record (LOD_WORDS = 4 words) as one load and one store.
+// A bundle's record (lipp::LOD_WORDS, 4 words) as one load and one store.
 @group(0) @binding(2) var<storage, read> lod_choices: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read_write> bundle_lod: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> raster_args: array<u32>;

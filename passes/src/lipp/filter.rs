@@ -743,17 +743,17 @@ mod tests {
             records[2 * slot + 1].store(r[1], Relaxed);
         };
         for i in 0..n {
-            let cons = shaded::pixel_flags(&f, words[i], words[n + i], 0.01);
+            let flags = shaded::pixel_flags(&f, words[i], words[n + i], 0.01);
             for layer in 0..2 {
                 let p = words[layer * n + i];
                 let c = [0, 1, 2]
                     .map(|j| super::super::unit(super::super::pcg((layer * n + i) as u32 * 3 + j)));
                 match p {
-                    EMPTY if layer == 0 => out(i, shaded::record([0.0; 3], 0, cons)),
+                    EMPTY if layer == 0 => out(i, shaded::record([0.0; 3], 0, flags)),
                     EMPTY => {}
                     _ => out(
                         layer * n + i,
-                        shaded::record(c, (p >> 32) as u32, shaded::HIT | cons),
+                        shaded::record(c, (p >> 32) as u32, shaded::HIT | flags),
                     ),
                 }
             }
@@ -880,14 +880,7 @@ mod tests {
             sh[2 * i + 1].store(empty[1], Relaxed);
         }
         let i = (cy * w + cx) as usize;
-        let at = |metres: f32| {
-            super::super::payload::pack(&Sample {
-                depth: ndc_depth(&f, metres),
-                tangent: [1.0, 0.0, 0.0],
-                uvw: [0.5; 3],
-                ao: 1.0,
-            })
-        };
+        let at = |metres| shaded::tests::payload_at(&f, metres);
         let (centre, cons) = (at(0.7), at(0.6));
         let flags = shaded::pixel_flags(&f, centre, cons, 0.01);
         for (slot, p, c) in [

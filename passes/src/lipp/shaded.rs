@@ -110,7 +110,7 @@ pub fn read_by_filter(layer: u32, layers: u32, centre_hit: bool, flags: u32) -> 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -147,21 +147,24 @@ mod tests {
         );
     }
 
+    /// A payload at `metres` of linear view depth (any tangent and uvw).
+    pub(crate) fn payload_at(f: &FrameData, metres: f32) -> u64 {
+        use super::super::filter::ndc_depth;
+        use super::super::payload::{Sample, pack};
+        pack(&Sample {
+            depth: ndc_depth(f, metres),
+            tangent: [1.0, 0.0, 0.0],
+            uvw: [0.5; 3],
+            ao: 1.0,
+        })
+    }
+
     /// A conservative sample 1 cm (the default threshold) or more in front
     /// of the centre one is a flyaway; nearer, behind or alone it is not.
     #[test]
     fn front_is_set_by_the_linear_depth_gap() {
-        use super::super::filter::ndc_depth;
-        use super::super::payload::{Sample, pack};
         let f = super::super::raster::tests::frame();
-        let at = |metres: f32| {
-            pack(&Sample {
-                depth: ndc_depth(&f, metres),
-                tangent: [1.0, 0.0, 0.0],
-                uvw: [0.5; 3],
-                ao: 1.0,
-            })
-        };
+        let at = |metres| payload_at(&f, metres);
         let flags = |centre, cons| pixel_flags(&f, centre, cons, 0.01);
         assert_eq!(flags(at(0.7), at(0.68)), CONS_HIT | FRONT);
         assert_eq!(flags(at(0.7), at(0.695)), CONS_HIT);
