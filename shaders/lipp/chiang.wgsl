@@ -3,7 +3,7 @@
 // offset h. Port of passes/src/lipp/chiang.rs, operation for operation (the
 // model, its sources and its measured error against pbrt are documented
 // there). Composed with naga_oil:
-//   #import strandgraph::chiang::{chiang}
+//   #import strandgraph::chiang::{chiang, fibre_paths, FibrePaths}
 #define_import_path strandgraph::chiang
 
 #import strandgraph::lipp::{PI, safe_normalize}
@@ -113,32 +113,53 @@ fn offset_at(j: u32, cos_o: f32, rc: vec2<f32>, sa: vec3<f32>) -> Offset {
     return Offset(fresnel(cos_o * node.z), exp(-2.0 * sa * cos_gt / rc.y), sin_gt);
 }
 
-// chiang::reflected_albedo: R's (x) and TRT's (yzw) directional albedo at
-// sin θ_o, pbrt-v4's A_p averaged over h.
-fn reflected_albedo(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> vec4<f32> {
+// chiang::FibrePaths: A_p and Φ_p − pπ of TT and TRT at each node (TT
+// then TRT), and R's (x) and TRT's (yzw) directional albedo: what the lobes
+// need of the view, once per shaded point for every light and the probe.
+struct FibrePaths {
+    ap: array<array<vec3<f32>, 5>, 2>,
+    dphi: array<array<f32, 5>, 2>,
+    albedo: vec4<f32>,
+}
+
+// chiang::FibrePaths::new at sin θ_o = sin_o_in (T · V).
+fn fibre_paths(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> FibrePaths {
     let sin_o = clamp(sin_o_in, -1.0, 1.0);
     let cos_o = sqrt(max(1.0 - sin_o * sin_o, 0.0));
     let sa = sigma_a(color, clamp(roughness, 0.02, 1.0));
     let rc = refraction(sin_o, cos_o);
+    var nodes = H_NODES;
     var pieces = PIECES;
+    var paths: FibrePaths;
+    var f_prev = 0.0;
     var r = 0.0;
     var trt = vec3<f32>(0.0);
-    var prev = vec4<f32>(0.0);
     for (var j = 0u; j < NODES; j++) {
+        let node = nodes[j];
         let o = offset_at(j, cos_o, rc, sa);
-        let cur = vec4<f32>(o.f, (1.0 - o.f) * (1.0 - o.f) * o.tr * o.tr * o.f);
+        let gamma_t = asin(o.sin_gt);
+        let f = o.f;
+        let tr = o.tr;
+        let t1 = (1.0 - f) * (1.0 - f);
+        paths.ap[0][j] = t1 * tr;
+        paths.ap[1][j] = t1 * tr * tr * f;
+        paths.dphi[0][j] = 2.0 * gamma_t - 2.0 * node.y;
+        paths.dphi[1][j] = 4.0 * gamma_t - 2.0 * node.y;
+        // The albedo: A_p linear in γ over each piece, as the lobes integrate it.
         if j > 0u {
             let w = pieces[j - 1u];
-            r += w.x * prev.x + w.y * cur.x;
-            trt += w.x * prev.yzw + w.y * cur.yzw;
+            r += w.x * f_prev + w.y * f;
+            trt += w.x * paths.ap[1][j - 1u] + w.y * paths.ap[1][j];
         }
-        prev = cur;
+        f_prev = f;
     }
-    return vec4<f32>(r, trt);
+    paths.albedo = vec4<f32>(r, trt);
+    return paths;
 }
 
-// chiang::chiang: R + TT + TRT, pbrt's f · |cos| averaged over h.
-fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> vec3<f32> {
+// chiang::chiang: R + TT + TRT, pbrt's f · |cos| averaged over h; `paths`
+// are the view's (fibre_paths(dot(t, v), ...)).
+fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, paths: FibrePaths, roughness: f32, alpha: f32) -> vec3<f32> {
     let sin_i = clamp(dot(t, l), -1.0, 1.0);
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
     let cos_i = sqrt(max(1.0 - sin_i * sin_i, 0.0));
@@ -162,25 +183,9 @@ fn chiang(t: vec3<f32>, l: vec3<f32>, v: vec3<f32>, color: vec3<f32>, roughness:
     let a = 3.717 * s;
     let r = (0.7619 * n_r(phi, cos_o) + 0.1190 * (n_r(phi - a, cos_o) + n_r(phi + a, cos_o)))
         * mps[0];
-    let sa = sigma_a(color, b);
-    let rc = refraction(sin_o, cos_o);
-    var nodes = H_NODES;
     var pieces = PIECES;
-    // A_p and Φ_p − pπ at each node, TT then TRT.
-    var ap: array<array<vec3<f32>, 5>, 2>;
-    var dphi: array<array<f32, 5>, 2>;
-    for (var j = 0u; j < NODES; j++) {
-        let node = nodes[j];
-        let o = offset_at(j, cos_o, rc, sa);
-        let gamma_t = asin(o.sin_gt);
-        let f = o.f;
-        let tr = o.tr;
-        let t1 = (1.0 - f) * (1.0 - f);
-        ap[0][j] = t1 * tr;
-        ap[1][j] = t1 * tr * tr * f;
-        dphi[0][j] = 2.0 * gamma_t - 2.0 * node.y;
-        dphi[1][j] = 4.0 * gamma_t - 2.0 * node.y;
-    }
+    var ap = paths.ap;
+    var dphi = paths.dphi;
     var x = array<f32, 2>(phi - PI, phi);
     let trim = 1.0 / (logistic_cdf(PI, s) - logistic_cdf(-PI, s));
     var out = vec3<f32>(r);

@@ -7,7 +7,6 @@
 #define_import_path strandgraph::probe
 
 #import strandgraph::lipp::{PI, safe_normalize}
-#import strandgraph::chiang::{reflected_albedo}
 
 // probe::{LEVELS, WIDTH, HEIGHT, MIN_WIDTH, MIN_HEIGHT}.
 const PROBE_LEVELS: u32 = 6u;
@@ -100,13 +99,13 @@ struct ProbeLobe {
     weight: vec3<f32>,
 }
 
-// probe::specular_lobe: one GGX lobe for R + TRT.
-fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> ProbeLobe {
+// probe::specular_lobe: one GGX lobe for R + TRT, from the view's
+// directional albedo (chiang's FibrePaths: R in x, TRT in yzw).
+fn probe_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, albedo: vec4<f32>, roughness: f32, alpha: f32) -> ProbeLobe {
     let sin_o = clamp(dot(t, v), -1.0, 1.0);
     let bm = clamp(roughness, 0.02, 1.0);
     let x0 = 0.726 * bm + 0.812 * bm * bm + 3.7 * pow(bm, 20.0);
     let v0 = x0 * x0;
-    let albedo = reflected_albedo(sin_o, color, roughness);
     let w_r = albedo.x;
     let a_trt = albedo.yzw;
     let w_trt = (a_trt.x + a_trt.y + a_trt.z) / 3.0;

@@ -20,7 +20,7 @@
 #import strandgraph::lipp_dom::{frame, models, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::hash::pcg
 #import strandgraph::lipp::{LightFrame, light_project, unit, safe_normalize, PI}
-#import strandgraph::chiang::{chiang}
+#import strandgraph::chiang::{chiang, fibre_paths, FibrePaths}
 #import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
 @group(0) @binding(#{ENV_SH_BINDING}) var<storage, read> env_sh: array<vec4<f32>, 9>;
@@ -168,8 +168,8 @@ fn probe_level(k: u32, d: vec3<f32>) -> vec3<f32> {
 }
 
 // probe::specular (specular_lobe): the R + TRT stand-in lobe's prefiltered radiance, weighted.
-fn specular_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, color: vec3<f32>, roughness: f32, alpha: f32) -> vec3<f32> {
-    let lobe = probe_lobe(t, v, n, color, roughness, alpha);
+fn specular_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, albedo: vec4<f32>, roughness: f32, alpha: f32) -> vec3<f32> {
+    let lobe = probe_lobe(t, v, n, albedo, roughness, alpha);
     let lod = probe_alpha_lod(lobe.alpha);
     let k0 = min(u32(floor(lod)), PROBE_LEVELS - 1u);
     let k1 = min(k0 + 1u, PROBE_LEVELS - 1u);
@@ -188,6 +188,8 @@ fn shade_point(s: Shading, pos: vec3<f32>, t: vec3<f32>, strand: vec2<u32>, ao: 
     let color = clamp(c.xyz * vary, vec3<f32>(0.0), vec3<f32>(1.0));
     let roughness = c.w;
     let alpha = models[model_index].highlight_shift;
+    // What the fibre's lobes need of the view, for every light and the probe.
+    let paths = fibre_paths(dot(t, v), color, roughness);
     var out = vec3<f32>(0.0);
     let count = min(frame.light_count, arrayLength(&lipp_dom::lights));
     for (var i = 0u; i < count; i++) {
@@ -204,7 +206,7 @@ fn shade_point(s: Shading, pos: vec3<f32>, t: vec3<f32>, strand: vec2<u32>, ao: 
             shadow = dom_transmittance(s, i, pos, delta);
         }
         let rad = lipp_dom::lights[i].radiance.xyz * atten * shadow;
-        var f = chiang(t, l, v, color, roughness, alpha) * s.specular;
+        var f = chiang(t, l, v, paths, roughness, alpha) * s.specular;
         if s.multiple_scattering != 0u {
             let sin_tl = sqrt(max(1.0 - dot(t, l) * dot(t, l), 0.0));
             f += color * (sin_tl / PI);
@@ -216,7 +218,7 @@ fn shade_point(s: Shading, pos: vec3<f32>, t: vec3<f32>, strand: vec2<u32>, ao: 
         let e = max(sh_irradiance(n), vec3<f32>(0.0));
         var spec = vec3<f32>(0.0);
         if s.probe_specular != 0u {
-            spec = specular_lobe(t, v, n, color, roughness, alpha);
+            spec = specular_lobe(t, v, n, paths.albedo, roughness, alpha);
         }
         out += (e / PI * color + spec * s.specular) * ao;
     }

@@ -47,7 +47,7 @@
 //! environment) along the specular cone and weighted by A_R + A_TRT
 //! ([`super::probe::specular_lobe`] says how the lobe is chosen).
 
-pub use super::chiang::{Material, chiang, sigma_a};
+pub use super::chiang::{FibrePaths, Material, chiang, sigma_a};
 use super::dom::{LightFrame, NO_HIT, OPACITY_SCALE, light_frames};
 use super::payload::{EMPTY, Sample, unpack};
 use super::probe;
@@ -395,6 +395,8 @@ pub fn shade_point(inp: &Inputs<'_>, model: &ModelData, p: &Point) -> [f32; 3] {
         roughness: c[3],
         alpha: model.highlight_shift,
     };
+    // What the fibre's lobes need of the view, for every light and the probe.
+    let paths = FibrePaths::new(dot(t, v), &m);
     let mut out = [0.0f32; 3];
     for (li, light) in inp.lights.iter().enumerate() {
         let pd = light.position_or_direction;
@@ -413,7 +415,7 @@ pub fn shade_point(inp: &Inputs<'_>, model: &ModelData, p: &Point) -> [f32; 3] {
             None => 1.0,
         };
         let rad = scale(rad, shadow);
-        let single = scale(chiang(t, l, v, &m), inp.params.specular);
+        let single = scale(chiang(t, l, v, &m, &paths), inp.params.specular);
         let mut f = single;
         if inp.params.multiple_scattering {
             let sin_tl = (1.0 - dot(t, l) * dot(t, l)).max(0.0).sqrt();
@@ -429,7 +431,7 @@ pub fn shade_point(inp: &Inputs<'_>, model: &ModelData, p: &Point) -> [f32; 3] {
         let n = probe::view_facing_normal(t, v);
         let e = sh_irradiance(&inp.sh, n);
         let spec = if inp.params.probe_specular {
-            probe::specular(&inp.prefiltered, t, v, n, &m)
+            probe::specular(&inp.prefiltered, t, v, n, &m, &paths)
         } else {
             [0.0; 3]
         };

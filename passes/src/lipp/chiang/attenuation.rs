@@ -1,7 +1,8 @@
 //! A_p of Chiang's model averaged over the fibre offset h: the offsets
 //! where it is evaluated, their Fresnel and transmittance (pbrt-v4
 //! `HairBxDF::Ap`), the weights of the pieces between them, and the
-//! directional albedo in R and TRT that the probe term uses.
+//! per-view table of them ([`FibrePaths`]) that every light and the probe
+//! term read.
 
 use super::{Material, sigma_a};
 
@@ -33,29 +34,58 @@ pub(super) fn offsets(sin_o: f32, cos_o: f32, sigma_a: [f32; 3]) -> [Offset; NOD
     })
 }
 
-/// The fibre's directional albedo in R and in TRT seen at sin θ_o: pbrt-v4's
-/// `HairBxDF::Ap` for p = 0 and 2 averaged over h (M_p and N_p integrate to
-/// one, so under uniform light the lobes return exactly this), by the same
-/// offsets and pieces as [`chiang_lobes`]. `lipp.shade`'s probe term weights
-/// its single GGX lobe with it (Lipp §3.4).
-pub fn reflected_albedo(sin_o: f32, m: &Material) -> (f32, [f32; 3]) {
-    let sin_o = sin_o.clamp(-1.0, 1.0);
-    let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
-    let at = offsets(sin_o, cos_o, sigma_a(m.color, m.roughness.clamp(0.02, 1.0)));
-    let node = |j: usize| {
-        let (f, tr) = (at[j].f, at[j].tr);
-        (f, tr.map(|t| (1.0 - f) * (1.0 - f) * t * t * f))
-    };
-    let (mut r, mut trt) = (0.0f32, [0.0f32; 3]);
-    for (j, &(wa, wb)) in PIECES.iter().enumerate() {
-        let ((ra, ta), (rb, tb)) = (node(j), node(j + 1));
-        r += wa * ra + wb * rb;
-        for k in 0..3 {
-            trt[k] += wa * ta[k] + wb * tb[k];
+/// What Chiang's model needs of one view through one fibre: A_p and
+/// Φ_p − pπ of TT and TRT at each of [`H_NODES`], and the directional albedo
+/// of R and TRT they give. None of it depends on the light, so `lipp.shade`
+/// computes it once per shaded point, for every light's lobes
+/// ([`super::chiang_lobes`]) and for the probe's lobe
+/// (`probe::specular_lobe`), which before each evaluated the offsets again.
+pub struct FibrePaths {
+    /// A_TT, A_TRT per node.
+    pub(super) ap: [[[f32; 3]; 2]; NODES],
+    /// Φ_TT − π, Φ_TRT − 2π per node.
+    pub(super) dphi: [[f32; 2]; NODES],
+    /// R's directional albedo: pbrt-v4's `HairBxDF::Ap` for p = 0 averaged
+    /// over h (M_p and N_p integrate to one, so under uniform light the lobe
+    /// returns exactly this). `lipp.shade`'s probe term weights its single
+    /// GGX lobe with it (Lipp §3.4).
+    pub r_albedo: f32,
+    /// TRT's, per channel.
+    pub trt_albedo: [f32; 3],
+}
+
+impl FibrePaths {
+    /// The paths seen at sin θ_o = `sin_o` (T · V) through a fibre of
+    /// material `m`.
+    pub fn new(sin_o: f32, m: &Material) -> Self {
+        let sin_o = sin_o.clamp(-1.0, 1.0);
+        let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
+        let at = offsets(sin_o, cos_o, sigma_a(m.color, m.roughness.clamp(0.02, 1.0)));
+        let mut ap = [[[0.0f32; 3]; 2]; NODES];
+        let mut dphi = [[0.0f32; 2]; NODES];
+        for (j, (o, &(_, gamma_o, _))) in at.iter().zip(&H_NODES).enumerate() {
+            let gamma_t = o.sin_gt.asin();
+            let (f, t1) = (o.f, (1.0 - o.f) * (1.0 - o.f));
+            ap[j] = [o.tr.map(|t| t1 * t), o.tr.map(|t| t1 * t * t * f)];
+            dphi[j] = [2.0 * gamma_t - 2.0 * gamma_o, 4.0 * gamma_t - 2.0 * gamma_o];
+        }
+        // The albedo: A_p linear in γ over each piece, as the lobes integrate it.
+        let (mut r_albedo, mut trt_albedo) = (0.0f32, [0.0f32; 3]);
+        for (j, &(wa, wb)) in PIECES.iter().enumerate() {
+            r_albedo += wa * at[j].f + wb * at[j + 1].f;
+            for k in 0..3 {
+                trt_albedo[k] += wa * ap[j][1][k] + wb * ap[j + 1][1][k];
+            }
+        }
+        Self {
+            ap,
+            dphi,
+            r_albedo,
+            trt_albedo,
         }
     }
-    (r, trt)
 }
+
 /// Offsets h ∈ [0, 1] (the average is symmetric in h) where Φ_p and A_p
 /// are evaluated: γ = asin h = (π/2) (j/4)^0.8, (h, γ, cos γ).
 pub(super) const NODES: usize = 5;

@@ -101,12 +101,13 @@ pub fn measure(color: [f32; 3], beta: f32, sin_o: f64) -> [Lobe; 4] {
     let phis = midpoints(N_PHI, -PI64, PI64);
     let reference = pbrt::Azimuthal::new(params, sin_o, phis.clone(), N_H);
     let v = dir(sin_o, 0.0);
+    let paths = FibrePaths::new(super::dot(T, v), &m);
     let dw = (2.0 / N_U as f64) * (2.0 * PI64 / N_PHI as f64);
     let mut sum = [[[0.0f64; 3]; 2]; 4];
     let mut diff = [0.0f64; 4];
     for &u in &us {
         for (j, &phi) in phis.iter().enumerate() {
-            let c = chiang_lobes(T, dir(u, phi), v, &m).map(|l| l.map(f64::from));
+            let c = chiang_lobes(T, dir(u, phi), v, &m, &paths).map(|l| l.map(f64::from));
             let r = reference.f_cos(u, j);
             let total = |x: &[[f64; 3]]| -> [f64; 3] {
                 std::array::from_fn(|k| x[0][k] + x[1][k] + x[2][k])
@@ -142,6 +143,7 @@ pub fn peak(beta: f32, sin_o: f64, p: usize) -> (f64, f64) {
     }
     .bxdf(0.0);
     let v = dir(sin_o, 0.0);
+    let paths = FibrePaths::new(super::dot(T, v), &m);
     let us = midpoints(8000, -1.0, 1.0);
     let argmax = |f: &dyn Fn(f64) -> f64| {
         let c = |u: f64| f(u) * (1.0 - u * u).sqrt();
@@ -153,7 +155,7 @@ pub fn peak(beta: f32, sin_o: f64, p: usize) -> (f64, f64) {
         u.asin().to_degrees()
     };
     (
-        argmax(&|u| chiang_lobes(T, dir(u, 0.0), v, &m)[p][0] as f64),
+        argmax(&|u| chiang_lobes(T, dir(u, 0.0), v, &m, &paths)[p][0] as f64),
         argmax(&|u| bxdf.mp_lobe(p, u, sin_o)),
     )
 }

@@ -34,8 +34,9 @@
 //!   pbrt's residual p ≥ 3 term (A_3 / 2π) is left out, as in Lipp (the
 //!   Kajiya-Kay-like term of `lipp.shade` stands for multiple scattering).
 //!
-//! Cost per light: 1 acos, 3 cos, 5 asin, 3 M_p (2 exp and up to 4 log
-//! each), 8 Fresnel, 15 exp for the RGB transmittances and 22 logistic exp.
+//! Cost per view ([`FibrePaths`]): 5 asin, 5 Fresnel and 15 exp for the RGB
+//! transmittances; per light: 1 acos, 3 cos, 3 M_p (2 exp and up to 4 log
+//! each), 3 Fresnel and 22 logistic exp.
 //!
 //! The check (`check` below, reference in `chiang_reference.rs`): 3 colours
 //! (blonde, brown, black) × β ∈ {0.2, 0.3, 0.5} × θ_o ∈ {−44°, −21°, 0°,
@@ -65,8 +66,9 @@
 //!
 //! The model is split by factor: `longitudinal` holds M_p and the cuticle
 //! tilts, `attenuation` the fibre offsets h with their Fresnel and
-//! transmittance (A_p) and the directional albedo the probe term uses; the
-//! lobes (N_p and the sum) are here. `check` compares the whole against
+//! transmittance (A_p), computed once per view ([`FibrePaths`], with the
+//! directional albedo the probe term uses) for every light; the lobes (N_p
+//! and the sum) are here. `check` compares the whole against
 //! `chiang_reference`.
 
 mod attenuation;
@@ -75,10 +77,10 @@ mod check;
 mod longitudinal;
 
 use super::{dot, normalize, scale, sub};
-use attenuation::{H_NODES, NODES, PIECES, fresnel, offsets};
+use attenuation::{NODES, PIECES, fresnel};
 use longitudinal::{mp, tilt};
 
-pub use attenuation::reflected_albedo;
+pub use attenuation::FibrePaths;
 
 const PI: f32 = std::f32::consts::PI;
 
@@ -109,14 +111,21 @@ fn logistic_cdf(x: f32, s: f32) -> f32 {
 
 /// R + TT + TRT: pbrt-v4's `HairBxDF::f` · |cos| averaged over the fibre
 /// offset h, for fibre tangent `t`, unit direction to the light `l` and to
-/// the viewer `v` (see the module doc).
-pub fn chiang(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [f32; 3] {
-    let [r, tt, trt] = chiang_lobes(t, l, v, m);
+/// the viewer `v` (see the module doc); `paths` are the view's,
+/// `FibrePaths::new(t · v, m)`.
+pub fn chiang(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material, paths: &FibrePaths) -> [f32; 3] {
+    let [r, tt, trt] = chiang_lobes(t, l, v, m, paths);
     std::array::from_fn(|k| r[k] + tt[k] + trt[k])
 }
 
 /// [`chiang`] per lobe: R, TT, TRT.
-pub fn chiang_lobes(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [[f32; 3]; 3] {
+pub fn chiang_lobes(
+    t: [f32; 3],
+    l: [f32; 3],
+    v: [f32; 3],
+    m: &Material,
+    paths: &FibrePaths,
+) -> [[f32; 3]; 3] {
     let (sin_i, sin_o) = (dot(t, l).clamp(-1.0, 1.0), dot(t, v).clamp(-1.0, 1.0));
     let cos_i = (1.0 - sin_i * sin_i).max(0.0).sqrt();
     let cos_o = (1.0 - sin_o * sin_o).max(0.0).sqrt();
@@ -146,17 +155,10 @@ pub fn chiang_lobes(t: [f32; 3], l: [f32; 3], v: [f32; 3], m: &Material) -> [[f3
     let r =
         (0.7619 * n_r(phi, cos_o) + 0.1190 * (n_r(phi - a, cos_o) + n_r(phi + a, cos_o))) * mps[0];
     // TT, TRT: ½∫ A_p(h) N_p(φ; h) dh with A_p and Φ_p(h) evaluated at the
-    // offsets of H_NODES and Φ_p linear in between: each piece is a box in φ
-    // convolved with the logistic, a difference of two logistic CDFs.
-    let mut ap = [[[0.0f32; 3]; 2]; NODES];
-    let mut dphi = [[0.0f32; 2]; NODES];
-    let at = offsets(sin_o, cos_o, sigma_a(m.color, b));
-    for (j, (o, &(_, gamma_o, _))) in at.iter().zip(&H_NODES).enumerate() {
-        let gamma_t = o.sin_gt.asin();
-        let (f, t1) = (o.f, (1.0 - o.f) * (1.0 - o.f));
-        ap[j] = [o.tr.map(|t| t1 * t), o.tr.map(|t| t1 * t * t * f)];
-        dphi[j] = [2.0 * gamma_t - 2.0 * gamma_o, 4.0 * gamma_t - 2.0 * gamma_o];
-    }
+    // offsets of H_NODES (`paths`) and Φ_p linear in between: each piece is
+    // a box in φ convolved with the logistic, a difference of two logistic
+    // CDFs.
+    let (ap, dphi) = (&paths.ap, &paths.dphi);
     // Deviation from each lobe's centre: TT at π, TRT at 2π.
     let x = [phi - PI, phi];
     let trim = 1.0 / (logistic_cdf(PI, s) - logistic_cdf(-PI, s));
@@ -208,8 +210,9 @@ mod tests {
         let t = [0.0, 1.0, 0.0];
         let v = normalize([0.0, 0.0, 1.0]);
         // Light on the mirror cone (sin θ_i = −sin θ_o) vs far off it.
-        let on = chiang(t, normalize([0.0, -0.05, 1.0]), v, &m);
-        let off = chiang(t, normalize([0.0, 0.9, 0.3]), v, &m);
+        let paths = FibrePaths::new(dot(t, v), &m);
+        let on = chiang(t, normalize([0.0, -0.05, 1.0]), v, &m, &paths);
+        let off = chiang(t, normalize([0.0, 0.9, 0.3]), v, &m, &paths);
         assert!(on.iter().chain(&off).all(|x| x.is_finite() && *x >= 0.0));
         assert!(on[0] > off[0] * 2.0, "{on:?} vs {off:?}");
         let sa = sigma_a([0.3, 0.2, 0.1], 0.3);

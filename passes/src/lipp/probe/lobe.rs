@@ -3,7 +3,7 @@
 
 use super::lookup::sample;
 use crate::kernel::Words;
-use crate::lipp::chiang::{Material, reflected_albedo};
+use crate::lipp::chiang::{FibrePaths, Material};
 use crate::lipp::{dot, normalize, scale, sub};
 
 /// The GGX lobe standing in for R + TRT (Lipp §3.4: "we approximate the R
@@ -22,10 +22,11 @@ pub struct SpecularLobe {
 /// The R + TRT stand-in lobe for a fibre of tangent `t` seen from `v` (both
 /// unit), with `n` the view-facing fibre normal, colour `color` and
 /// longitudinal roughness `roughness` (β_m), in the terms of
-/// [`super::chiang::chiang`]:
+/// [`super::chiang::chiang`], whose view `paths` it reads:
 ///
 /// - **Weight**: R's and TRT's directional albedo at θ_o, pbrt-v4's A_p
-///   averaged over the fibre offset h ([`super::chiang::reflected_albedo`]).
+///   averaged over the fibre offset h ([`FibrePaths::r_albedo`] and
+///   [`FibrePaths::trt_albedo`]).
 ///   The hair lobes are normalised in M_p and N_p, so under uniform radiance
 ///   their sum returns A_R + A_TRT of it, and so does this term.
 /// - **Direction**: the longitudinal mirror of V across the fibre's normal
@@ -43,7 +44,13 @@ pub struct SpecularLobe {
 ///   (Walter et al. 2007), so α = √(σ² / 2). The GGX lobe is isotropic: the
 ///   azimuthal spread of R and TRT across the fibre's width (N_p) is not
 ///   represented — the price of Lipp's single lobe.
-pub fn specular_lobe(t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> SpecularLobe {
+pub fn specular_lobe(
+    t: [f32; 3],
+    v: [f32; 3],
+    n: [f32; 3],
+    m: &Material,
+    paths: &FibrePaths,
+) -> SpecularLobe {
     let sin_o = dot(t, v).clamp(-1.0, 1.0);
     let bm = m.roughness.clamp(0.02, 1.0);
     let v0 = {
@@ -51,7 +58,7 @@ pub fn specular_lobe(t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> Spe
         x * x
     };
     let alpha = m.alpha;
-    let (w_r, a_trt) = reflected_albedo(sin_o, m);
+    let (w_r, a_trt) = (paths.r_albedo, paths.trt_albedo);
     let w_trt = (a_trt[0] + a_trt[1] + a_trt[2]) / 3.0;
     // Where M_p peaks in sin θ_i + sin θ_o (tangent root to tip, as in
     // `chiang`): R at +2α, TRT at −4α.
@@ -83,8 +90,15 @@ pub fn view_facing_normal(t: [f32; 3], v: [f32; 3]) -> [f32; 3] {
 }
 
 /// Radiance of the R + TRT probe term (before AO and the `specular` scale).
-pub fn specular(w: &Words<'_>, t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> [f32; 3] {
-    let lobe = specular_lobe(t, v, n, m);
+pub fn specular(
+    w: &Words<'_>,
+    t: [f32; 3],
+    v: [f32; 3],
+    n: [f32; 3],
+    m: &Material,
+    paths: &FibrePaths,
+) -> [f32; 3] {
+    let lobe = specular_lobe(t, v, n, m, paths);
     let l = sample(w, lobe.direction, lobe.alpha);
     std::array::from_fn(|k| l[k] * lobe.weight[k])
 }
@@ -103,6 +117,11 @@ mod tests {
         }
     }
 
+    /// The lobe with the view's own fibre paths.
+    fn lobe_of(t: [f32; 3], v: [f32; 3], n: [f32; 3], m: &Material) -> SpecularLobe {
+        specular_lobe(t, v, n, m, &FibrePaths::new(dot(t, v), m))
+    }
+
     #[test]
     fn the_stand_in_lobe_mirrors_the_view_and_widens_with_roughness() {
         let t = [0.0, 1.0, 0.0];
@@ -110,12 +129,13 @@ mod tests {
         let n = view_facing_normal(t, v);
         assert!((dot(n, [0.0, 0.0, 1.0]) - 1.0).abs() < 1e-6);
         let dark = [0.02, 0.015, 0.01];
-        let lobe = specular_lobe(t, v, n, &mat(dark, 0.3));
+        let lobe = lobe_of(t, v, n, &mat(dark, 0.3));
         // The lobe sits on the specular cone (sin θ_l = −sin θ_o) shifted by
         // the A-weighted mean of R's +2α and TRT's −4α; dark hair: nearly R's.
         let sin_o = dot(t, v);
         let shift = dot(lobe.direction, t) + sin_o;
-        let (f, trt) = reflected_albedo(sin_o, &mat(dark, 0.3));
+        let paths = FibrePaths::new(sin_o, &mat(dark, 0.3));
+        let (f, trt) = (paths.r_albedo, paths.trt_albedo);
         let a_trt = trt.iter().sum::<f32>() / 3.0;
         assert!((lobe.weight.iter().sum::<f32>() / 3.0 - (f + a_trt)).abs() < 1e-6);
         let alpha_c = 2f32.to_radians();
@@ -139,13 +159,13 @@ mod tests {
             "{lobe:?}"
         );
         // Blond hair: TRT adds weight (more in red), shifts the lobe towards −4α, widens it.
-        let blond = specular_lobe(t, v, n, &mat([0.8, 0.6, 0.35], 0.3));
+        let blond = lobe_of(t, v, n, &mat([0.8, 0.6, 0.35], 0.3));
         assert!(blond.weight[0] > blond.weight[2] && blond.weight[2] > lobe.weight[2]);
         assert!(dot(blond.direction, t) < dot(lobe.direction, t));
         assert!(blond.alpha > lobe.alpha);
         // Rougher hair, wider lobe; capped at α = 1.
-        let rough = specular_lobe(t, v, n, &mat(dark, 0.6));
-        assert!(rough.alpha > lobe.alpha && specular_lobe(t, v, n, &mat(dark, 1.0)).alpha <= 1.0);
+        let rough = lobe_of(t, v, n, &mat(dark, 0.6));
+        assert!(rough.alpha > lobe.alpha && lobe_of(t, v, n, &mat(dark, 1.0)).alpha <= 1.0);
     }
 
     #[test]
@@ -155,8 +175,10 @@ mod tests {
         let w = Words::new(&a, &oob);
         let (t, v) = ([1.0, 0.0, 0.0], normalize([0.5, 0.2, 1.0]));
         let n = view_facing_normal(t, v);
-        let lobe = specular_lobe(t, v, n, &mat([0.5, 0.4, 0.3], 0.35));
-        let s = specular(&w, t, v, n, &mat([0.5, 0.4, 0.3], 0.35));
+        let m = mat([0.5, 0.4, 0.3], 0.35);
+        let paths = FibrePaths::new(dot(t, v), &m);
+        let lobe = specular_lobe(t, v, n, &m, &paths);
+        let s = specular(&w, t, v, n, &m, &paths);
         for k in 0..3 {
             assert!((s[k] - c[k] * lobe.weight[k]).abs() < 1e-6, "{s:?}");
         }
