@@ -236,29 +236,6 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // SWR 1 and SWR 1+F above switch off the maps' own LOD (ours,
-    // `shadow_lod`) with the paper's LOD, so their maps receive every strand
-    // at full detail, as the paper's maps built from "the full geometry
-    // set" (§3.2.3). These two keep it, as "as published" does: against it
-    // they differ in the paper's switches only, so they measure what the
-    // paper's L and F cost and buy on their own (README, "What the LOD buys
-    // at far").
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1, maps' own LOD",
-        graph: LIPP,
-        overrides: &["lod.enabled=false", "filter.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
-    Variant {
-        pipeline: "Lipp",
-        name: "SWR 1+F, maps' own LOD",
-        graph: LIPP,
-        overrides: &["lod.enabled=false"],
-        raster: &["raster"],
-        ceiling: "atomic_min64",
-    },
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+L",
@@ -403,13 +380,26 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // Without the camera's LOD but with the maps' own (ours): SWR 1 with
-    // its deep opacity maps built like SWR 1+F+L's.
+    // Without the camera's LOD but with the maps' own (ours): SWR 1 and
+    // SWR 1+F with their deep opacity maps built like SWR 1+F+L's. The rows
+    // "SWR 1" and "SWR 1+F" switch the maps' LOD off with the paper's, so
+    // their maps receive every strand at full detail, as the paper's built
+    // from "the full geometry set" (§3.2.3); against "as published" these
+    // two differ in the paper's switches only (README, "What the LOD buys
+    // at far").
     Variant {
         pipeline: "Lipp",
         name: "SWR 1, shadow LOD",
         graph: LIPP,
         overrides: &["lod.enabled=false", "filter.enabled=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F, shadow LOD",
+        graph: LIPP,
+        overrides: &["lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
