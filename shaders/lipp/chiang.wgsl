@@ -113,6 +113,15 @@ fn offset_at(j: u32, cos_o: f32, rc: vec2<f32>, sa: vec3<f32>) -> Offset {
     return Offset(fresnel(cos_o * node.z), exp(-2.0 * sa * cos_gt / rc.y), sin_gt);
 }
 
+// chiang::R_ALBEDO_NODES: R's directional albedo by 4-point Gauss-Legendre
+// in γ, (cos γ_k, (π/4) w_k cos γ_k) (attenuation.rs says why not the pieces).
+const R_ALBEDO_NODES: array<vec2<f32>, 4> = array<vec2<f32>, 4>(
+    vec2<f32>(0.994058, 0.271581),
+    vec2<f32>(0.868624, 0.444904),
+    vec2<f32>(0.495472, 0.253777),
+    vec2<f32>(0.108847, 0.029738),
+);
+
 // chiang::FibrePaths: A_p and Φ_p − pπ of TT and TRT at each node (TT
 // then TRT), and R's (x) and TRT's (yzw) directional albedo: what the lobes
 // need of the view, once per shaded point for every light and the probe.
@@ -131,8 +140,6 @@ fn fibre_paths(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> FibrePaths {
     var nodes = H_NODES;
     var pieces = PIECES;
     var paths: FibrePaths;
-    var f_prev = 0.0;
-    var r = 0.0;
     var trt = vec3<f32>(0.0);
     for (var j = 0u; j < NODES; j++) {
         let node = nodes[j];
@@ -145,13 +152,18 @@ fn fibre_paths(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> FibrePaths {
         paths.ap[1][j] = t1 * tr * tr * f;
         paths.dphi[0][j] = 2.0 * gamma_t - 2.0 * node.y;
         paths.dphi[1][j] = 4.0 * gamma_t - 2.0 * node.y;
-        // The albedo: A_p linear in γ over each piece, as the lobes integrate it.
+        // TRT's albedo: A_p linear in γ over each piece, as the lobe
+        // integrates it.
         if j > 0u {
             let w = pieces[j - 1u];
-            r += w.x * f_prev + w.y * f;
             trt += w.x * paths.ap[1][j - 1u] + w.y * paths.ap[1][j];
         }
-        f_prev = f;
+    }
+    // R's: its own quadrature.
+    var r_nodes = R_ALBEDO_NODES;
+    var r = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        r += r_nodes[k].y * fresnel(cos_o * r_nodes[k].x);
     }
     paths.albedo = vec4<f32>(r, trt);
     return paths;

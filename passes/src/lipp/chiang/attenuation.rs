@@ -39,7 +39,7 @@ pub(super) fn offsets(sin_o: f32, cos_o: f32, sigma_a: [f32; 3]) -> [Offset; NOD
 /// of R and TRT they give. None of it depends on the light, so `lipp.shade`
 /// computes it once per shaded point, for every light's lobes
 /// ([`super::chiang_lobes`]) and for the probe's lobe
-/// (`probe::specular_lobe`), which before each evaluated the offsets again.
+/// (`probe::specular_lobe`).
 pub struct FibrePaths {
     /// A_TT, A_TRT per node.
     pub(super) ap: [[[f32; 3]; 2]; NODES],
@@ -47,8 +47,8 @@ pub struct FibrePaths {
     pub(super) dphi: [[f32; 2]; NODES],
     /// R's directional albedo: pbrt-v4's `HairBxDF::Ap` for p = 0 averaged
     /// over h (M_p and N_p integrate to one, so under uniform light the lobe
-    /// returns exactly this). `lipp.shade`'s probe term weights its single
-    /// GGX lobe with it (Lipp §3.4).
+    /// returns this; [`R_ALBEDO_NODES`]). `lipp.shade`'s probe term weights
+    /// its single GGX lobe with it and TRT's (Lipp §3.4).
     pub r_albedo: f32,
     /// TRT's, per channel.
     pub trt_albedo: [f32; 3],
@@ -69,14 +69,18 @@ impl FibrePaths {
             ap[j] = [o.tr.map(|t| t1 * t), o.tr.map(|t| t1 * t * t * f)];
             dphi[j] = [2.0 * gamma_t - 2.0 * gamma_o, 4.0 * gamma_t - 2.0 * gamma_o];
         }
-        // The albedo: A_p linear in γ over each piece, as the lobes integrate it.
-        let (mut r_albedo, mut trt_albedo) = (0.0f32, [0.0f32; 3]);
+        // TRT's albedo: A_p linear in γ over each piece, as the lobe
+        // integrates it. R's: its own quadrature (R_ALBEDO_NODES).
+        let mut trt_albedo = [0.0f32; 3];
         for (j, &(wa, wb)) in PIECES.iter().enumerate() {
-            r_albedo += wa * at[j].f + wb * at[j + 1].f;
             for k in 0..3 {
                 trt_albedo[k] += wa * ap[j][1][k] + wb * ap[j + 1][1][k];
             }
         }
+        let r_albedo = R_ALBEDO_NODES
+            .iter()
+            .map(|&(cos_gamma, w)| w * fresnel(cos_o * cos_gamma))
+            .sum();
         Self {
             ap,
             dphi,
@@ -85,6 +89,19 @@ impl FibrePaths {
         }
     }
 }
+
+/// R's directional albedo, ∫₀¹ F(cos θ_o √(1 − h²)) dh = ∫₀^{π/2} F(cos θ_o
+/// cos γ) cos γ dγ, by 4-point Gauss–Legendre in γ: (cos γ_k, (π/4) w_k cos
+/// γ_k). It is what R's lobe (d'Eon's ¼ cos(φ/2) F over φ) integrates to.
+/// The pieces of [`H_NODES`], which take A linear in γ, overestimate it
+/// by 5-14%: Fresnel rises to 1 at grazing offsets, within the last piece.
+/// This rule is within 0.7% (`check::the_paths_albedo_is_what_the_lobes_reflect`).
+pub(super) const R_ALBEDO_NODES: [(f32, f32); 4] = [
+    (0.994058, 0.271581),
+    (0.868624, 0.444904),
+    (0.495472, 0.253777),
+    (0.108847, 0.029738),
+];
 
 /// Offsets h ∈ [0, 1] (the average is symmetric in h) where Φ_p and A_p
 /// are evaluated: γ = asin h = (π/2) (j/4)^0.8, (h, γ, cos γ).

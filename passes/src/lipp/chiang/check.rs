@@ -29,6 +29,10 @@ const L1: [f64; 4] = [0.09, 0.11, 0.09, 0.08];
 /// pbrt's M_p and tilts, so only the f32 evaluation and the grid differ
 /// (≤ 0.1°); the cuticle shift itself is 4° (R) and 8° (TRT).
 const PEAK_DEG: f64 = 0.25;
+/// The probe's weight (`FibrePaths`' R and TRT albedo) against the compact
+/// lobes integrated over the sphere, relative: R within 0.7% (its 4-point
+/// rule), TRT the lobe's own pieces.
+const ALBEDO_TOL: f64 = 0.01;
 
 pub struct Hair {
     pub name: &'static str,
@@ -216,6 +220,57 @@ fn r_and_trt_peak_where_pbrt_puts_them() {
             }
         }
     }
+}
+
+/// The probe term's weight, `FibrePaths`' directional albedo of R and TRT,
+/// is what the compact lobes reflect under uniform light: M_p and N_p are
+/// normalised, so ∫ lobe dω_i returns A_p averaged over h (Lipp §3.4's GGX
+/// lobe stands for R + TRT with this weight).
+#[test]
+fn the_paths_albedo_is_what_the_lobes_reflect() {
+    let us = midpoints(N_U, -1.0, 1.0);
+    let phis = midpoints(N_PHI, -PI64, PI64);
+    let dw = (2.0 / N_U as f64) * (2.0 * PI64 / N_PHI as f64);
+    let mut worst = (0.0f64, String::new());
+    for hair in &HAIRS {
+        for beta in [0.2, 0.5] {
+            let m = Material {
+                color: hair.color,
+                roughness: beta,
+                alpha: super::DEFAULT_ALPHA,
+            };
+            for sin_o in [-0.5, 0.0, 0.6] {
+                let v = dir(sin_o, 0.0);
+                let paths = FibrePaths::new(super::dot(T, v), &m);
+                let (mut r, mut trt) = (0.0f64, [0.0f64; 3]);
+                for &u in &us {
+                    for &phi in &phis {
+                        let c = chiang_lobes(T, dir(u, phi), v, &m, &paths);
+                        r += f64::from(c[0][0]) * dw;
+                        for k in 0..3 {
+                            trt[k] += f64::from(c[2][k]) * dw;
+                        }
+                    }
+                }
+                let pairs = [(r, paths.r_albedo)]
+                    .into_iter()
+                    .chain((0..3).map(|k| (trt[k], paths.trt_albedo[k])));
+                for (lobes, albedo) in pairs {
+                    let e = (lobes / f64::from(albedo) - 1.0).abs();
+                    if e > worst.0 {
+                        worst = (
+                            e,
+                            format!(
+                                "{} β={beta} sin θo={sin_o}: lobes {lobes:.5}, albedo {albedo:.5}",
+                                hair.name
+                            ),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(worst.0 < ALBEDO_TOL, "{}", worst.1);
 }
 
 /// The reference's factored h-average is pbrt's f averaged directly.
