@@ -198,3 +198,29 @@ fn probe() {
         assert_eq!(constant_bits(&module, name), Some(rust.to_bits()), "{name}");
     }
 }
+
+/// Chiang's R albedo fit (chiang.wgsl `R_ALBEDO_FIT`) has the Rust
+/// coefficients' bits, element by element.
+#[test]
+fn r_albedo_fit_has_the_rust_bits() {
+    use strandgraph_passes::lipp::chiang::R_ALBEDO_FIT;
+    let aliases: String = (0..R_ALBEDO_FIT.len())
+        .map(|i| format!("const PROBE_R{i}: f32 = R_ALBEDO_FIT[{i}];\n"))
+        .collect();
+    let source = format!(
+        "#import strandgraph::chiang::R_ALBEDO_FIT\n{aliases}\
+         @compute @workgroup_size(1)\nfn probe() {{\n    _ = PROBE_R0 + PROBE_R7;\n}}\n"
+    );
+    let mut composer = composer();
+    let module = compose(&mut composer, "r_albedo_probe.wgsl", &source, BASE)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0;
+    for (i, rust) in R_ALBEDO_FIT.iter().enumerate() {
+        let name = format!("PROBE_R{i}");
+        assert_eq!(
+            constant_bits(&module, &name),
+            Some(rust.to_bits()),
+            "{name}"
+        );
+    }
+}

@@ -113,14 +113,18 @@ fn offset_at(j: u32, cos_o: f32, rc: vec2<f32>, sa: vec3<f32>) -> Offset {
     return Offset(fresnel(cos_o * node.z), exp(-2.0 * sa * cos_gt / rc.y), sin_gt);
 }
 
-// chiang::R_ALBEDO_NODES: R's directional albedo by 4-point Gauss-Legendre
-// in γ, (cos γ_k, (π/4) w_k cos γ_k) (attenuation.rs says why not the pieces).
-const R_ALBEDO_NODES: array<vec2<f32>, 4> = array<vec2<f32>, 4>(
-    vec2<f32>(0.994058, 0.271581),
-    vec2<f32>(0.868624, 0.444904),
-    vec2<f32>(0.495472, 0.253777),
-    vec2<f32>(0.108847, 0.029738),
+// chiang::R_ALBEDO_FIT: R's directional albedo, a polynomial in cos θ_o
+// fitted to its 4-point Gauss-Legendre rule in γ (attenuation.rs).
+const R_ALBEDO_FIT: array<f32, 8> = array<f32, 8>(
+    0.99871098, -4.4404744, 11.730038, -21.808463, 28.510157, -24.327722, 11.955967, -2.5427854,
 );
+
+// chiang::r_albedo, by Horner's rule with constant indices.
+fn r_albedo(cos_o: f32) -> f32 {
+    let c = R_ALBEDO_FIT;
+    return c[0] + cos_o * (c[1] + cos_o * (c[2] + cos_o * (c[3] + cos_o * (c[4] + cos_o * (c[5] + cos_o * (c[6]
+        + cos_o * c[7]))))));
+}
 
 // chiang::FibrePaths: A_p and Φ_p − pπ of TT and TRT at each node (TT
 // then TRT), and R's (x) and TRT's (yzw) directional albedo: what the lobes
@@ -159,13 +163,8 @@ fn fibre_paths(sin_o_in: f32, color: vec3<f32>, roughness: f32) -> FibrePaths {
             trt += w.x * paths.ap[1][j - 1u] + w.y * paths.ap[1][j];
         }
     }
-    // R's: its own quadrature.
-    var r_nodes = R_ALBEDO_NODES;
-    var r = 0.0;
-    for (var k = 0u; k < 4u; k++) {
-        r += r_nodes[k].y * fresnel(cos_o * r_nodes[k].x);
-    }
-    paths.albedo = vec4<f32>(r, trt);
+    // R's: its own rule.
+    paths.albedo = vec4<f32>(r_albedo(cos_o), trt);
     return paths;
 }
 

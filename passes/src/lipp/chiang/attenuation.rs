@@ -47,7 +47,7 @@ pub struct FibrePaths {
     pub(super) dphi: [[f32; 2]; NODES],
     /// R's directional albedo: pbrt-v4's `HairBxDF::Ap` for p = 0 averaged
     /// over h (M_p and N_p integrate to one, so under uniform light the lobe
-    /// returns this; [`R_ALBEDO_NODES`]). `lipp.shade`'s probe term weights
+    /// returns this; [`r_albedo`]). `lipp.shade`'s probe term weights
     /// its single GGX lobe with it and TRT's (Lipp §3.4).
     pub r_albedo: f32,
     /// TRT's, per channel.
@@ -70,17 +70,14 @@ impl FibrePaths {
             dphi[j] = [2.0 * gamma_t - 2.0 * gamma_o, 4.0 * gamma_t - 2.0 * gamma_o];
         }
         // TRT's albedo: A_p linear in γ over each piece, as the lobe
-        // integrates it. R's: its own quadrature (R_ALBEDO_NODES).
+        // integrates it. R's: its own rule (r_albedo).
         let mut trt_albedo = [0.0f32; 3];
         for (j, &(wa, wb)) in PIECES.iter().enumerate() {
             for k in 0..3 {
                 trt_albedo[k] += wa * ap[j][1][k] + wb * ap[j + 1][1][k];
             }
         }
-        let r_albedo = R_ALBEDO_NODES
-            .iter()
-            .map(|&(cos_gamma, w)| w * fresnel(cos_o * cos_gamma))
-            .sum();
+        let r_albedo = r_albedo(cos_o);
         Self {
             ap,
             dphi,
@@ -91,16 +88,36 @@ impl FibrePaths {
 }
 
 /// R's directional albedo, ∫₀¹ F(cos θ_o √(1 − h²)) dh = ∫₀^{π/2} F(cos θ_o
-/// cos γ) cos γ dγ, by 4-point Gauss–Legendre in γ: (cos γ_k, (π/4) w_k cos
-/// γ_k). It is what R's lobe (d'Eon's ¼ cos(φ/2) F over φ) integrates to.
-/// The pieces of [`H_NODES`], which take A linear in γ, overestimate it
+/// cos γ) cos γ dγ: what R's lobe (d'Eon's ¼ cos(φ/2) F over φ) integrates
+/// to. The pieces of [`H_NODES`], which take A linear in γ, overestimate it
 /// by 5-14%: Fresnel rises to 1 at grazing offsets, within the last piece.
-/// This rule is within 0.7% (`check::the_paths_albedo_is_what_the_lobes_reflect`).
-pub(super) const R_ALBEDO_NODES: [(f32, f32); 4] = [
-    (0.994058, 0.271581),
-    (0.868624, 0.444904),
-    (0.495472, 0.253777),
-    (0.108847, 0.029738),
+///
+/// It depends on cos θ_o alone (η is fixed), so it is a polynomial in cos θ_o
+/// ([`R_ALBEDO_FIT`]) rather than the four Fresnel terms of its 4-point
+/// Gauss–Legendre rule in γ (`tests::R_ALBEDO_NODES`, within 0.7% of what
+/// the lobe reflects: `check::the_paths_albedo_is_what_the_lobes_reflect`)
+/// at every shaded point: those cost 12 µs of `lipp.shade` at the close
+/// view on the H200 (benches/results/lipp-r-albedo-h200.txt).
+pub(super) fn r_albedo(cos_o: f32) -> f32 {
+    R_ALBEDO_FIT
+        .iter()
+        .rev()
+        .fold(0.0, |acc, &c| acc * cos_o + c)
+}
+
+/// [`r_albedo`]'s coefficients, constant term first: the least-squares fit
+/// of the Gauss–Legendre rule over cos θ_o ∈ [0, 1] in relative error (worst
+/// 0.13%; `tests::the_r_albedo_fit_follows_its_rule`). `chiang.wgsl` holds
+/// the same bits (passes/tests/wgsl_shared.rs).
+pub const R_ALBEDO_FIT: [f32; 8] = [
+    0.998_710_98,
+    -4.440_474_4,
+    11.730_038,
+    -21.808_463,
+    28.510_157,
+    -24.327_722,
+    11.955_967,
+    -2.542_785_4,
 ];
 
 /// Offsets h ∈ [0, 1] (the average is symmetric in h) where Φ_p and A_p
@@ -129,4 +146,36 @@ pub(super) fn fresnel(cos_i: f32) -> f32 {
     let r_parl = (ETA * cos_i - cos_t) / (ETA * cos_i + cos_t);
     let r_perp = (cos_i - ETA * cos_t) / (cos_i + ETA * cos_t);
     0.5 * (r_parl * r_parl + r_perp * r_perp)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// R's albedo by 4-point Gauss–Legendre in γ: (cos γ_k, (π/4) w_k cos
+    /// γ_k), four Fresnel terms.
+    const R_ALBEDO_NODES: [(f32, f32); 4] = [
+        (0.994058, 0.271581),
+        (0.868624, 0.444904),
+        (0.495472, 0.253777),
+        (0.108847, 0.029738),
+    ];
+
+    fn r_albedo_rule(cos_o: f32) -> f32 {
+        R_ALBEDO_NODES
+            .iter()
+            .map(|&(cos_gamma, w)| w * fresnel(cos_o * cos_gamma))
+            .sum()
+    }
+
+    #[test]
+    fn the_r_albedo_fit_follows_its_rule() {
+        let worst = (0..=1000)
+            .map(|i| {
+                let c = i as f32 / 1000.0;
+                (r_albedo(c) / r_albedo_rule(c) - 1.0).abs()
+            })
+            .fold(0.0f32, f32::max);
+        assert!(worst < 0.002, "worst relative error {worst}");
+    }
 }

@@ -80,7 +80,7 @@ use super::{dot, normalize, scale, sub};
 use attenuation::{NODES, PIECES, fresnel};
 use longitudinal::{mp, tilt};
 
-pub use attenuation::FibrePaths;
+pub use attenuation::{FibrePaths, R_ALBEDO_FIT};
 
 const PI: f32 = std::f32::consts::PI;
 
