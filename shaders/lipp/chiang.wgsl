@@ -116,7 +116,7 @@ fn offset_at(j: u32, cos_o: f32, rc: vec2<f32>, sa: vec3<f32>) -> Offset {
 // chiang::R_ALBEDO_FIT: R's directional albedo, a polynomial in cos θ_o
 // fitted to its 4-point Gauss-Legendre rule in γ (attenuation.rs).
 const R_ALBEDO_FIT: array<f32, 8> = array<f32, 8>(
-    0.99871098, -4.4404744, 11.730038, -21.808463, 28.510157, -24.327722, 11.955967, -2.5427854,
+    0.998711, -4.4404744, 11.730038, -21.808463, 28.510157, -24.327722, 11.955967, -2.5427854,
 );
 
 // chiang::r_albedo, by Horner's rule with constant indices.

@@ -110,7 +110,7 @@ pub(super) fn r_albedo(cos_o: f32) -> f32 {
 /// 0.13%; `tests::the_r_albedo_fit_follows_its_rule`). `chiang.wgsl` holds
 /// the same bits (passes/tests/wgsl_shared.rs).
 pub const R_ALBEDO_FIT: [f32; 8] = [
-    0.998_710_98,
+    0.998_711,
     -4.440_474_4,
     11.730_038,
     -21.808_463,
