@@ -179,19 +179,19 @@ fn error_with(declared: &str, small: &str) -> String {
     e.to_string()
 }
 
-/// A graph whose `raster_args` has no room for the runs' dispatch that
-/// `lipp.clear_gbuffer` and `lipp.shade` read (words 8-10) is an error
-/// naming the pass and the buffer, not a read past its end.
+/// A graph whose `raster_args` has no room for the dispatch over blocks of
+/// runs that `lipp.clear_gbuffer` reads (words 13-15), the last words, is
+/// an error naming the pass and the buffer, not a read past its end.
 #[test]
 fn a_raster_args_too_small_for_the_runs_dispatch_is_an_error() {
     let message = error_with(
+        r#"Buffer(name: "raster_args", size: Bytes(64))"#,
         r#"Buffer(name: "raster_args", size: Bytes(52))"#,
-        r#"Buffer(name: "raster_args", size: Bytes(32))"#,
     );
     assert!(
         message.contains("clear_gbuffer")
             && message.contains("`raster_args`")
-            && message.contains("44 bytes"),
+            && message.contains("64 bytes"),
         "{message}"
     );
 }

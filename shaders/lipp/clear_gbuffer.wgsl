@@ -1,7 +1,7 @@
 // lipp.clear_gbuffer (ours): every G-buffer layer cleared over the runs of
 // 64 pixels the groom's screen rectangle touches, the runs lipp.shade
-// shades, through the same indirect dispatch (lipp::rect). Port of
-// passes/src/lipp/clear.rs.
+// shades, a workgroup a block of runs (lipp::rect::Rect::clear_dispatch).
+// Port of passes/src/lipp/clear.rs.
 
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, RUN, rect_from_args, rect_runs, touches_run}
 
@@ -26,8 +26,11 @@ fn clear_gbuffer(
     let rect = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
     let runs = rect_runs(rect, params.width);
     let layers = arrayLength(&gbuffer) / pixels;
-    // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).
-    for (var k = wg.x; k < runs.y; k += max(groups.x, 1u)) {
+    // This workgroup's block of the runs (rect::Rect::runs_of_block).
+    let per = (runs.y + groups.x - 1u) / max(groups.x, 1u);
+    let lo = min(wg.x * per, runs.y);
+    let hi = min(lo + per, runs.y);
+    for (var k = lo; k < hi; k++) {
         let run = runs.x + k;
         let i = run * RUN + lane;
         if touches_run(rect, run * RUN, RUN, params.width) && i < pixels {

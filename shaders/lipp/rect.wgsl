@@ -8,10 +8,11 @@
 #import strandgraph::clip::{transform, clip_to_screen}
 #import strandgraph::lipp::bilinear
 
-// rect::ARGS_RECT_LO/HI, ARGS_RUNS and FILTER_RECT_LO/HI; tiles::TILE.
+// rect::ARGS_RECT_LO/HI, ARGS_RUNS, ARGS_CLEAR and FILTER_RECT_LO/HI; tiles::TILE.
 const ARGS_RECT_LO: u32 = 6u;
 const ARGS_RECT_HI: u32 = 7u;
 const ARGS_RUNS: u32 = 8u;
+const ARGS_CLEAR: u32 = 13u;
 const RUN: u32 = 64u;
 const FILTER_RECT_LO: u32 = 4u;
 const FILTER_RECT_HI: u32 = 5u;

@@ -370,6 +370,17 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // lipp.clear_gbuffer a workgroup per run of 64 pixels, as lipp.shade is
+    // dispatched, rather than a block of lod_scan's clear_runs runs
+    // (passes/src/lipp/clear.rs).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, G-buffer clear a workgroup per run",
+        graph: LIPP,
+        overrides: &["lod_scan.clear_runs=1"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // The window of Lipp's Fig. 5 ("a single 7 × 7 kernel pass"), where
     // §3.3.1 says r = 5 (the default) and Code 2 r = 7.
     Variant {

@@ -19,10 +19,11 @@
 //!   [`ARGS_RUNS`]..) of the passes that work in runs of [`TILE`] pixels,
 //!   one workgroup per run from the one holding the rectangle's first
 //!   pixel to the one holding its last ([`Rect::runs`]): `lipp.shade`,
-//!   which returns at once in a run the rectangle's rows pass by, and
-//!   `lipp.clear_gbuffer`. A full-screen dispatch whose workgroups return
-//!   still cost the H100 launching them: 36 µs of shading for the far
-//!   view's groom, about 60 µs for each of the crowd's.
+//!   which returns at once in a run the rectangle's rows pass by. A
+//!   full-screen dispatch whose workgroups return still cost the H100
+//!   launching them: 36 µs of shading for the far view's groom, about
+//!   60 µs for each of the crowd's. `lipp.clear_gbuffer` gets its own
+//!   dispatch over blocks of those runs (words [`ARGS_CLEAR`]..).
 //! - `lipp.clear_gbuffer` clears those runs only: every pixel `lipp.shade`
 //!   reads. Elsewhere the G-buffer keeps what an earlier groom, or another
 //!   resource aliased to it, left there, which nothing reads.
@@ -63,6 +64,9 @@ pub const ARGS_RECT_HI: usize = 7;
 /// [`TILE`] pixels [`Rect::runs`] covers, at most [`MAX_GROUPS_X`] (the
 /// kernels stride past it).
 pub const ARGS_RUNS: usize = 8;
+/// `raster_args` words 13..=15: `lipp.clear_gbuffer`'s workgroups (x, 1, 1),
+/// one per `lipp.lod_scan`'s `clear_runs` runs ([`Rect::clear_dispatch`]).
+pub const ARGS_CLEAR: usize = 13;
 /// `filter_args` words: the pixels `lipp.shade` wrote records for, the same
 /// packing; a `filter_args` with no room for them shades the whole screen.
 pub const FILTER_RECT_LO: usize = 4;
@@ -170,6 +174,28 @@ impl Rect {
     /// [`Rect::runs`], at most [`MAX_GROUPS_X`].
     pub fn run_dispatch(&self, w: u32) -> [u32; 3] {
         [self.runs(w).1.min(MAX_GROUPS_X), 1, 1]
+    }
+
+    /// `raster_args` words [`ARGS_CLEAR`]..: a workgroup per
+    /// `runs_per_group` runs of [`Rect::runs`], at most [`MAX_GROUPS_X`].
+    pub fn clear_dispatch(&self, w: u32, runs_per_group: u32) -> [u32; 3] {
+        let groups = self.runs(w).1.div_ceil(runs_per_group.max(1));
+        [groups.min(MAX_GROUPS_X), 1, 1]
+    }
+
+    /// The runs workgroup `group` of a dispatch of `workgroups` takes in
+    /// blocks ([`Rect::clear_dispatch`]): the `group`th of `workgroups`
+    /// contiguous blocks of [`Rect::runs`], those runs that touch the
+    /// rectangle. However many workgroups, the blocks cover every run.
+    pub fn runs_of_block(&self, w: u32, group: u32, workgroups: u32) -> impl Iterator<Item = u32> {
+        let (first, runs) = self.runs(w);
+        let per = runs.div_ceil(workgroups.max(1));
+        let lo = group.saturating_mul(per).min(runs);
+        let hi = lo.saturating_add(per).min(runs);
+        let rect = *self;
+        (lo..hi)
+            .map(move |k| first + k)
+            .filter(move |&run| rect.touches_run(run * TILE, TILE, w))
     }
 
     /// The rectangle in tiles of [`granularity`] pixels, a byte per edge

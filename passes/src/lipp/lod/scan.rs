@@ -18,7 +18,7 @@
 //! scans their sums in workgroup memory (shaders/lipp/lod_scan.wgsl); the
 //! CPU kernel computes the same values sequentially.
 
-use super::super::rect::{ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, Rect};
+use super::super::rect::{ARGS_CLEAR, ARGS_RECT_HI, ARGS_RECT_LO, ARGS_RUNS, Rect};
 use super::super::{
     ARGS_ALL, ARGS_BUNDLES_HI, ARGS_BUNDLES_LO, ARGS_DRAWN, ARGS_KEPT, BUNDLE_WORDS, BundleLod,
     BundleRecord, LOD_CULLED, LOD_OTHER_GROOM, LOD_WORDS, MAX_GROUPS_X, bundle_count,
@@ -28,7 +28,7 @@ use super::ALL_MODELS;
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::Ctx;
-use crate::params::PassParams;
+use crate::params::{Invalid, PassParams, in_range};
 
 /// Threads of the single scan workgroup (WGSL).
 pub const SCAN_GROUP: u32 = 256;
@@ -49,6 +49,10 @@ pub struct ScanParams {
     /// A `raster_args` with no room for the range gets every bundle's.
     #[serde(rename = "model_index", deserialize_with = "crate::params::some")]
     pub model: Option<u32>,
+    /// Ours: runs of the rectangle each `lipp.clear_gbuffer` workgroup
+    /// clears (`raster_args` words [`ARGS_CLEAR`]..); 1: a workgroup a run,
+    /// as `lipp.shade` is dispatched (passes/src/lipp/clear.rs says why).
+    pub clear_runs: u32,
 }
 
 impl Default for ScanParams {
@@ -56,13 +60,21 @@ impl Default for ScanParams {
         Self {
             groom_rect: true,
             model: None,
+            clear_runs: 8,
         }
     }
 }
 
 impl PassParams for ScanParams {
     const READS_MODEL_INDEX: bool = true;
+
+    fn validate(&self) -> Result<(), Invalid> {
+        in_range("clear_runs", self.clear_runs, 1..=MAX_CLEAR_RUNS)
+    }
 }
+
+/// The most runs one `lipp.clear_gbuffer` workgroup is given.
+pub const MAX_CLEAR_RUNS: u32 = 64;
 
 crate::gpu_block! {
     /// `ScanParams` in shaders/lipp/lod_scan.wgsl.
@@ -75,7 +87,7 @@ crate::gpu_block! {
         groom_rect: u32,
         /// The groom scanned, or ALL_MODELS.
         model: u32,
-        _pad0: u32,
+        clear_runs: u32,
         _pad1: u32,
         _pad2: u32,
     }
@@ -101,6 +113,7 @@ pub static LOD_SCAN: PassKind<ScanParams, ScanGpu> = PassKind {
         height: q.height,
         groom_rect: flag(p.groom_rect),
         model: p.model.unwrap_or(ALL_MODELS),
+        clear_runs: p.clear_runs,
         ..ScanGpu::default()
     },
     raster: None,
@@ -167,6 +180,12 @@ impl CpuKernel for ScanKernel {
                 args.store(ARGS_RUNS + i, n);
             }
         }
+        if args.len() > ARGS_CLEAR + 2 {
+            let dispatch = groom.clear_dispatch(w, self.0.clear_runs);
+            for (i, n) in dispatch.into_iter().enumerate() {
+                args.store(ARGS_CLEAR + i, n);
+            }
+        }
         if room {
             args.store(ARGS_BUNDLES_LO, range.start as u32);
             args.store(ARGS_BUNDLES_HI, range.end as u32);
@@ -213,7 +232,7 @@ mod tests {
         h.buffer("hairmesh.bundles", bundles)
             .buffer("lod_choices", choices)
             .buffer("bundle_lod", vec![0; 4 * counts.len()])
-            .buffer("raster_args", vec![0; 11]);
+            .buffer("raster_args", vec![0; ARGS_CLEAR + 3]);
         h.run(&ScanKernel(ScanParams::default()), 1, SCAN_GROUP);
         let lod = h.read("bundle_lod");
         let firsts: Vec<u32> = lod.chunks(4).map(|w| w[2]).collect();
@@ -236,9 +255,11 @@ mod tests {
         );
         // Runs of 64 pixels from (8, 24) to (47, 71) on a 640-wide screen:
         // 24 * 10 + 0 to 71 * 10 + 0.
-        assert_eq!(&args[ARGS_RUNS..], &[471, 1, 1]);
+        assert_eq!(&args[ARGS_RUNS..ARGS_RUNS + 3], &[471, 1, 1]);
+        // lipp.clear_gbuffer's: 8 runs a workgroup.
+        assert_eq!(&args[ARGS_CLEAR..], &[59, 1, 1]);
         // Off, the whole screen: 640 * 480 / 64 runs.
-        h.buffer("raster_args", vec![0; 11]);
+        h.buffer("raster_args", vec![0; ARGS_CLEAR + 3]);
         let off = ScanParams {
             groom_rect: false,
             ..ScanParams::default()
@@ -249,7 +270,8 @@ mod tests {
             Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]),
             Rect::full(640, 480)
         );
-        assert_eq!(&args[ARGS_RUNS..], &[4800, 1, 1]);
+        assert_eq!(&args[ARGS_RUNS..ARGS_RUNS + 3], &[4800, 1, 1]);
+        assert_eq!(&args[ARGS_CLEAR..], &[600, 1, 1]);
     }
 
     /// Three grooms' bundles (models 0, 0, 1, 1, 1, 2), scanned for groom

@@ -95,6 +95,42 @@ fn runs_of_pixels_touch_the_rectangle_where_they_share_a_pixel() {
     }
 }
 
+/// However many workgroups a clear is dispatched with (the scan's
+/// `clear_runs`, or the cap past 65,535), their blocks take every run the
+/// rectangle touches exactly once, the same runs a workgroup a run takes.
+#[test]
+fn blocks_of_runs_take_every_touching_run_once() {
+    let r = Rect {
+        x0: 70,
+        y0: 3,
+        x1: 613,
+        y1: 41,
+    };
+    let w = 640;
+    let (_, runs) = r.runs(w);
+    let one_each: Vec<u32> = (0..runs)
+        .flat_map(|g| r.runs_of_group(w, g, runs))
+        .collect();
+    for per in [1, 2, 7, 8, runs - 1, runs, runs + 5] {
+        let [groups, y, z] = r.clear_dispatch(w, per);
+        assert_eq!(
+            (groups, y, z),
+            (runs.div_ceil(per), 1, 1),
+            "{per} runs a group"
+        );
+        let mut taken: Vec<u32> = (0..groups)
+            .flat_map(|g| r.runs_of_block(w, g, groups))
+            .collect();
+        taken.sort_unstable();
+        assert_eq!(taken, one_each, "{per} runs a group");
+    }
+    // Fewer workgroups than asked for (the dispatch's cap): still all.
+    let mut taken: Vec<u32> = (0..3).flat_map(|g| r.runs_of_block(w, g, 3)).collect();
+    taken.sort_unstable();
+    assert_eq!(taken, one_each);
+    assert_eq!(Rect::EMPTY.clear_dispatch(w, 8), [0, 1, 1]);
+}
+
 /// A bundle of `n` layers, twisted, curled and noisy, its layers' quads
 /// uneven and bent, in `words`.
 fn styled_bundle(n: u32, seed: u32) -> (Vec<AtomicU32>, BundleRecord) {
