@@ -52,10 +52,14 @@ struct ProbeTaps {
     t: vec2<f32>,
 }
 
-// probe::bilinear_taps at level k, as indices: x wraps, y clamps.
-fn probe_taps(k: u32, d: vec3<f32>) -> ProbeTaps {
+// probe::bilinear_taps at level k and lat-long (u, v) (latlong_uv, once for
+// both levels), as indices: x wraps, y clamps. Every level's width is a
+// power of two (probe.rs tests it), so x wraps with a mask. Four integer
+// remainders a level by a width the compiler does not know, and the
+// lat-long angles computed for each level, cost lipp.shade 14 µs at close
+// on the H200 (benches/results/lipp-clear-blocks-h200.txt, item 7).
+fn probe_taps(k: u32, uv: vec2<f32>) -> ProbeTaps {
     let size = probe_level_size(k);
-    let uv = latlong_uv(d);
     let fx = uv.x * f32(size.x) - 0.5;
     let fy = uv.y * f32(size.y) - 0.5;
     let x0f = floor(fx);
@@ -66,8 +70,9 @@ fn probe_taps(k: u32, d: vec3<f32>) -> ProbeTaps {
     let h = i32(size.y);
     let x0 = i32(x0f);
     let y0 = i32(y0f);
-    let xa = u32(((x0 % w) + w) % w);
-    let xb = u32((((x0 + 1) % w) + w) % w);
+    // x0 >= -1: -1 wraps to size.x - 1, as rem_euclid does.
+    let xa = bitcast<u32>(x0) & (size.x - 1u);
+    let xb = bitcast<u32>(x0 + 1) & (size.x - 1u);
     let ya = u32(clamp(y0, 0, h - 1));
     let yb = u32(clamp(y0 + 1, 0, h - 1));
     let o = probe_level_offset(k);

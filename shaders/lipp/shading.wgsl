@@ -21,7 +21,7 @@
 #import strandgraph::hash::pcg
 #import strandgraph::lipp::{LightFrame, light_project, unit, safe_normalize, PI}
 #import strandgraph::chiang::{chiang, fibre_paths, FibrePaths}
-#import strandgraph::probe::{PROBE_LEVELS, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
+#import strandgraph::probe::{PROBE_LEVELS, latlong_uv, probe_alpha_lod, probe_taps, probe_blend, view_facing_normal, probe_lobe}
 
 @group(0) @binding(#{ENV_SH_BINDING}) var<storage, read> env_sh: array<vec4<f32>, 9>;
 @group(0) @binding(#{DOM_DEPTH_BINDING}) var<storage, read> dom_depth: array<u32>;
@@ -155,9 +155,9 @@ fn sh_irradiance(n: vec3<f32>) -> vec3<f32> {
         + 2.0 * c2 * (env_sh[3].xyz * x + env_sh[1].xyz * y + env_sh[2].xyz * z);
 }
 
-// probe::sample_level.
-fn probe_level(k: u32, d: vec3<f32>) -> vec3<f32> {
-    let tp = probe_taps(k, d);
+// probe::sample_level, at lat-long (u, v).
+fn probe_level(k: u32, uv: vec2<f32>) -> vec3<f32> {
+    let tp = probe_taps(k, uv);
     return probe_blend(
         env_prefiltered[tp.texel.x].xyz,
         env_prefiltered[tp.texel.y].xyz,
@@ -173,8 +173,9 @@ fn specular_lobe(t: vec3<f32>, v: vec3<f32>, n: vec3<f32>, albedo: vec4<f32>, ro
     let lod = probe_alpha_lod(lobe.alpha);
     let k0 = min(u32(floor(lod)), PROBE_LEVELS - 1u);
     let k1 = min(k0 + 1u, PROBE_LEVELS - 1u);
-    let a = probe_level(k0, lobe.direction);
-    let b = probe_level(k1, lobe.direction);
+    let uv = latlong_uv(lobe.direction);
+    let a = probe_level(k0, uv);
+    let b = probe_level(k1, uv);
     return (a + (b - a) * (lod - f32(k0))) * lobe.weight;
 }
 

@@ -13,15 +13,19 @@ pub fn latlong_uv(d: [f32; 3]) -> (f32, f32) {
 }
 
 /// Bilinear texel coordinates at (u, v) of a w × h lat-long grid: the four
-/// (x, y) (x wraps around, y clamps at the poles) and the fractions.
+/// (x, y) (x wraps around, y clamps at the poles) and the fractions. `w` is
+/// a power of two (every level's is, `level_widths_are_powers_of_two`), so x
+/// wraps with a mask, as the WGSL does: there an integer remainder by a
+/// width the compiler does not know is a long instruction sequence.
 pub(super) fn bilinear_taps(u: f32, v: f32, w: u32, h: u32) -> ([(u32, u32); 4], f32, f32) {
     let fx = u * w as f32 - 0.5;
     let fy = v * h as f32 - 0.5;
     let (x0, y0) = (fx.floor(), fy.floor());
     let (tx, ty) = (fx - x0, fy - y0);
     let (x0, y0) = (x0 as i32, y0 as i32);
-    let xa = x0.rem_euclid(w as i32) as u32;
-    let xb = (x0 + 1).rem_euclid(w as i32) as u32;
+    // x0 >= -1 (u >= 0): -1 wraps to w - 1, as rem_euclid would.
+    let xa = (x0 as u32) & (w - 1);
+    let xb = ((x0 + 1) as u32) & (w - 1);
     let ya = y0.clamp(0, h as i32 - 1) as u32;
     let yb = (y0 + 1).clamp(0, h as i32 - 1) as u32;
     ([(xa, ya), (xb, ya), (xa, yb), (xb, yb)], tx, ty)
@@ -37,10 +41,9 @@ pub(super) fn blend(c: [[f32; 3]; 4], tx: f32, ty: f32) -> [f32; 3] {
     })
 }
 
-/// Bilinear radiance of prefiltered level `k` in direction `d`.
-pub fn sample_level(w: &Words<'_>, k: u32, d: [f32; 3]) -> [f32; 3] {
+/// Bilinear radiance of prefiltered level `k` at lat-long (u, v).
+pub fn sample_level(w: &Words<'_>, k: u32, (u, v): (f32, f32)) -> [f32; 3] {
     let (lw, lh) = level_size(k);
-    let (u, v) = latlong_uv(d);
     let (taps, tx, ty) = bilinear_taps(u, v, lw, lh);
     let c = taps.map(|(x, y)| {
         let t = w.load_vec4((level_offset(k) + y * lw + x) as usize);
@@ -56,7 +59,8 @@ pub fn sample(w: &Words<'_>, d: [f32; 3], alpha: f32) -> [f32; 3] {
     let k0 = (lod.floor() as u32).min(LEVELS - 1);
     let k1 = (k0 + 1).min(LEVELS - 1);
     let t = lod - k0 as f32;
-    let (a, b) = (sample_level(w, k0, d), sample_level(w, k1, d));
+    let uv = latlong_uv(d);
+    let (a, b) = (sample_level(w, k0, uv), sample_level(w, k1, uv));
     std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t)
 }
 
@@ -66,6 +70,19 @@ mod tests {
     use super::*;
     use std::sync::atomic::AtomicU64;
     use strandgraph_assets::loaders::envmap;
+
+    /// bilinear_taps wraps x with a mask (and the WGSL with it).
+    #[test]
+    fn level_widths_are_powers_of_two() {
+        for k in 0..LEVELS {
+            assert!(level_size(k).0.is_power_of_two(), "level {k}");
+        }
+        // Across the seam both ways, as rem_euclid wraps.
+        let (taps, _, _) = bilinear_taps(0.0, 0.5, 16, 8);
+        assert_eq!((taps[0].0, taps[1].0), (15, 0));
+        let (taps, _, _) = bilinear_taps(0.999, 0.5, 16, 8);
+        assert_eq!((taps[0].0, taps[1].0), (15, 0));
+    }
 
     #[test]
     fn lookup_convention_matches_the_loader() {
