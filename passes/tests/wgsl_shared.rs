@@ -173,30 +173,39 @@ fn constant_bits(module: &Module, name: &str) -> Option<u32> {
     }
 }
 
+/// Asserts that each WGSL constant expression (after `import`, e.g.
+/// `DEPTH_MAX` or `R_ALBEDO_FIT[3]`) has the f32 bits of its Rust value.
+fn assert_wgsl_bits(import: &str, constants: &[(String, f32)]) {
+    let aliases: String = constants
+        .iter()
+        .enumerate()
+        .map(|(i, (expr, _))| format!("const PROBE_{i}: f32 = {expr};\n"))
+        .collect();
+    let source = format!(
+        "#import {import}\n{aliases}@compute @workgroup_size(1)\nfn probe() {{\n    _ = PROBE_0;\n}}\n"
+    );
+    let mut composer = composer();
+    let module = compose(&mut composer, "constants_probe.wgsl", &source, BASE)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0;
+    for (i, (expr, rust)) in constants.iter().enumerate() {
+        let bits = constant_bits(&module, &format!("PROBE_{i}"));
+        assert_eq!(bits, Some(rust.to_bits()), "{expr}");
+    }
+}
+
 /// Constants whose exact bits both sides must share: a kernel multiplies by
 /// them where a division would round differently on a GPU (payload.rs).
 #[test]
 fn wgsl_constants_have_the_rust_bits() {
-    let source = "
-#import strandgraph::lipp::{DEPTH_MAX, INV_DEPTH_MAX}
-const PROBE_DEPTH_MAX: f32 = DEPTH_MAX;
-const PROBE_INV_DEPTH_MAX: f32 = INV_DEPTH_MAX;
-@compute @workgroup_size(1)
-fn probe() {
-    _ = PROBE_DEPTH_MAX * PROBE_INV_DEPTH_MAX;
-}
-";
-    let mut composer = composer();
-    let module = compose(&mut composer, "constants_probe.wgsl", source, BASE)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .0;
     use strandgraph_passes::lipp::payload::{DEPTH_MAX, INV_DEPTH_MAX};
-    for (name, rust) in [
-        ("PROBE_DEPTH_MAX", DEPTH_MAX),
-        ("PROBE_INV_DEPTH_MAX", INV_DEPTH_MAX),
-    ] {
-        assert_eq!(constant_bits(&module, name), Some(rust.to_bits()), "{name}");
-    }
+    assert_wgsl_bits(
+        "strandgraph::lipp::{DEPTH_MAX, INV_DEPTH_MAX}",
+        &[
+            ("DEPTH_MAX".into(), DEPTH_MAX),
+            ("INV_DEPTH_MAX".into(), INV_DEPTH_MAX),
+        ],
+    );
 }
 
 /// Chiang's R albedo fit (chiang.wgsl `R_ALBEDO_FIT`) has the Rust
@@ -204,23 +213,10 @@ fn probe() {
 #[test]
 fn r_albedo_fit_has_the_rust_bits() {
     use strandgraph_passes::lipp::chiang::R_ALBEDO_FIT;
-    let aliases: String = (0..R_ALBEDO_FIT.len())
-        .map(|i| format!("const PROBE_R{i}: f32 = R_ALBEDO_FIT[{i}];\n"))
+    let constants: Vec<(String, f32)> = R_ALBEDO_FIT
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| (format!("R_ALBEDO_FIT[{i}]"), c))
         .collect();
-    let source = format!(
-        "#import strandgraph::chiang::R_ALBEDO_FIT\n{aliases}\
-         @compute @workgroup_size(1)\nfn probe() {{\n    _ = PROBE_R0 + PROBE_R7;\n}}\n"
-    );
-    let mut composer = composer();
-    let module = compose(&mut composer, "r_albedo_probe.wgsl", &source, BASE)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .0;
-    for (i, rust) in R_ALBEDO_FIT.iter().enumerate() {
-        let name = format!("PROBE_R{i}");
-        assert_eq!(
-            constant_bits(&module, &name),
-            Some(rust.to_bits()),
-            "{name}"
-        );
-    }
+    assert_wgsl_bits("strandgraph::chiang::R_ALBEDO_FIT", &constants);
 }

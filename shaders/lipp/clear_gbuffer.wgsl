@@ -1,9 +1,9 @@
 // lipp.clear_gbuffer (ours): every G-buffer layer cleared over the runs of
 // 64 pixels the groom's screen rectangle touches, the runs lipp.shade
-// shades, a workgroup a block of runs (lipp::rect::Rect::clear_dispatch).
+// shades, a workgroup a block of runs (lipp::rect::Rect::run_dispatch).
 // Port of passes/src/lipp/clear.rs.
 
-#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, RUN, rect_from_args, rect_runs, touches_run}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, RUN, rect_from_args, rect_runs, group_runs, touches_run}
 
 struct ClearParams {
     width: u32,
@@ -26,11 +26,9 @@ fn clear_gbuffer(
     let rect = rect_from_args(raster_args[ARGS_RECT_LO], raster_args[ARGS_RECT_HI]);
     let runs = rect_runs(rect, params.width);
     let layers = arrayLength(&gbuffer) / pixels;
-    // This workgroup's block of the runs (rect::Rect::runs_of_block).
-    let per = (runs.y + groups.x - 1u) / max(groups.x, 1u);
-    let lo = min(wg.x * per, runs.y);
-    let hi = min(lo + per, runs.y);
-    for (var k = lo; k < hi; k++) {
+    // This workgroup's block of the runs (rect::Rect::runs_of_group).
+    let block = group_runs(runs.y, wg.x, groups.x);
+    for (var k = block.x; k < block.y; k++) {
         let run = runs.x + k;
         let i = run * RUN + lane;
         if touches_run(rect, run * RUN, RUN, params.width) && i < pixels {

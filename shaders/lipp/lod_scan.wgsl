@@ -4,7 +4,7 @@
 // contiguous run of bundles; the lanes' sums are scanned in workgroup memory
 // (Hillis and Steele), then each lane writes its run.
 
-#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, ARGS_RUNS, ARGS_CLEAR, rect_union, rect_is_empty, unpack_tiles, rect_args, rect_runs}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, ARGS_RUNS, ARGS_CLEAR, rect_union, rect_is_empty, unpack_tiles, rect_args, rect_runs, run_groups}
 #import strandgraph::lipp::{BUNDLE_WORDS, MAX_GROUPS_X, LOD_OTHER_GROOM, LOD_CULLED, ARGS_BUNDLES_LO, ARGS_BUNDLES_HI}
 
 struct ScanParams {
@@ -196,15 +196,13 @@ fn scan(@builtin(local_invocation_index) lane: u32) {
             raster_args[ARGS_BUNDLES_HI] = range.y;
         }
         if arrayLength(&raster_args) > ARGS_RUNS + 2u {
-            raster_args[ARGS_RUNS] = min(rect_runs(groom, params.width).y, MAX_GROUPS_X);
+            raster_args[ARGS_RUNS] = run_groups(rect_runs(groom, params.width).y, 1u);
             raster_args[ARGS_RUNS + 1u] = 1u;
             raster_args[ARGS_RUNS + 2u] = 1u;
         }
-        // rect::Rect::clear_dispatch.
+        // rect::Rect::run_dispatch, again in blocks of clear_runs.
         if arrayLength(&raster_args) > ARGS_CLEAR + 2u {
-            let runs = rect_runs(groom, params.width).y;
-            let per = max(params.clear_runs, 1u);
-            raster_args[ARGS_CLEAR] = min((runs + per - 1u) / per, MAX_GROUPS_X);
+            raster_args[ARGS_CLEAR] = run_groups(rect_runs(groom, params.width).y, params.clear_runs);
             raster_args[ARGS_CLEAR + 1u] = 1u;
             raster_args[ARGS_CLEAR + 2u] = 1u;
         }

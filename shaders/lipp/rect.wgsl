@@ -6,7 +6,7 @@
 #define_import_path strandgraph::lipp_rect
 
 #import strandgraph::clip::{transform, clip_to_screen}
-#import strandgraph::lipp::bilinear
+#import strandgraph::lipp::{bilinear, MAX_GROUPS_X}
 
 // rect::ARGS_RECT_LO/HI, ARGS_RUNS, ARGS_CLEAR and FILTER_RECT_LO/HI; tiles::TILE.
 const ARGS_RECT_LO: u32 = 6u;
@@ -82,6 +82,20 @@ fn rect_runs(r: vec4<u32>, w: u32) -> vec2<u32> {
     let first = (r.y * w + r.x) / RUN;
     let last = ((r.w - 1u) * w + r.z - 1u) / RUN;
     return vec2<u32>(first, last - first + 1u);
+}
+
+// Rect::run_dispatch's x: a workgroup per `per` of `runs` runs.
+fn run_groups(runs: u32, per: u32) -> u32 {
+    let p = max(per, 1u);
+    return min((runs + p - 1u) / p, MAX_GROUPS_X);
+}
+
+// Rect::runs_of_group: the block [lo, hi) of the `count` runs that
+// workgroup `wg` of `groups` takes (one run each with as many workgroups).
+fn group_runs(count: u32, wg: u32, groups: u32) -> vec2<u32> {
+    let per = (count + groups - 1u) / max(groups, 1u);
+    let lo = min(wg * per, count);
+    return vec2<u32>(lo, min(lo + per, count));
 }
 
 // Rect::touches_run.

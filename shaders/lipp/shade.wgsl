@@ -19,7 +19,7 @@
 #import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction, share_light_frames}
 #import strandgraph::lipp_shaded::{shaded_record, pixel_flags, read_by_filter, HIT}
-#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, touches_run}
+#import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, group_runs, touches_run}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
 @group(0) @binding(5) var<storage, read> gbuffer: array<vec2<u32>>;
@@ -69,8 +69,9 @@ fn shade(
     workgroupBarrier();
     let rect = shaded_rect(wg.x, lane);
     let runs = rect_runs(rect, params.width);
-    // Past 65,535 runs the workgroups stride (rect::Rect::run_dispatch).
-    for (var k = wg.x; k < runs.y; k += max(groups.x, 1u)) {
+    // A run a workgroup; past 65,535 runs a block (rect::Rect::runs_of_group).
+    let block = group_runs(runs.y, wg.x, groups.x);
+    for (var k = block.x; k < block.y; k++) {
         let run = runs.x + k;
         // The same for the whole workgroup: it skips the run as one.
         if touches_run(rect, run * SHADE_GROUP, SHADE_GROUP, params.width) {

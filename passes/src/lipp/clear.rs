@@ -40,7 +40,7 @@ pub static CLEAR_GBUFFER: PassKind<NoParams, ClearGpu> = PassKind {
     source: "ours (lipp::rect)",
     bindings: Some(&[Binding::read("raster_args"), Binding::write("gbuffer")]),
     workgroup_size: TILE,
-    // A workgroup per block of runs (rect::Rect::clear_dispatch).
+    // A workgroup per block of runs (rect::Rect::run_dispatch).
     dispatch: Dispatch::Indirect {
         binding: "raster_args",
         word: ARGS_CLEAR,
@@ -65,7 +65,7 @@ impl CpuKernel for ClearKernel {
         let rect = Rect::from_args(args.load(ARGS_RECT_LO), args.load(ARGS_RECT_HI));
         let layers = (g.len() / (2 * pixels as usize)) as u32;
         let empty = [EMPTY as u32, (EMPTY >> 32) as u32];
-        for run in rect.runs_of_block(w, group, ctx.workgroups) {
+        for run in rect.runs_of_group(w, group, ctx.workgroups) {
             for layer in 0..layers {
                 for i in run * TILE..((run + 1) * TILE).min(pixels) {
                     let slot = 2 * (layer * pixels + i) as usize;
@@ -98,7 +98,7 @@ mod tests {
         let mut args = vec![0u32; ARGS_CLEAR + 3];
         let [lo, hi] = rect.args();
         (args[ARGS_RECT_LO], args[ARGS_RECT_HI]) = (lo, hi);
-        args[ARGS_CLEAR..].copy_from_slice(&rect.clear_dispatch(w, 2));
+        args[ARGS_CLEAR..].copy_from_slice(&rect.run_dispatch(w, 2));
         assert_eq!(args[ARGS_CLEAR], 2);
         let mut hs = Harness::new(Quantities {
             width: w,

@@ -61,11 +61,11 @@ use crate::layout::FrameData;
 pub const ARGS_RECT_LO: usize = 6;
 pub const ARGS_RECT_HI: usize = 7;
 /// `raster_args` words 8..=10: the workgroups (x, 1, 1) of one per run of
-/// [`TILE`] pixels [`Rect::runs`] covers, at most [`MAX_GROUPS_X`] (the
-/// kernels stride past it).
+/// [`TILE`] pixels [`Rect::runs`] covers, at most [`MAX_GROUPS_X`] (past
+/// it a workgroup takes a block of runs, [`Rect::runs_of_group`]).
 pub const ARGS_RUNS: usize = 8;
 /// `raster_args` words 13..=15: `lipp.clear_gbuffer`'s workgroups (x, 1, 1),
-/// one per `lipp.lod_scan`'s `clear_runs` runs ([`Rect::clear_dispatch`]).
+/// one per `lipp.lod_scan`'s `clear_runs` runs ([`Rect::run_dispatch`]).
 pub const ARGS_CLEAR: usize = 13;
 /// `filter_args` words: the pixels `lipp.shade` wrote records for, the same
 /// packing; a `filter_args` with no room for them shades the whole screen.
@@ -158,36 +158,22 @@ impl Rect {
         (first, last - first + 1)
     }
 
-    /// The runs workgroup `group` of the [`Rect::run_dispatch`] of
-    /// `workgroups` takes (striding past 65,535), those that touch the
-    /// rectangle: what `lipp.shade` and `lipp.clear_gbuffer` each work on.
-    pub fn runs_of_group(&self, w: u32, group: u32, workgroups: u32) -> impl Iterator<Item = u32> {
-        let (first, runs) = self.runs(w);
-        let rect = *self;
-        (group..runs)
-            .step_by(workgroups.max(1) as usize)
-            .map(move |k| first + k)
-            .filter(move |&run| rect.touches_run(run * TILE, TILE, w))
-    }
-
-    /// `raster_args` words [`ARGS_RUNS`]..: a workgroup per run of
-    /// [`Rect::runs`], at most [`MAX_GROUPS_X`].
-    pub fn run_dispatch(&self, w: u32) -> [u32; 3] {
-        [self.runs(w).1.min(MAX_GROUPS_X), 1, 1]
-    }
-
-    /// `raster_args` words [`ARGS_CLEAR`]..: a workgroup per
-    /// `runs_per_group` runs of [`Rect::runs`], at most [`MAX_GROUPS_X`].
-    pub fn clear_dispatch(&self, w: u32, runs_per_group: u32) -> [u32; 3] {
+    /// An indirect dispatch over [`Rect::runs`]: a workgroup per
+    /// `runs_per_group` runs, at most [`MAX_GROUPS_X`]. `raster_args` words
+    /// [`ARGS_RUNS`].. (`lipp.shade`, one run a workgroup) and
+    /// [`ARGS_CLEAR`].. (`lipp.clear_gbuffer`, the scan's `clear_runs`).
+    pub fn run_dispatch(&self, w: u32, runs_per_group: u32) -> [u32; 3] {
         let groups = self.runs(w).1.div_ceil(runs_per_group.max(1));
         [groups.min(MAX_GROUPS_X), 1, 1]
     }
 
-    /// The runs workgroup `group` of a dispatch of `workgroups` takes in
-    /// blocks ([`Rect::clear_dispatch`]): the `group`th of `workgroups`
-    /// contiguous blocks of [`Rect::runs`], those runs that touch the
-    /// rectangle. However many workgroups, the blocks cover every run.
-    pub fn runs_of_block(&self, w: u32, group: u32, workgroups: u32) -> impl Iterator<Item = u32> {
+    /// The runs workgroup `group` of a [`Rect::run_dispatch`] of
+    /// `workgroups` takes, those that touch the rectangle: the `group`th of
+    /// `workgroups` contiguous blocks of [`Rect::runs`] (one run each where
+    /// there are as many workgroups as runs). However many workgroups, the
+    /// blocks cover every run once. What `lipp.shade` and
+    /// `lipp.clear_gbuffer` each work on.
+    pub fn runs_of_group(&self, w: u32, group: u32, workgroups: u32) -> impl Iterator<Item = u32> {
         let (first, runs) = self.runs(w);
         let per = runs.div_ceil(workgroups.max(1));
         let lo = group.saturating_mul(per).min(runs);

@@ -176,12 +176,12 @@ impl CpuKernel for ScanKernel {
             args.store(ARGS_RECT_HI, hi);
         }
         if args.len() > ARGS_RUNS + 2 {
-            for (i, n) in groom.run_dispatch(w).into_iter().enumerate() {
+            for (i, n) in groom.run_dispatch(w, 1).into_iter().enumerate() {
                 args.store(ARGS_RUNS + i, n);
             }
         }
         if args.len() > ARGS_CLEAR + 2 {
-            let dispatch = groom.clear_dispatch(w, self.0.clear_runs);
+            let dispatch = groom.run_dispatch(w, self.0.clear_runs);
             for (i, n) in dispatch.into_iter().enumerate() {
                 args.store(ARGS_CLEAR + i, n);
             }

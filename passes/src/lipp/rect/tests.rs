@@ -95,9 +95,9 @@ fn runs_of_pixels_touch_the_rectangle_where_they_share_a_pixel() {
     }
 }
 
-/// However many workgroups a clear is dispatched with (the scan's
-/// `clear_runs`, or the cap past 65,535), their blocks take every run the
-/// rectangle touches exactly once, the same runs a workgroup a run takes.
+/// However many workgroups a pass is dispatched with (a run each, the
+/// scan's `clear_runs`, or the cap past 65,535), their blocks take every
+/// run the rectangle touches exactly once.
 #[test]
 fn blocks_of_runs_take_every_touching_run_once() {
     let r = Rect {
@@ -107,28 +107,29 @@ fn blocks_of_runs_take_every_touching_run_once() {
         y1: 41,
     };
     let w = 640;
-    let (_, runs) = r.runs(w);
-    let one_each: Vec<u32> = (0..runs)
-        .flat_map(|g| r.runs_of_group(w, g, runs))
+    let (first, runs) = r.runs(w);
+    let one_each: Vec<u32> = (first..first + runs)
+        .filter(|&run| r.touches_run(run * TILE, TILE, w))
         .collect();
+    assert!(one_each.len() > 1 && one_each.len() < runs as usize);
     for per in [1, 2, 7, 8, runs - 1, runs, runs + 5] {
-        let [groups, y, z] = r.clear_dispatch(w, per);
+        let [groups, y, z] = r.run_dispatch(w, per);
         assert_eq!(
             (groups, y, z),
             (runs.div_ceil(per), 1, 1),
             "{per} runs a group"
         );
         let mut taken: Vec<u32> = (0..groups)
-            .flat_map(|g| r.runs_of_block(w, g, groups))
+            .flat_map(|g| r.runs_of_group(w, g, groups))
             .collect();
         taken.sort_unstable();
         assert_eq!(taken, one_each, "{per} runs a group");
     }
     // Fewer workgroups than asked for (the dispatch's cap): still all.
-    let mut taken: Vec<u32> = (0..3).flat_map(|g| r.runs_of_block(w, g, 3)).collect();
+    let mut taken: Vec<u32> = (0..3).flat_map(|g| r.runs_of_group(w, g, 3)).collect();
     taken.sort_unstable();
     assert_eq!(taken, one_each);
-    assert_eq!(Rect::EMPTY.clear_dispatch(w, 8), [0, 1, 1]);
+    assert_eq!(Rect::EMPTY.run_dispatch(w, 8), [0, 1, 1]);
 }
 
 /// A bundle of `n` layers, twisted, curled and noisy, its layers' quads
