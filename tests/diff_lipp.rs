@@ -21,8 +21,9 @@
 //! No device or no validation layer is a failure, not a skip.
 
 use std::path::PathBuf;
-use strandgraph::frame::prepare;
+use strandgraph::frame::{Prepared, override_param, prepare};
 use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
+use strandgraph_passes::lipp::tiles::{filter_groups, filter_lanes};
 use strandgraph_passes::lipp::{ARGS_BUNDLES_HI, ARGS_BUNDLES_LO};
 
 mod common;
@@ -210,6 +211,58 @@ fn lipp_msaa_graph_matches_on_cpu_wgpu_and_ash() {
 #[test]
 fn lipp_two_grooms_match_on_cpu_wgpu_and_ash() {
     run(None, true);
+}
+
+/// `lipp.filter`'s lanes a pixel (ours, passes/src/lipp/tiles.rs) split
+/// each window's sums, not what is summed: on ash, the eight lanes the
+/// small groom's few tiles get, then four, two, one, and two again through
+/// a dispatch of a workgroup a tile, give the same image up to the order of
+/// the additions (a few half-float steps), and each dispatch is the one the
+/// shade pass's budget sized.
+#[test]
+fn the_filters_lanes_change_only_the_order_of_its_sums() {
+    let mut p = prepare(&small_scene("lanes", false), None, Some((W, H)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let frame = |p: &Prepared| {
+        let s = ash(p, false);
+        (read_ash(&s, "output"), read_ash(&s, "filter_args"))
+    };
+    let (eight, args) = frame(&p);
+    let tiles = args[3];
+    assert!(tiles > 0, "no tiles listed: {args:?}");
+    assert_eq!(args[0], filter_groups(tiles, 1 << 19), "{args:?}");
+    assert_eq!(
+        filter_lanes(args[0], tiles, 8),
+        8,
+        "{tiles} tiles, {args:?}"
+    );
+    for (set, groups) in [
+        ("filter.lanes=4", args[0]),
+        ("filter.lanes=2", args[0]),
+        ("filter.lanes=1", args[0]),
+        ("filter.lanes=8", args[0]),
+        ("shade.filter_lane_budget=0", tiles),
+    ] {
+        override_param(&mut p.plan, set).unwrap();
+        let (image, a) = frame(&p);
+        assert_eq!((a[0], a[3]), (groups, tiles), "{set}: {a:?}");
+        let halves = |w: &[u32]| -> Vec<i32> {
+            w.iter()
+                .flat_map(|&x| [(x & 0xFFFF) as i32, (x >> 16) as i32])
+                .collect()
+        };
+        let (a, b) = (halves(&eight), halves(&image));
+        let steps = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).max().unwrap();
+        let changed = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+        eprintln!(
+            "{set}: {changed} of {} half floats differ, by at most {steps} steps",
+            a.len()
+        );
+        assert!(
+            steps <= 4,
+            "{set}: a channel moved {steps} half-float steps"
+        );
+    }
 }
 
 fn run(graph: Option<&str>, beard: bool) {

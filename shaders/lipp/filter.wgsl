@@ -8,6 +8,7 @@
 #import strandgraph::lipp::{safe_normalize, is_empty, unpack_payload, world_position, linear_depth, Sample, F32_MIN}
 #import strandgraph::lipp_shaded::{unpack_rgb9e5, record_depth, HIT, CONS_HIT, FRONT}
 #import strandgraph::lipp_rect::{FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args}
+#import strandgraph::lipp_tiles::{TILE, FILTER_GROUP, filter_lanes}
 
 // FilterParams (booleans as 0/1).
 struct FilterParams {
@@ -36,6 +37,9 @@ struct FilterParams {
     packed_taps: u32,
     // Ours: pixels; only taps this near the tangent's line (0: every tap).
     band: f32,
+    // Ours: the most lanes a pixel (filter.rs `lanes`).
+    lanes: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: FilterParams;
@@ -49,9 +53,6 @@ struct FilterParams {
 // lipp.shade's tiles with hair and their count (lipp::tiles).
 @group(0) @binding(7) var<storage, read> filter_tiles: array<u32>;
 @group(0) @binding(8) var<storage, read> filter_args: array<u32>;
-
-// lipp::tiles::TILE, this pass's workgroup size.
-const TILE: u32 = 64u;
 
 fn payload(layer: u32, i: u32) -> vec2<u32> {
     return gbuffer[layer * params.width * params.height + i];
@@ -130,8 +131,8 @@ fn band_span(dy: f32, tp: vec2<f32>, r: i32) -> vec2<i32> {
 }
 
 // filter::reconstruct: (filtered colour, alpha). With `parts` lanes a
-// pixel (filter_pairs), lane `part` takes every parts-th row of the window
-// and the lanes add their sums (filter.rs, `pairs`).
+// pixel, lane `part` takes every parts-th row of the window and the lanes
+// add their sums (filter.rs, `lanes`).
 fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promoted: bool, part: u32, parts: u32) -> vec4<f32> {
     let r = i32(params.radius);
     let sp = f32(params.radius) * params.s_parallel;
@@ -194,12 +195,13 @@ fn reconstruct(x: u32, y: u32, z_ref: f32, tp: vec2<f32>, cp: vec3<f32>, promote
             wsum += w;
         }
     }
-    if parts == 2u {
-        // The pair's lanes are neighbours and take the same branches.
-        sum += subgroupShuffleXor(sum, 1u);
-        wsum += subgroupShuffleXor(wsum, 1u);
-        hc += subgroupShuffleXor(hc, 1u);
-        hcons += subgroupShuffleXor(hcons, 1u);
+    // A pixel's lanes are neighbours, aligned to their count, and take the
+    // same branches.
+    for (var m = 1u; m < parts; m <<= 1u) {
+        sum += subgroupShuffleXor(sum, m);
+        wsum += subgroupShuffleXor(wsum, m);
+        hc += subgroupShuffleXor(hc, m);
+        hcons += subgroupShuffleXor(hcons, m);
     }
     var c = cp;
     if wsum > 0.0 {
@@ -225,37 +227,23 @@ fn true_width_alpha(f: f32, line: f32, width: f32) -> f32 {
     return 1.0 - pow(1.0 - f, k);
 }
 
-// The listed tiles, striding past 65,535 workgroups: 128 lanes a
-// workgroup, `parts` neighbouring lanes a pixel, so 2 / parts tiles a
-// workgroup (with a lane a pixel, the dispatch's second half has none).
-fn filter_listed(wg: u32, groups: u32, lane: u32, parts: u32) {
-    let count = min(filter_args[3], arrayLength(&filter_tiles));
-    let per = 2u / parts;
-    let pixel = lane / parts;
-    for (var t = wg * per + pixel / TILE; t < count; t += max(groups, 1u) * per) {
-        filter_pixel(filter_tiles[t] * TILE + pixel % TILE, lane % parts, parts);
-    }
-}
-
-// A lane a pixel (pairs off).
+// The listed tiles' pixels, `parts` neighbouring lanes a pixel as many as
+// the dispatch holds (tiles::filter_lanes), within one subgroup for the
+// shuffles, FILTER_GROUP / parts pixels a workgroup, striding past 65,535
+// workgroups.
 @compute @workgroup_size(128)
 fn filter_pixels(
     @builtin(workgroup_id) wg: vec3<u32>,
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
+    @builtin(subgroup_size) sg_size: u32,
 ) {
-    filter_listed(wg.x, groups.x, lane, 1u);
-}
-
-// filter.rs `pairs`: two neighbouring lanes a pixel, each taking every other
-// row of the window.
-@compute @workgroup_size(128)
-fn filter_pairs(
-    @builtin(workgroup_id) wg: vec3<u32>,
-    @builtin(num_workgroups) groups: vec3<u32>,
-    @builtin(local_invocation_index) lane: u32,
-) {
-    filter_listed(wg.x, groups.x, lane, 2u);
+    let count = min(filter_args[3], arrayLength(&filter_tiles));
+    let parts = filter_lanes(groups.x, count, min(params.lanes, sg_size));
+    let per = FILTER_GROUP / parts;
+    for (var p = wg.x * per + lane / parts; p < count * TILE; p += max(groups.x, 1u) * per) {
+        filter_pixel(filter_tiles[p / TILE] * TILE + p % TILE, lane % parts, parts);
+    }
 }
 
 // Lane `part` of `parts` filtering pixel i; part 0 writes.

@@ -16,9 +16,10 @@
 #define DOM_LAYERS_BINDING 8
 #define ENV_PREFILTERED_BINDING 10
 #import strandgraph::lipp_dom::frame
-#import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample, MAX_GROUPS_X}
+#import strandgraph::lipp::{is_empty, unpack_payload, world_position, Sample}
 #import strandgraph::lipp_shading::{ShadeParams, shading_of, shade_point, depth_correction, share_light_frames}
 #import strandgraph::lipp_shaded::{shaded_record, pixel_flags, read_by_filter, HIT}
+#import strandgraph::lipp_tiles::filter_groups
 #import strandgraph::lipp_rect::{ARGS_RECT_LO, ARGS_RECT_HI, FILTER_RECT_LO, FILTER_RECT_HI, rect_from_args, rect_args, rect_runs, group_runs, touches_run}
 
 @group(0) @binding(0) var<uniform> params: ShadeParams;
@@ -116,7 +117,7 @@ fn shade_run(run: u32, lane: u32) {
     if lane == 0u && (atomicLoad(&tile_has_hair) != 0u || params.hair_tiles == 0u) {
         let k = atomicAdd(&filter_args[3], 1u);
         filter_tiles[k] = run;
-        atomicMax(&filter_args[0], min(k + 1u, MAX_GROUPS_X));
+        atomicMax(&filter_args[0], filter_groups(k + 1u, params.filter_lane_budget));
         if k == 0u {
             atomicStore(&filter_args[1], 1u);
             atomicStore(&filter_args[2], 1u);

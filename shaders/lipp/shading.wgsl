@@ -55,7 +55,8 @@ struct ShadeParams {
     // whether only the samples lipp.filter reads are shaded (shade.rs).
     front_threshold: f32,
     read_layers_only: u32,
-    reserved_a: u32,
+    // lipp.shade: the lanes lipp.filter's dispatch is sized for (tiles.rs).
+    filter_lane_budget: u32,
     reserved_b: u32,
     reserved_c: u32,
 }

@@ -339,13 +339,23 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
-    // lipp.filter with a lane a pixel rather than two, each taking every
-    // other row of the window (passes/src/lipp/filter.rs, `pairs`).
+    // lipp.filter with a lane a pixel rather than two or more, each taking
+    // every other row of the window (passes/src/lipp/filter.rs, `lanes`).
     Variant {
         pipeline: "Lipp",
         name: "SWR 1+F+L, filter a lane per pixel",
         graph: LIPP,
-        overrides: &["filter.pairs=false"],
+        overrides: &["filter.lanes=1"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
+    // Ours off: lipp.filter's dispatch a workgroup a tile, two lanes a pixel
+    // however few the tiles (passes/src/lipp/tiles.rs, `filter_lane_budget`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, filter two lanes a pixel at every size",
+        graph: LIPP,
+        overrides: &["shade.filter_lane_budget=0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
     },

@@ -53,7 +53,7 @@ use super::payload::{EMPTY, Sample, from_words, unpack};
 use super::rect::{FILTER_RECT_HI, FILTER_RECT_LO, Rect};
 use super::shade::world_position;
 use super::shaded;
-use super::tiles::{self, TILE};
+use super::tiles::{self, MAX_FILTER_LANES, TILE};
 use super::{add, frame, normalize, scale, transform};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, flag};
 use crate::describe::PassKind;
@@ -62,9 +62,9 @@ use crate::kulikov::debug_resolve::{load_rgba16f, store_rgba16f};
 use crate::layout::{FrameData, ModelData, read};
 use crate::params::{Invalid, PassParams, in_range};
 
-/// Lanes a workgroup on the GPU: a tile of two lanes a pixel (`pairs`), or
-/// two tiles of a lane a pixel. The CPU kernel filters a tile a workgroup.
-pub const FILTER_GROUP: u32 = 2 * super::tiles::TILE;
+/// Lanes a workgroup on the GPU: 128, a tile at two lanes a pixel
+/// ([`FilterParams::lanes`]). The CPU kernel filters a tile a workgroup.
+pub use super::tiles::FILTER_GROUP;
 pub const MAX_RADIUS: u32 = 8;
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
@@ -96,13 +96,15 @@ pub struct FilterParams {
     /// (8 bytes) rather than both G-buffer layers and then its colour
     /// ([`super::shaded`] says why). The output is the same.
     pub packed_taps: bool,
-    /// Ours: two lanes a pixel on the GPU (entry point `filter_pairs`), each
-    /// taking every other row of the window, their sums added through a
-    /// subgroup shuffle. A far groom lists a few tiles, a workgroup or two
-    /// an SM, and each lane's 121 taps in a row then set the pass's time.
-    /// The sums are the same up to the order of two additions. Off
-    /// (`filter_pixels`), a workgroup of the same 128 lanes takes two tiles.
-    pub pairs: bool,
+    /// Ours: the most lanes a pixel on the GPU (1, 2, 4 or 8), each taking
+    /// every `lanes`-th row of the window, their sums added through subgroup
+    /// shuffles. A far groom lists a few tiles, a workgroup or two an SM, and
+    /// each lane's chain of taps then sets the pass's time. The filter takes
+    /// as many as its dispatch holds ([`super::tiles::filter_lanes`]:
+    /// `lipp.shade`'s `filter_lane_budget` sizes it), at least two. The sums
+    /// are the same up to the order of the additions. 1: a lane a pixel, a
+    /// workgroup of the same 128 lanes taking two tiles.
+    pub lanes: u32,
     /// Ours: pixels; only the window's taps within `band` of the line
     /// through the pixel along its screen tangent are read (0: every tap,
     /// as published). Across the strand the spatial Gaussian has
@@ -130,20 +132,20 @@ impl Default for FilterParams {
             centre_diameter: 0.5,
             model_index: 0,
             packed_taps: true,
-            pairs: true,
+            lanes: MAX_FILTER_LANES,
             band: 2.5,
         }
     }
 }
 
 impl PassParams for FilterParams {
-    const VARIANT_ENTRIES: &'static [&'static str] = &["filter_pairs"];
-
-    fn entry(&self, default: &'static str) -> &'static str {
-        if self.pairs { "filter_pairs" } else { default }
-    }
-
     fn validate(&self) -> Result<(), Invalid> {
+        if !(self.lanes.is_power_of_two() && self.lanes <= MAX_FILTER_LANES) {
+            return Err(Invalid::new(
+                "lanes",
+                format!("{} is not 1, 2, 4 or 8", self.lanes),
+            ));
+        }
         if ![0, 1, 2, 4, 8].contains(&self.msaa) {
             return Err(Invalid::new(
                 "msaa",
@@ -201,6 +203,8 @@ crate::gpu_block! {
         model_index: u32,
         packed_taps: u32,
         band: f32,
+        lanes: u32,
+        _pad: u32,
     }
 }
 
@@ -246,6 +250,8 @@ pub static FILTER: PassKind<FilterParams, FilterGpu> = PassKind {
         model_index: p.model_index,
         packed_taps: flag(p.packed_taps),
         band: p.band,
+        lanes: p.lanes,
+        _pad: 0,
     },
     raster: None,
 };

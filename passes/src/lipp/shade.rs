@@ -105,6 +105,14 @@ pub struct ShadeParams {
     /// ([`read_by_filter`]: no centre sample, or a flyaway in front); off,
     /// every sample. The pictures are the same.
     pub read_layers_only: bool,
+    /// Ours: lanes the dispatch of `lipp.filter` that this pass lists tiles
+    /// for is sized to fill ([`super::tiles::filter_groups`]): a groom of
+    /// few tiles gets up to eight lanes a pixel, its windows split over
+    /// them; 0: a workgroup a tile, two lanes a pixel. The default, 2^19,
+    /// is about twice what an H100 or H200 holds in flight (132 SMs of
+    /// 2,048 lanes): on the H200 it gave the mid view four lanes a pixel
+    /// where 2^18 gave two, and the far view eight with either.
+    pub filter_lane_budget: u32,
 }
 
 impl Default for ShadeParams {
@@ -124,6 +132,7 @@ impl Default for ShadeParams {
             hair_tiles: true,
             front_threshold: 0.01,
             read_layers_only: true,
+            filter_lane_budget: 1 << 19,
         }
     }
 }
@@ -170,7 +179,8 @@ crate::gpu_block! {
         front_threshold: f32,
         /// `lipp.shade` only: [`ShadeParams::read_layers_only`].
         read_layers_only: u32,
-        reserved_a: u32,
+        /// `lipp.shade` only: [`ShadeParams::filter_lane_budget`].
+        filter_lane_budget: u32,
         reserved_b: u32,
         reserved_c: u32,
     }
@@ -196,7 +206,7 @@ pub fn shade_gpu(p: &ShadeParams, q: &Quantities, slots: u32) -> ShadeGpu {
         hair_tiles: flag(p.hair_tiles),
         front_threshold: p.front_threshold,
         read_layers_only: flag(p.read_layers_only),
-        reserved_a: 0,
+        filter_lane_budget: p.filter_lane_budget,
         reserved_b: 0,
         reserved_c: 0,
     }
@@ -531,7 +541,8 @@ impl ShadeKernel {
             }
         }
         if hair || !self.0.hair_tiles {
-            tiles::list(&ctx.words("filter_args"), &ctx.words("filter_tiles"), run);
+            let (args, listed) = (ctx.words("filter_args"), ctx.words("filter_tiles"));
+            tiles::list(&args, &listed, run, self.0.filter_lane_budget);
         }
     }
 }
