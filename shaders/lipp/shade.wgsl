@@ -66,12 +66,22 @@ fn shade(
     @builtin(num_workgroups) groups: vec3<u32>,
     @builtin(local_invocation_index) lane: u32,
 ) {
-    share_light_frames(lane);
-    workgroupBarrier();
     let rect = shaded_rect(wg.x, lane);
     let runs = rect_runs(rect, params.width);
     // A run a workgroup; past 65,535 runs a block (rect::Rect::runs_of_group).
     let block = group_runs(runs.y, wg.x, groups.x);
+    // Most of a far groom's runs lie beside its rectangle, on the rows it
+    // spans: their workgroups leave before the light frames, which would
+    // hold their registers the longest (the same for the whole workgroup).
+    var touched = false;
+    for (var k = block.x; k < block.y && !touched; k++) {
+        touched = touches_run(rect, (runs.x + k) * SHADE_GROUP, SHADE_GROUP, params.width);
+    }
+    if !touched {
+        return;
+    }
+    share_light_frames(lane);
+    workgroupBarrier();
     for (var k = block.x; k < block.y; k++) {
         let run = runs.x + k;
         // The same for the whole workgroup: it skips the run as one.

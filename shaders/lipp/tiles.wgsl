@@ -8,7 +8,7 @@
 // tiles::{TILE, FILTER_GROUP, MAX_FILTER_LANES}.
 const TILE: u32 = 64u;
 const FILTER_GROUP: u32 = 128u;
-const MAX_FILTER_LANES: u32 = 8u;
+const MAX_FILTER_LANES: u32 = 16u;
 
 // tiles::filter_groups: workgroups for n listed tiles, at the most lanes a
 // pixel whose lanes fit `budget`; non-decreasing in n.

@@ -96,7 +96,8 @@ pub struct FilterParams {
     /// (8 bytes) rather than both G-buffer layers and then its colour
     /// ([`super::shaded`] says why). The output is the same.
     pub packed_taps: bool,
-    /// Ours: the most lanes a pixel on the GPU (1, 2, 4 or 8), each taking
+    /// Ours: the most lanes a pixel on the GPU (1, 2, 4, 8 or 16, and at
+    /// most the subgroup's, for the shuffles), each taking
     /// every `lanes`-th row of the window, their sums added through subgroup
     /// shuffles. A far groom lists a few tiles, a workgroup or two an SM, and
     /// each lane's chain of taps then sets the pass's time. The filter takes
@@ -143,7 +144,7 @@ impl PassParams for FilterParams {
         if !(self.lanes.is_power_of_two() && self.lanes <= MAX_FILTER_LANES) {
             return Err(Invalid::new(
                 "lanes",
-                format!("{} is not 1, 2, 4 or 8", self.lanes),
+                format!("{} is not 1, 2, 4, 8 or 16", self.lanes),
             ));
         }
         if ![0, 1, 2, 4, 8].contains(&self.msaa) {

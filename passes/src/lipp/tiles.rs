@@ -20,10 +20,10 @@
 //! idle, waits on that chain. The list therefore sizes the filter's
 //! dispatch for as many lanes a pixel (up to [`MAX_FILTER_LANES`]) as fit
 //! `lipp.shade`'s `filter_lane_budget`, and the filter splits each window
-//! over the lanes its dispatch gives it ([`filter_lanes`]): eight lanes a
-//! pixel for the far view's tiles, two for the close view's, whose tiles
-//! already fill the GPU (eight there made the filter 0.18 → 0.32 ms on the
-//! H200; benches/results/lipp-filter-lanes-h200.txt).
+//! over the lanes its dispatch gives it ([`filter_lanes`]), within a
+//! subgroup: sixteen lanes a pixel for the far view's 191 tiles, two for the
+//! close view's, whose tiles already fill the GPU (eight there made the
+//! filter 0.18 → 0.32 ms on the H200; benches/results/lipp-filter-lanes-h200.txt).
 
 use super::MAX_GROUPS_X;
 use crate::kernel::Words;
@@ -36,7 +36,7 @@ pub const ARGS_TILES: usize = 3;
 /// `lipp.filter`'s workgroup: 128 lanes (filter.rs `FILTER_GROUP`).
 pub const FILTER_GROUP: u32 = 2 * TILE;
 /// The most lanes a pixel the filter's dispatch is sized for.
-pub const MAX_FILTER_LANES: u32 = 8;
+pub const MAX_FILTER_LANES: u32 = 16;
 
 /// Workgroups of [`FILTER_GROUP`] lanes for `n` listed tiles: a workgroup a
 /// tile (two lanes a pixel), or more, up to [`MAX_FILTER_LANES`] lanes a
@@ -125,45 +125,44 @@ mod tests {
 
     #[test]
     fn the_dispatch_grows_with_the_tiles_and_widens_the_few() {
-        let budget = 1 << 18;
+        let budget = 1 << 19;
         // Never fewer workgroups for more tiles: the atomicMax of each
         // tile's count is the final count's.
         let mut last = 0;
-        for n in 0..5000 {
+        for n in 0..20_000 {
             let g = filter_groups(n, budget);
             assert!(g >= last && g >= n, "{n} tiles: {g} after {last}");
             last = g;
         }
         // Off: a workgroup a tile, two lanes a pixel.
-        for n in [1, 300, 16_000] {
+        for n in [1, 191, 16_000] {
             assert_eq!(filter_groups(n, 0), n);
             assert_eq!(filter_lanes(filter_groups(n, 0), n, MAX_FILTER_LANES), 2);
         }
-        // A far groom's few tiles take eight lanes a pixel, within the budget.
-        let far = 300;
-        assert_eq!(filter_groups(far, budget), 4 * far);
-        assert_eq!(filter_lanes(filter_groups(far, budget), far, 8), 8);
-        assert!(far * TILE * 8 <= budget);
-        // Between: four.
-        let mid = 600;
-        assert_eq!(filter_lanes(filter_groups(mid, budget), mid, 8), 4);
+        let lanes = |n| filter_lanes(filter_groups(n, budget), n, MAX_FILTER_LANES);
+        // The far view's tiles take sixteen lanes a pixel, within the budget.
+        assert_eq!(filter_groups(191, budget), 8 * 191);
+        assert_eq!(lanes(191), 16);
+        assert!(191 * TILE * 16 <= budget);
+        // Fewer as the tiles grow, by the lanes they fit.
+        assert_eq!(lanes(700), 8);
+        assert_eq!(lanes(1500), 4);
         // A close groom's fill the GPU at two.
-        let close = 16_000;
-        assert_eq!(filter_groups(close, budget), close);
-        assert_eq!(filter_lanes(close, close, 8), 2);
+        assert_eq!(filter_groups(16_000, budget), 16_000);
+        assert_eq!(lanes(16_000), 2);
     }
 
     #[test]
     fn the_filter_takes_what_the_dispatch_holds_up_to_its_cap() {
         // A lane a pixel stays one; a cap below the dispatch's width wins.
-        assert_eq!(filter_lanes(1200, 300, 1), 1);
-        assert_eq!(filter_lanes(1200, 300, 4), 4);
+        assert_eq!(filter_lanes(1528, 191, 1), 1);
+        assert_eq!(filter_lanes(1528, 191, 4), 4);
         // Past 65,535 workgroups the filter strides at two lanes a pixel.
         let n = 200_000;
         assert_eq!(filter_groups(n, 1 << 18), MAX_GROUPS_X);
-        assert_eq!(filter_lanes(MAX_GROUPS_X, n, 8), 2);
+        assert_eq!(filter_lanes(MAX_GROUPS_X, n, 16), 2);
         // The check itself does not overflow at the largest counts.
-        assert_eq!(filter_lanes(u32::MAX, u32::MAX, 8), 2);
-        assert_eq!(filter_lanes(MAX_GROUPS_X, 0, 8), 8);
+        assert_eq!(filter_lanes(u32::MAX, u32::MAX, 16), 2);
+        assert_eq!(filter_lanes(MAX_GROUPS_X, 0, 16), 16);
     }
 }
