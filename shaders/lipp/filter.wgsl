@@ -240,8 +240,19 @@ fn filter_pixels(
 ) {
     let count = min(filter_args[3], arrayLength(&filter_tiles));
     let parts = filter_lanes(groups.x, count, min(params.lanes, sg_size));
+    // Two lanes a pixel, the close views' width, as a constant the compiler
+    // folds: with `parts` unknown the close view's filter took 0.189 ms on
+    // the H200 against 0.187 with this copy.
+    if parts == 2u {
+        filter_listed(wg.x, groups.x, lane, count, 2u);
+    } else {
+        filter_listed(wg.x, groups.x, lane, count, parts);
+    }
+}
+
+fn filter_listed(wg: u32, groups: u32, lane: u32, count: u32, parts: u32) {
     let per = FILTER_GROUP / parts;
-    for (var p = wg.x * per + lane / parts; p < count * TILE; p += max(groups.x, 1u) * per) {
+    for (var p = wg * per + lane / parts; p < count * TILE; p += max(groups, 1u) * per) {
         filter_pixel(filter_tiles[p / TILE] * TILE + p % TILE, lane % parts, parts);
     }
 }
