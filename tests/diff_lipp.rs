@@ -233,8 +233,8 @@ fn the_filters_lanes_change_only_the_order_of_its_sums() {
     assert!(tiles > 0, "no tiles listed: {args:?}");
     assert_eq!(args[0], filter_groups(tiles, 1 << 19), "{args:?}");
     assert_eq!(
-        filter_lanes(args[0], tiles, 8),
-        8,
+        filter_lanes(args[0], tiles, 16),
+        16,
         "{tiles} tiles, {args:?}"
     );
     for (set, groups) in [

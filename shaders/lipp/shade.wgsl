@@ -70,9 +70,10 @@ fn shade(
     let runs = rect_runs(rect, params.width);
     // A run a workgroup; past 65,535 runs a block (rect::Rect::runs_of_group).
     let block = group_runs(runs.y, wg.x, groups.x);
-    // Most of a far groom's runs lie beside its rectangle, on the rows it
-    // spans: their workgroups leave before the light frames, which would
-    // hold their registers the longest (the same for the whole workgroup).
+    // Most of a far or mid groom's runs lie beside its rectangle, on the
+    // rows it spans: their workgroups leave before computing the light
+    // frames and waiting at the barrier (the same for the whole workgroup;
+    // lipp.shade at mid 0.070 -> 0.060 ms on the H200).
     var touched = false;
     for (var k = block.x; k < block.y && !touched; k++) {
         touched = touches_run(rect, (runs.x + k) * SHADE_GROUP, SHADE_GROUP, params.width);
