@@ -7,13 +7,15 @@
 
 #import strandgraph::clip::{transform, clip_to_screen}
 #import strandgraph::lipp::{bilinear, MAX_GROUPS_X}
+#import strandgraph::lipp_tiles::TILE
 
-// rect::ARGS_RECT_LO/HI, ARGS_RUNS, ARGS_CLEAR and FILTER_RECT_LO/HI; tiles::TILE.
+// rect::ARGS_RECT_LO/HI, ARGS_RUNS, ARGS_CLEAR and FILTER_RECT_LO/HI; a run
+// is a tile (tiles.wgsl).
 const ARGS_RECT_LO: u32 = 6u;
 const ARGS_RECT_HI: u32 = 7u;
 const ARGS_RUNS: u32 = 8u;
 const ARGS_CLEAR: u32 = 13u;
-const RUN: u32 = 64u;
+const RUN: u32 = TILE;
 const FILTER_RECT_LO: u32 = 4u;
 const FILTER_RECT_HI: u32 = 5u;
 const TWIST_REACH: f32 = 0.25;
