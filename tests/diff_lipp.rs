@@ -267,6 +267,74 @@ fn the_filters_lanes_change_only_the_order_of_its_sums() {
     }
 }
 
+/// `lipp.dom_opacity` walking the points `lipp.dom_depth` kept (ours,
+/// `shared_points`: passes/src/lipp/dom.rs) draws the same maps, bit for
+/// bit, as assembling every strand again, on ash and on the CPU: with the
+/// shadow LOD, whose strands all fit the room the graph's `dom_points`
+/// gives, and with every strand at C_max (no LOD, no groom cap), where none
+/// fits and both passes assemble them.
+#[test]
+fn the_maps_are_the_same_whether_opacity_assembles_or_reads_the_points() {
+    let mut p = prepare(&small_scene("shared", false), None, Some((W, H)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let share = |p: &mut Prepared, on: bool| {
+        for pass in ["dom_depth", "dom_opacity"] {
+            override_param(&mut p.plan, &format!("{pass}.shared_points={on}")).unwrap();
+        }
+    };
+    let no_lod: &[&str] = &[
+        "shadow_lod.enabled=false",
+        "shadow_lod.groom_resolution=false",
+    ];
+    for (case, sets) in [("LOD", &[][..]), ("C_max", no_lod)] {
+        for set in sets {
+            override_param(&mut p.plan, set).unwrap();
+        }
+        share(&mut p, true);
+        let s = ash(&p, false);
+        let (depth, layers) = (read_ash(&s, "dom_depth"), read_ash(&s, "dom_layers"));
+        let room = read_ash(&s, "dom_points")[0];
+        // Each drawn bundle's C (bundle_lod: strands, C, first strand, flags).
+        let cs: Vec<u32> = read_ash(&s, "shadow_lod")
+            .chunks(4)
+            .filter(|r| r[0] > 0)
+            .map(|r| r[1])
+            .collect();
+        let kept = cs.iter().filter(|&&c| c <= room).count();
+        eprintln!("{case}: room {room}, {kept} of {} bundles kept", cs.len());
+        let expected = if sets.is_empty() { cs.len() } else { 0 };
+        assert_eq!(kept, expected, "{case}: room {room}, C {cs:?}");
+        if sets.is_empty() {
+            let c = cpu(&p, s.subgroup_size);
+            let read = |name: &str| c.read(&p.plan, name).unwrap();
+            assert_eq!(read("dom_points")[0], room, "cpu: the room");
+            let (d, l) = (read("dom_depth"), read("dom_layers"));
+            share(&mut p, false);
+            let c = cpu(&p, s.subgroup_size);
+            let read = |name: &str| c.read(&p.plan, name).unwrap();
+            assert!(
+                read("dom_depth") == d && read("dom_layers") == l,
+                "cpu: the maps differ"
+            );
+        }
+        share(&mut p, false);
+        let s = ash(&p, false);
+        assert_eq!(
+            read_ash(&s, "dom_points")[0],
+            0,
+            "{case}: kept with the switch off"
+        );
+        assert!(
+            read_ash(&s, "dom_depth") == depth,
+            "{case}: ash: the depth maps differ"
+        );
+        assert!(
+            read_ash(&s, "dom_layers") == layers,
+            "{case}: ash: the opacity maps differ"
+        );
+    }
+}
+
 fn run(graph: Option<&str>, beard: bool) {
     let tag = match (graph, beard) {
         (_, true) => "grooms",

@@ -10,7 +10,7 @@
 #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_len, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
 
 // Bindings 0 and 8.. are the DOM entries' own.
 
@@ -23,12 +23,18 @@ struct DomParams {
     cooperative_assembly: u32,
     styling: u32,
     bundles: u32,
+    shared_points: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> dom_params: DomParams;
 @group(0) @binding(8) var<storage, read_write> dom_depth: array<atomic<u32>>;
 @group(0) @binding(8) var<storage, read> dom_opacity_pass_dom_depth: array<u32>;
-@group(0) @binding(9) var<storage, read_write> dom_layers: array<atomic<u32>>;
+@group(0) @binding(9) var<storage, read_write> dom_points: array<u32>;
+@group(0) @binding(9) var<storage, read> dom_opacity_pass_dom_points: array<u32>;
+@group(0) @binding(10) var<storage, read_write> dom_layers: array<atomic<u32>>;
 
 // dom::MAX_DOM_LIGHTS.
 const MAX_DOM_LIGHTS: u32 = 4u;
@@ -45,6 +51,87 @@ fn dom_end(lf: LightFrame, p: vec3<f32>, res: u32) -> vec3<f32> {
     let q = light_project(lf, p);
     let r = f32(res);
     return vec3<f32>(snap(q.x * r), snap(q.y * r), q.z);
+}
+
+// Ours, after Lipp §5 ("strand assembly is performed only once, while
+// projection is executed per view"; dom::shared_points): dom_depth keeps
+// the world-space control points it assembles in dom_points, and
+// dom_opacity walks them instead of assembling each strand again. Word 0
+// holds the points of room a strand had this frame (0: none kept); point k
+// of strand s is at words POINTS_HEADER + (s * room + k) * 3. A strand of
+// more points than the room is assembled by both passes.
+const POINTS_HEADER: u32 = 4u;
+
+// dom::points_room: the room per strand `words` of dom_points give `total`
+// strands.
+fn points_room(words: u32, total: u32) -> u32 {
+    if words <= POINTS_HEADER || total == 0u {
+        return 0u;
+    }
+    return min((words - POINTS_HEADER) / 3u / total, MAX_CONTROL_POINTS);
+}
+
+fn keep_point(i: u32, p: vec3<f32>) {
+    let w = POINTS_HEADER + i * 3u;
+    dom_points[w] = bitcast<u32>(p.x);
+    dom_points[w + 1u] = bitcast<u32>(p.y);
+    dom_points[w + 2u] = bitcast<u32>(p.z);
+}
+
+// The lane's strip points (pass_two's first..first + have) into strand
+// slot `base` (s * room). When C - 1 is a multiple of the 32 lanes' strips
+// (C = 33, 65, 129), the last point is no lane's own but the last lane's
+// `next`, and that lane keeps it.
+fn keep_points(strip: Strip, base: u32, lane: u32, c: u32) {
+    let first = lane * strip_len(c, 4u);
+    for (var m = 0u; m < strip.have; m++) {
+        keep_point(base + first + m, strip_point(strip, m).pos);
+    }
+    if lane + 1u == RASTER_GROUP && strip.has_next {
+        keep_point(base + first + strip.have, strip.next.pos);
+    }
+}
+
+fn kept_point(i: u32) -> ControlPoint {
+    let w = POINTS_HEADER + i * 3u;
+    let p = vec3<f32>(
+        bitcast<f32>(dom_opacity_pass_dom_points[w]),
+        bitcast<f32>(dom_opacity_pass_dom_points[w + 1u]),
+        bitcast<f32>(dom_opacity_pass_dom_points[w + 2u]),
+    );
+    return ControlPoint(p, 0.0, 0.0);
+}
+
+// pass_two's strip for the lane, from the points dom_depth kept: the same
+// points, so the same walk. Only positions: the maps read nothing else.
+fn kept_strip(base: u32, lane: u32, c: u32) -> Strip {
+    let len = strip_len(c, 4u);
+    let first = lane * len;
+    let have = min(select(0u, c - first, first < c), len);
+    let none = ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
+    var p0 = none;
+    var p1 = none;
+    var p2 = none;
+    var p3 = none;
+    if have > 0u {
+        p0 = kept_point(base + first);
+    }
+    if have > 1u {
+        p1 = kept_point(base + first + 1u);
+    }
+    if have > 2u {
+        p2 = kept_point(base + first + 2u);
+    }
+    if have > 3u {
+        p3 = kept_point(base + first + 3u);
+    }
+    let has_next = have > 0u && first + have < c;
+    var next = none;
+    if has_next {
+        next = kept_point(base + first + have);
+    }
+    let t = vec3<f32>(0.0);
+    return Strip(p0, p1, p2, p3, t, t, t, t, have, next, t, has_next);
 }
 
 fn dom_amount(st: Strand) -> u32 {
@@ -166,12 +253,19 @@ fn dom_depth_pass(
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
     let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_depth));
+    let room = select(0u, points_room(arrayLength(&dom_points), total), dom_params.shared_points != 0u);
+    if wg.x == 0u && lane == 0u {
+        dom_points[0] = room;
+    }
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
         pass_one(st, l);
         workgroupBarrier();
         let strip = pass_two(st, l);
+        if st.c <= room {
+            keep_points(strip, s * room, lane, st.c);
+        }
         let share = share_segments(st, strip, lane);
         // Each light's view once per strand, the strip's segments in it.
         for (var li = 0u; li < lights_n; li++) {
@@ -202,12 +296,19 @@ fn dom_opacity_pass(
     let count = min(dom_params.bundles, arrayLength(&bundle_lod) / LOD_WORDS);
     let l = lanes_of(lane, sg_lane, sg_size, dom_params.cooperative_assembly != 0u);
     let lights_n = dom_light_count(dom_params.resolution, arrayLength(&dom_opacity_pass_dom_depth));
+    // dom_depth's room this frame, where this pass reads its points.
+    let room = select(0u, dom_opacity_pass_dom_points[0], dom_params.shared_points != 0u);
     let stride = max(groups.x, 1u);
     for (var s = wg.x; s < total; s += stride) {
         let st = load_strand(count, s, dom_params.styling != 0u);
-        pass_one(st, l);
-        workgroupBarrier();
-        let strip = pass_two(st, l);
+        var strip: Strip;
+        if st.c <= room {
+            strip = kept_strip(s * room, lane, st.c);
+        } else {
+            pass_one(st, l);
+            workgroupBarrier();
+            strip = pass_two(st, l);
+        }
         let share = share_segments(st, strip, lane);
         let amount = dom_amount(st);
         for (var li = 0u; li < lights_n; li++) {

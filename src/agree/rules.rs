@@ -206,6 +206,28 @@ static EXCEPTIONS: &[Exception] = &[
         why: "contracted light projection: 18.6% of texels differ, by ≤ 122423 ULP of depth (1.5%), and a strand's edge moves into or out of a few texels (lavapipe)",
     },
     Exception {
+        kind: "lipp.dom_depth",
+        binding: "dom_points",
+        on: On::Wgpu,
+        rule: Rule::F32 {
+            ulps: 256,
+            abs: 1e-5,
+        },
+        outliers: 0.0,
+        why: "the strands' world-space points, assembled with the Hermite and styling arithmetic contracted (as lipp.reference_strands' reference_points)",
+    },
+    Exception {
+        kind: "lipp.dom_depth",
+        binding: "dom_points",
+        on: On::Every,
+        rule: Rule::F32 {
+            ulps: 16,
+            abs: 1e-6,
+        },
+        outliers: 0.0,
+        why: "the strands' world-space points: the GPU's sin and cos of the curl, twist and noise are not the CPU's",
+    },
+    Exception {
         kind: "lipp.dom_opacity",
         binding: "dom_layers",
         on: On::Wgpu,

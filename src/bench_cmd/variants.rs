@@ -359,6 +359,20 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Ours off: lipp.dom_opacity assembles every strand again rather than
+    // walk the points lipp.dom_depth kept (passes/src/lipp/dom.rs,
+    // `shared_points`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, each deep opacity map assembles its strands",
+        graph: LIPP,
+        overrides: &[
+            "dom_depth.shared_points=false",
+            "dom_opacity.shared_points=false",
+        ],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // Ours: every tap of the window, not only the band along the tangent
     // (passes/src/lipp/filter.rs, `band`).
     Variant {

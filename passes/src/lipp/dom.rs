@@ -24,11 +24,18 @@
 //! remaining ones"), so the optical depth of the whole groom is preserved in
 //! expectation and the maps stand for the full geometry set, as the paper's
 //! do, at a fraction of the strands.
+//!
+//! Assembly once for both maps (ours, `shared_points`, after Lipp §5):
+//! `dom_depth` keeps the world-space control points it assembles in
+//! `dom_points`, and `dom_opacity` walks those rather than assemble each
+//! strand again, which at the full geometry was half its time. The points are
+//! the same bits, so the maps are the same. The buffer's size sets the room a
+//! strand has ([`points_room`]); a strand of more points is assembled by both.
 
 use super::assemble::{Assembly, Strands, assemble};
 use super::strand::ControlPoint;
 use super::walk::Dda;
-use super::{RASTER_GROUP, cross, dot, frame, normalize, scale, sub};
+use super::{MAX_CONTROL_POINTS, RASTER_GROUP, cross, dot, frame, normalize, scale, sub};
 use crate::contract::{Binding, CpuKernel, Dispatch, Shader, count, flag};
 use crate::describe::PassKind;
 use crate::kernel::{Ctx, Words};
@@ -42,6 +49,19 @@ pub const OPACITY_SCALE: f32 = 1024.0;
 pub const NO_HIT: u32 = u32::MAX;
 /// Lights with a deep opacity map (the rest are unshadowed).
 pub const MAX_DOM_LIGHTS: usize = 4;
+/// Words of `dom_points` before the kept points: word 0 is the room per
+/// strand `dom_depth` kept this frame (0: none), then padding.
+pub const POINTS_HEADER: usize = 4;
+
+/// Points of room per strand that `words` of `dom_points` give `total`
+/// strands: strand s's point k is at words `POINTS_HEADER + (s · room + k)
+/// · 3` (x, y, z as f32 bits).
+pub fn points_room(words: usize, total: u32) -> u32 {
+    if words <= POINTS_HEADER || total == 0 {
+        return 0;
+    }
+    ((words - POINTS_HEADER) / 3 / total as usize).min(MAX_CONTROL_POINTS as usize) as u32
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
@@ -57,6 +77,9 @@ pub struct DomParams {
     pub density_compensation: bool,
     pub cooperative_assembly: bool,
     pub styling: bool,
+    /// Ours: `dom_opacity` walks the points `dom_depth` assembled rather
+    /// than assemble each strand again (set it on both passes).
+    pub shared_points: bool,
 }
 
 impl Default for DomParams {
@@ -69,6 +92,7 @@ impl Default for DomParams {
             density_compensation: true,
             cooperative_assembly: true,
             styling: true,
+            shared_points: true,
         }
     }
 }
@@ -98,6 +122,10 @@ crate::gpu_block! {
         cooperative_assembly: u32,
         styling: u32,
         bundles: u32,
+        shared_points: u32,
+        _pad0: u32,
+        _pad1: u32,
+        _pad2: u32,
     }
 }
 
@@ -113,6 +141,8 @@ impl DomParams {
             cooperative_assembly: flag(self.cooperative_assembly),
             styling: flag(self.styling),
             bundles: count(q.bundles),
+            shared_points: flag(self.shared_points),
+            ..Default::default()
         }
     }
 }
@@ -280,7 +310,10 @@ pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = dom_pass(
     "lipp.dom_depth",
     "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
     "Lipp §3.4; Yuksel and Keyser 2008",
-    dom_bindings!(Binding::atomic("dom_depth")),
+    dom_bindings!(
+        Binding::atomic("dom_depth"),
+        Binding::write("dom_points").at_least(POINTS_HEADER as u32),
+    ),
 );
 
 pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = dom_pass(
@@ -288,7 +321,11 @@ pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = dom_pass(
     "lipp.dom_opacity",
     "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
     "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
-    dom_bindings!(Binding::read("dom_depth"), Binding::atomic("dom_layers")),
+    dom_bindings!(
+        Binding::read("dom_depth"),
+        Binding::read("dom_points").at_least(POINTS_HEADER as u32),
+        Binding::atomic("dom_layers"),
+    ),
 );
 
 /// A stage's declaration. The two stages differ only in their name, maps,
@@ -389,19 +426,58 @@ impl DomKernel {
     }
 }
 
+impl DomKernel {
+    /// The room per strand in `dom_points` this frame: `dom_depth` decides
+    /// it (and workgroup 0 records it in the header), `dom_opacity` reads it.
+    fn room(&self, group: u32, points: &Words<'_>, total: u32) -> u32 {
+        if !self.p.shared_points {
+            return 0;
+        }
+        match self.stage {
+            Stage::Depth => {
+                let room = points_room(points.len(), total);
+                if group == 0 {
+                    points.store(0, room);
+                }
+                room
+            }
+            Stage::Opacity => points.load(0),
+        }
+    }
+
+    /// Segment (a, b) in world space through every light's map.
+    fn walk_segment(
+        &self,
+        maps: (&Words<'_>, &Words<'_>),
+        lights: &[LightFrame],
+        (a, b): ([f32; 3], [f32; 3]),
+        amount: u32,
+    ) {
+        let res = self.p.resolution;
+        let r = res as f32;
+        for (l, lf) in lights.iter().enumerate() {
+            let (pa, pb) = (lf.project(a), lf.project(b));
+            let pa = [snap(pa[0] * r), snap(pa[1] * r), pa[2]];
+            let pb = [snap(pb[0] * r), snap(pb[1] * r), pb[2]];
+            walk(pa, pb, res, &mut |x, y, z| {
+                self.visit(maps, l, lf, (x, y, z), amount);
+            });
+        }
+    }
+}
+
 impl CpuKernel for DomKernel {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
-        let res = self.p.resolution;
         let depth = ctx.words("dom_depth");
         let layers_map = match self.stage {
             Stage::Depth => depth,
             Stage::Opacity => ctx.words("dom_layers"),
         };
-        let lights = light_frames(ctx, Some((res, depth.len())));
-        if lights.is_empty() {
-            return;
-        }
+        let maps = (&depth, &layers_map);
+        let points = ctx.words("dom_points");
+        let lights = light_frames(ctx, Some((self.p.resolution, depth.len())));
         let strands = Strands::load(ctx);
+        let room = self.room(group, &points, strands.total);
         let opts = Assembly::new(ctx, self.p.cooperative_assembly, self.p.styling);
         let stride = ctx.workgroups.max(1);
         let mut s = group;
@@ -413,18 +489,40 @@ impl CpuKernel for DomKernel {
                 1.0
             };
             let amount = (self.p.strand_opacity * thinning * OPACITY_SCALE + 0.5).floor() as u32;
-            let mut draw = |a: &ControlPoint, _: [f32; 3], b: &ControlPoint, _: [f32; 3]| {
-                for (l, lf) in lights.iter().enumerate() {
-                    let (pa, pb) = (lf.project(a.pos), lf.project(b.pos));
-                    let r = res as f32;
-                    let pa = [snap(pa[0] * r), snap(pa[1] * r), pa[2]];
-                    let pb = [snap(pb[0] * r), snap(pb[1] * r), pb[2]];
-                    walk(pa, pb, res, &mut |x, y, z| {
-                        self.visit((&depth, &layers_map), l, lf, (x, y, z), amount);
-                    });
+            let c = lod.control_points.clamp(2, MAX_CONTROL_POINTS);
+            // Strand s's slot: point k at words slot + 3k.
+            let slot = POINTS_HEADER + s as usize * room as usize * 3;
+            let kept = c <= room;
+            if self.stage == Stage::Opacity && kept {
+                let point = |k: usize| {
+                    let w = slot + 3 * k;
+                    [0, 1, 2].map(|i| f32::from_bits(points.load(w + i)))
+                };
+                for k in 0..c as usize - 1 {
+                    self.walk_segment(maps, &lights, (point(k), point(k + 1)), amount);
                 }
-            };
-            assemble(&strands.layers, &rec, &lod, k, &opts, &mut draw);
+            } else {
+                let keep = self.stage == Stage::Depth && kept;
+                let store = |k: usize, p: [f32; 3]| {
+                    for (i, v) in p.into_iter().enumerate() {
+                        points.store(slot + 3 * k + i, v.to_bits());
+                    }
+                };
+                // Code 1 draws a strand's segments in order, so segment n
+                // ends at point n + 1.
+                let mut n = 0;
+                let mut draw = |a: &ControlPoint, _: [f32; 3], b: &ControlPoint, _: [f32; 3]| {
+                    if keep {
+                        if n == 0 {
+                            store(0, a.pos);
+                        }
+                        store(n + 1, b.pos);
+                    }
+                    n += 1;
+                    self.walk_segment(maps, &lights, (a.pos, b.pos), amount);
+                };
+                assemble(&strands.layers, &rec, &lod, k, &opts, &mut draw);
+            }
             s += stride;
         }
     }
@@ -468,6 +566,21 @@ mod tests {
         let mut n = 0;
         walk([-5.0, 2.0, 0.0], [20.0, 2.0, 0.0], 8, &mut |_, _, _| n += 1);
         assert_eq!(n, 8, "clipped to the map");
+    }
+
+    #[test]
+    fn points_room_fits_every_strand_in_the_buffer() {
+        // The graphs' size: 65 points of each of N strands after the header.
+        let words = |n: usize| POINTS_HEADER + n * 65 * 3;
+        assert_eq!(points_room(words(1000), 1000), 65);
+        assert_eq!(points_room(words(1000), 2000), 32);
+        assert_eq!(points_room(words(1000), 10), MAX_CONTROL_POINTS);
+        assert_eq!(points_room(words(1000), 0), 0);
+        assert_eq!(points_room(POINTS_HEADER, 5), 0);
+        for total in [1, 7, 1000, 130_000] {
+            let room = points_room(words(1000), total) as usize;
+            assert!(POINTS_HEADER + total as usize * room * 3 <= words(1000));
+        }
     }
 
     #[test]
