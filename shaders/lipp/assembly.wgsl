@@ -315,6 +315,14 @@ fn strip_len(c: u32, max_strip: u32) -> u32 {
     return min((c - 1u + RASTER_GROUP - 1u) / RASTER_GROUP, max_strip);
 }
 
+// The points of lane slot `slot` (round * 32 + lane) in strips of
+// strip_len(c, max_strip): (first, have), have 0 past the strand's end.
+fn strip_span(c: u32, slot: u32, max_strip: u32) -> vec2<u32> {
+    let len = strip_len(c, max_strip);
+    let first = slot * len;
+    return vec2<u32>(first, min(select(0u, c - first, first < c), len));
+}
+
 // strand::strip_rounds: the rounds of strips of strip_len(c, max_strip)
 // points that cover C points (1 when max_strip is 4: every C <= 129).
 fn strip_rounds(c: u32, max_strip: u32) -> u32 {
@@ -332,9 +340,9 @@ fn pass_two_round(st: Strand, l: Lanes, round: u32, max_strip: u32) -> Strip {
     let b = st.bundle;
     let id = st.id;
     let c = st.c;
-    let strip = strip_len(c, max_strip);
-    let first = (round * RASTER_GROUP + l.lane) * strip;
-    let have = min(select(0u, c - first, first < c), strip);
+    let span = strip_span(c, round * RASTER_GROUP + l.lane, max_strip);
+    let first = span.x;
+    let have = span.y;
     let none = ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
     var p0 = none;
     var p1 = none;

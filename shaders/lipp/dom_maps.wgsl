@@ -10,7 +10,7 @@
 #import strandgraph::lipp_dom::{frame, models, lights, light_frame, NO_HIT, OPACITY_SCALE}
 #import strandgraph::layout::{FrameData, ModelData, LightData}
 #import strandgraph::lipp::{LightFrame, light_frame_of, light_project, unit, safe_normalize, lerp_vec, calc_tangent, strand_uv, strand_id, BUNDLE_WORDS, LOD_WORDS, LAYER_VEC4S, MAX_LAYERS, RASTER_GROUP, MAX_CONTROL_POINTS, SNAP, TAU, PI}
-#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_len, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
+#import strandgraph::lipp_assembly::{raster_args, bundle_lod, hairmesh_bundles, hairmesh_layers, ControlPoint, Strand, Strip, load_strand, lanes_of, pass_one, pass_two, strip_span, strip_point, strip_tangent, strip_segments, snap, walk_column, walk_columns}
 
 // Bindings 0 and 8.. are the DOM entries' own.
 
@@ -83,7 +83,7 @@ fn keep_point(i: u32, p: vec3<f32>) {
 // (C = 33, 65, 129), the last point is no lane's own but the last lane's
 // `next`, and that lane keeps it.
 fn keep_points(strip: Strip, base: u32, lane: u32, c: u32) {
-    let first = lane * strip_len(c, 4u);
+    let first = strip_span(c, lane, 4u).x;
     for (var m = 0u; m < strip.have; m++) {
         keep_point(base + first + m, strip_point(strip, m).pos);
     }
@@ -92,7 +92,11 @@ fn keep_points(strip: Strip, base: u32, lane: u32, c: u32) {
     }
 }
 
-fn kept_point(i: u32) -> ControlPoint {
+// Point i of the kept strands where `ok`, else nothing.
+fn kept_point(i: u32, ok: bool) -> ControlPoint {
+    if !ok {
+        return ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
+    }
     let w = POINTS_HEADER + i * 3u;
     let p = vec3<f32>(
         bitcast<f32>(dom_opacity_pass_dom_points[w]),
@@ -105,33 +109,22 @@ fn kept_point(i: u32) -> ControlPoint {
 // pass_two's strip for the lane, from the points dom_depth kept: the same
 // points, so the same walk. Only positions: the maps read nothing else.
 fn kept_strip(base: u32, lane: u32, c: u32) -> Strip {
-    let len = strip_len(c, 4u);
-    let first = lane * len;
-    let have = min(select(0u, c - first, first < c), len);
-    let none = ControlPoint(vec3<f32>(0.0), 0.0, 0.0);
-    var p0 = none;
-    var p1 = none;
-    var p2 = none;
-    var p3 = none;
-    if have > 0u {
-        p0 = kept_point(base + first);
-    }
-    if have > 1u {
-        p1 = kept_point(base + first + 1u);
-    }
-    if have > 2u {
-        p2 = kept_point(base + first + 2u);
-    }
-    if have > 3u {
-        p3 = kept_point(base + first + 3u);
-    }
-    let has_next = have > 0u && first + have < c;
-    var next = none;
-    if has_next {
-        next = kept_point(base + first + have);
-    }
+    let span = strip_span(c, lane, 4u);
+    let at = base + span.x;
+    let have = span.y;
+    let has_next = have > 0u && span.x + have < c;
     let t = vec3<f32>(0.0);
-    return Strip(p0, p1, p2, p3, t, t, t, t, have, next, t, has_next);
+    return Strip(
+        kept_point(at, have > 0u),
+        kept_point(at + 1u, have > 1u),
+        kept_point(at + 2u, have > 2u),
+        kept_point(at + 3u, have > 3u),
+        t, t, t, t,
+        have,
+        kept_point(at + have, has_next),
+        t,
+        has_next,
+    );
 }
 
 fn dom_amount(st: Strand) -> u32 {
