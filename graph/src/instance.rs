@@ -157,6 +157,15 @@ fn resolve_size(decl: &ResourceDecl, q: &Quantities) -> Result<ResourceSize, Str
                     .checked_mul(per)
                     .and_then(|b| b.checked_add(extra))
                     .ok_or_else(overflow)?,
+                BufferSize::Capped {
+                    quantity,
+                    per,
+                    header,
+                    at_most,
+                } => elements(quantity)
+                    .checked_mul(per)
+                    .and_then(|b| b.checked_add(header))
+                    .map_or(at_most, |b| b.min(at_most)),
                 BufferSize::Atlas {
                     tile,
                     tiles,

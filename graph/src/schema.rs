@@ -166,6 +166,16 @@ pub enum BufferSize {
         layers: u32,
         texel_bytes: u32,
     },
+    /// `PerElementPlus(quantity, per, header)` capped at `at_most` bytes:
+    /// room that grows with the scene but stays bindable (2^27 bytes, 128
+    /// MiB, is Vulkan's least maxStorageBufferRange: lavapipe's, and wgpu's
+    /// default). A pass that binds it derives what it holds from its size.
+    Capped {
+        quantity: Quantity,
+        per: u64,
+        header: u64,
+        at_most: u64,
+    },
 }
 
 /// How large an image is.
@@ -376,12 +386,13 @@ mod tests {
                 Buffer(name: "d", size: Atlas(tile: 64, tiles: 512, layers: 4, texel_bytes: 4)),
                 Image(name: "e", format: D32Float, size: ScreenDiv(16), lifetime: Imported),
                 Image(name: "f", format: Rgba16Float, size: Fixed(8, 8), layers: 2),
+                Buffer(name: "g", size: Capped(quantity: Strands, per: 12, header: 16, at_most: 4096)),
             ],
             passes: [Pass(name: "p", kind: "k", queue: AsyncCompute, params: {"x": 1})],
             outputs: [],
         )"#;
         let g: GraphDesc = ron::from_str(src).unwrap();
-        assert_eq!(g.resources.len(), 6);
+        assert_eq!(g.resources.len(), 7);
         assert_eq!(g.resources[1].lifetime(), LifetimeClass::History);
         assert!(g.resources[5].is_image());
         assert_eq!(g.passes[0].queue, Queue::AsyncCompute);

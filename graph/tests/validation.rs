@@ -451,6 +451,30 @@ fn optional_scene_content_may_be_absent() {
 }
 
 #[test]
+fn a_capped_size_grows_with_the_scene_up_to_its_cap() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "room", size: Capped(quantity: Strands, per: 12, header: 16, at_most: 1000), lifetime: Imported),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "b", kind: "test.consume", reads: ["room"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let plan = compile_str("capped.ron", src, &registry(), 1).unwrap();
+    for (strands, bytes) in [(10, 136), (82, 1000), (1 << 40, 1000), (u64::MAX, 1000)] {
+        let q = Quantities {
+            strands,
+            ..Quantities::example()
+        };
+        let instance = plan.instantiate(&q).unwrap();
+        assert_eq!(instance.sizes[0].bytes, bytes, "{strands} strands");
+    }
+}
+
+#[test]
 fn several_errors_are_reported_together() {
     let src = r#"Graph(
     name: "g",
