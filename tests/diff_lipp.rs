@@ -441,3 +441,26 @@ fn run(graph: Option<&str>, beard: bool) {
         "ash: the aliased run's image differs"
     );
 }
+
+/// `lipp.dom_depth` with and without its plain load before the atomicMin
+/// (ours, `test_first`: passes/src/lipp/dom.rs) draws the same maps, bit
+/// for bit, on ash: the load only skips atomics that could not lower the
+/// texel.
+#[test]
+fn the_maps_are_the_same_whether_depth_tests_before_its_atomic() {
+    let mut p = prepare(&small_scene("test_first", false), None, Some((W, H)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let maps = |p: &mut Prepared, on: bool| {
+        override_param(&mut p.plan, &format!("dom_depth.test_first={on}")).unwrap();
+        let s = ash(p, false);
+        (read_ash(&s, "dom_depth"), read_ash(&s, "dom_layers"))
+    };
+    let (depth, layers) = maps(&mut p, true);
+    assert!(
+        depth.iter().any(|&t| t != u32::MAX),
+        "no strand reached the depth map"
+    );
+    let (d, l) = maps(&mut p, false);
+    assert!(d == depth, "the depth maps differ");
+    assert!(l == layers, "the opacity maps differ");
+}

@@ -24,7 +24,7 @@ struct DomParams {
     styling: u32,
     bundles: u32,
     shared_points: u32,
-    _pad0: u32,
+    test_first: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -195,9 +195,10 @@ fn dom_segment_depth(a: vec3<f32>, b: vec3<f32>, l: u32, lf: LightFrame, first: 
             for (var row = max(span.x, 0.0); row <= min(span.y, f32(res) - 1.0); row += 1.0) {
                 let xy = select(vec2<f32>(row, col), vec2<f32>(col, row), x_major);
                 let texel = l * res * res + u32(xy.y) * res + u32(xy.x);
-                // A plain load first (see dom.rs): skips most atomics.
+                // test_first: a plain load first (see dom.rs), which skips
+                // most atomics.
                 let bits = bitcast<u32>(z);
-                if bits < atomicLoad(&dom_depth[texel]) {
+                if dom_params.test_first == 0u || bits < atomicLoad(&dom_depth[texel]) {
                     atomicMin(&dom_depth[texel], bits);
                 }
             }

@@ -373,6 +373,16 @@ pub const VARIANTS: &[Variant] = &[
         raster: &["raster"],
         ceiling: "atomic_min64",
     },
+    // Ours: the first-hit map's atomicMin without the plain load before it
+    // (passes/src/lipp/dom.rs, `test_first`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, every deep opacity map texel an atomicMin",
+        graph: LIPP,
+        overrides: &["dom_depth.test_first=false"],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+    },
     // Ours: every tap of the window, not only the band along the tangent
     // (passes/src/lipp/filter.rs, `band`).
     Variant {

@@ -81,6 +81,10 @@ pub struct DomParams {
     /// Ours: `dom_opacity` walks the points `dom_depth` assembled rather
     /// than assemble each strand again (set it on both passes).
     pub shared_points: bool,
+    /// `dom_depth` only: a plain load of the texel before its atomicMin,
+    /// which most strand texels behind the first hit then skip; off, every
+    /// texel an atomicMin whose result nobody waits for.
+    pub test_first: bool,
 }
 
 impl Default for DomParams {
@@ -94,6 +98,7 @@ impl Default for DomParams {
             cooperative_assembly: true,
             styling: true,
             shared_points: true,
+            test_first: true,
         }
     }
 }
@@ -124,7 +129,7 @@ crate::gpu_block! {
         styling: u32,
         bundles: u32,
         shared_points: u32,
-        _pad0: u32,
+        test_first: u32,
         _pad1: u32,
         _pad2: u32,
     }
@@ -143,6 +148,7 @@ impl DomParams {
             styling: flag(self.styling),
             bundles: count(q.bundles),
             shared_points: flag(self.shared_points),
+            test_first: flag(self.test_first),
             ..Default::default()
         }
     }
@@ -401,11 +407,15 @@ impl DomKernel {
         }
         match self.stage {
             Stage::Depth => {
-                // A plain load first: most strand texels lie behind the
-                // current first hit, and skipping their atomics cuts the
-                // contention on the small map (a standard atomicMin filter).
+                // Ours, `test_first`: a plain load first. Most strand texels
+                // lie behind the current first hit, and skipping their
+                // atomics cuts the contention on the small map (a standard
+                // atomicMin filter); but the lane then waits for the load,
+                // where an atomicMin alone is fire-and-forget. On the H200
+                // neither wins everywhere (README, "Lipp: the maps' lanes,
+                // two changes not kept and one switch").
                 let bits = z.to_bits();
-                if bits < maps.0.load(texel) {
+                if !self.p.test_first || bits < maps.0.load(texel) {
                     maps.0.fetch_min(texel, bits);
                 }
             }
