@@ -39,10 +39,12 @@ export XDG_RUNTIME_DIR="${XDG_RUNTIME_DIR:-/tmp}"
 cargo fmt --all -- --check
 cargo test --workspace --release --locked
 # The Table-1 bench on every backend that opens here (cpu, and wgpu and
-# ash on lavapipe): 320x180, 2 frames per cell. The binary `cargo test`
-# built for the CLI tests (`cargo run` would rebuild the workspace with
-# the root package's features alone).
-target/release/strandgraph bench --quick --backend all
+# ash on lavapipe): 320x180, 2 frames per cell, the mid view only. The
+# three views differ only in the camera's distance (which the LOD tests
+# cover) and took 600 s here on 2 cores, the mid view alone 190 s. The
+# binary `cargo test` built for the CLI tests (`cargo run` would rebuild
+# the workspace with the root package's features alone).
+target/release/strandgraph bench --quick --backend all scenes/distances/mid.ron
 # Benches report, they do not assert; --quick keeps this to seconds.
 cargo bench --locked --bench graph_compile -- --quick
 # An installed binary renders from any directory: `cargo install` into a
