@@ -413,7 +413,7 @@ impl DomKernel {
                 // atomicMin filter); but the lane then waits for the load,
                 // where an atomicMin alone is fire-and-forget. On the H200
                 // neither wins everywhere (README, "Lipp: the maps' lanes,
-                // two changes not kept and one switch").
+                // what did not pay, and one switch").
                 let bits = z.to_bits();
                 if !self.p.test_first || bits < maps.0.load(texel) {
                     maps.0.fetch_min(texel, bits);
