@@ -14,7 +14,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strandgraph::frame::prepare;
-use strandgraph::runner::{self, Backend, CpuOptions, frame_millis};
+use strandgraph::runner::{self, Backend, OpenOptions, frame_millis};
 
 const PIPELINES: [(&str, &str); 2] = [
     ("kulikov", "scenes/graphs/kulikov.ron"),
@@ -40,7 +40,7 @@ fn frame_benches(c: &mut Criterion) {
             for backend in [Backend::Cpu, Backend::Wgpu, Backend::Ash] {
                 let id = format!("{}/{pipeline}/{view}", backend.name());
                 let mut runner =
-                    match runner::open(backend, &p.plan, &p.instance, CpuOptions::default()) {
+                    match runner::open(backend, &p.plan, &p.instance, OpenOptions::default()) {
                         Ok(r) => r,
                         Err(e) => {
                             eprintln!("frame/{id}: skipped: {e}");

@@ -9,7 +9,7 @@ mod common;
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::time::Duration;
 use strandgraph::frame::{override_param, prepare};
-use strandgraph::runner::{self, Backend, CpuOptions};
+use strandgraph::runner::{self, Backend, OpenOptions};
 
 const SWITCHES: [(&str, &[&str]); 3] = [
     ("all_optimisations", &[]),
@@ -31,7 +31,7 @@ fn raster_benches(c: &mut Criterion) {
         for o in overrides {
             override_param(&mut plan, o).unwrap_or_else(|e| panic!("{e:?}"));
         }
-        let mut runner = runner::open(Backend::Cpu, &plan, &p.instance, CpuOptions::default())
+        let mut runner = runner::open(Backend::Cpu, &plan, &p.instance, OpenOptions::default())
             .unwrap_or_else(|e| panic!("{e:?}"));
         group.bench_function(name, |b| {
             b.iter_custom(|iters| {

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
 use strandgraph::images::{Picture, main_picture};
-use strandgraph::runner::{self, Backend, Clock, CpuOptions, PassTime, Session, frame_millis};
+use strandgraph::runner::{self, Backend, Clock, OpenOptions, PassTime, Session, frame_millis};
 use strandgraph::sequence;
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -246,11 +246,11 @@ pub fn run(mut args: Args) -> Result<()> {
             }
         })
         .collect();
-    let cpu = CpuOptions {
+    let cpu = OpenOptions {
         subgroup_width: args.subgroup,
-        ..CpuOptions::default()
+        ..OpenOptions::default()
     };
-    let counting = CpuOptions {
+    let counting = OpenOptions {
         instrument: true,
         ..cpu
     };
@@ -540,7 +540,12 @@ fn variant_plan(p: &Prepared, v: &Variant, extra: &[String]) -> Result<strandgra
 /// configuration, in the unit of the row's ceiling: atomics, or for rows
 /// drawn by the hardware rasterizer (ceiling `fragments`) the fragments
 /// they shade. GPUs expose no such counters, so GPU rows use this count.
-fn count_atomics(p: &Prepared, v: &Variant, extra: &[String], counting: CpuOptions) -> Result<u64> {
+fn count_atomics(
+    p: &Prepared,
+    v: &Variant,
+    extra: &[String],
+    counting: OpenOptions,
+) -> Result<u64> {
     let plan = variant_plan(p, v, extra)?;
     let mut counter = runner::open(Backend::Cpu, &plan, &p.instance, counting)?;
     let fragments = v.ceiling == "fragments";
@@ -568,11 +573,15 @@ fn measure(
     p: &Prepared,
     v: &Variant,
     args: &Args,
-    cpu: CpuOptions,
+    cpu: OpenOptions,
     atomics: u64,
     animation: Option<&[Upload]>,
 ) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
+    let cpu = OpenOptions {
+        loop_bounding: v.loop_bounding,
+        ..cpu
+    };
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
     // A still scene: a game's frames at 60 fps, the simulation stepping.
     let still = [sequence::running(&p.upload, FPS)];
@@ -626,8 +635,8 @@ fn roofline(
     backend: Backend,
     first: &Prepared,
     args: &Args,
-    cpu: CpuOptions,
-    counting: CpuOptions,
+    cpu: OpenOptions,
+    counting: OpenOptions,
 ) -> Result<Roofline> {
     let plan = strandgraph_graph::compile_file(&locate(ROOFLINE), &Registry, 1)?;
     let instance = plan.instantiate(&first.upload.quantities)?;

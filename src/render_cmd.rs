@@ -8,7 +8,7 @@ use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{
     Display, Tonemap, coverage, depth_to_view, motion_image, to_linear, to_picture,
 };
-use strandgraph::runner::{self, CpuOptions, PassTime, frame_millis};
+use strandgraph::runner::{self, OpenOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
 use strandgraph_passes::backend::Clock;
 
@@ -76,6 +76,10 @@ pub struct Args {
     /// Give every transient its own memory instead of the plan's aliasing.
     #[arg(long)]
     pub no_alias: bool,
+    /// Compile the GPU backends' shaders with naga's forced loop bounding
+    /// (a counter in every loop; off by default, docs/architecture.md).
+    #[arg(long)]
+    pub loop_bounding: bool,
     /// The display transform of PNG outputs (EXR stays scene-linear).
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: Tonemap,
@@ -134,10 +138,11 @@ pub fn run(args: Args) -> Result<()> {
         Backend::Ash => &[runner::Backend::Ash],
         Backend::All => &runner::Backend::ALL,
     };
-    let options = CpuOptions {
+    let options = OpenOptions {
         subgroup_width: args.subgroup,
         instrument: args.instrument,
         alias: !args.no_alias,
+        loop_bounding: args.loop_bounding,
     };
     let mut all = Vec::new();
     for (i, &backend) in chosen.iter().enumerate() {

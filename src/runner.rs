@@ -44,23 +44,29 @@ impl Backend {
     }
 }
 
-/// How to open a backend: what the CPU simulator, and aliasing, need.
+/// How to open a backend: what the CPU simulator, aliasing and the GPU
+/// backends' shader translation need.
 #[derive(Debug, Clone, Copy)]
-pub struct CpuOptions {
+pub struct OpenOptions {
+    /// The CPU simulator's subgroup width.
     pub subgroup_width: u32,
-    /// Count atomics, active lanes and pixels per pass (slower).
+    /// Count atomics, active lanes and pixels per pass (CPU, slower).
     pub instrument: bool,
     /// Place transients at the plan's aliasing offsets (cpu, ash; wgpu
     /// cannot alias); off gives every transient its own memory.
     pub alias: bool,
+    /// naga's forced loop bounding in the GPU backends' shaders
+    /// (`strandgraph_ash::AshBackend::loop_bounding`); off by default.
+    pub loop_bounding: bool,
 }
 
-impl Default for CpuOptions {
+impl Default for OpenOptions {
     fn default() -> Self {
         Self {
             subgroup_width: 32,
             instrument: false,
             alias: true,
+            loop_bounding: false,
         }
     }
 }
@@ -71,7 +77,7 @@ pub fn open(
     backend: Backend,
     plan: &Plan,
     instance: &Instance,
-    options: CpuOptions,
+    options: OpenOptions,
 ) -> Result<Box<dyn Session>> {
     Ok(match backend {
         Backend::Cpu => {
@@ -88,19 +94,22 @@ pub fn open(
             // process; hold it loaded (strandgraph_ash::keep_driver_loaded
             // says why). Without a loader wgpu reports its own error.
             let _ = strandgraph_ash::keep_driver_loaded();
-            let session = strandgraph_wgpu::WgpuBackend::default()
-                .open(&Registry, plan, instance)
-                .map_err(|e| match e {
-                    strandgraph_wgpu::WgpuError::MissingFeature { .. } => {
-                        Unsupported(e.to_string()).into()
-                    }
-                    e => miette::Report::from_err(e),
-                })?;
+            let b = strandgraph_wgpu::WgpuBackend {
+                loop_bounding: options.loop_bounding,
+                ..Default::default()
+            };
+            let session = b.open(&Registry, plan, instance).map_err(|e| match e {
+                strandgraph_wgpu::WgpuError::MissingFeature { .. } => {
+                    Unsupported(e.to_string()).into()
+                }
+                e => miette::Report::from_err(e),
+            })?;
             Box::new(session)
         }
         Backend::Ash => {
             let b = strandgraph_ash::AshBackend {
                 alias: options.alias,
+                loop_bounding: options.loop_bounding,
                 ..Default::default()
             };
             Box::new(b.open(plan, instance).map_err(|e| match e {

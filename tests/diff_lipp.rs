@@ -27,7 +27,7 @@ use strandgraph_passes::lipp::tiles::{filter_groups, filter_lanes};
 use strandgraph_passes::lipp::{ARGS_BUNDLES_HI, ARGS_BUNDLES_LO};
 
 mod common;
-use common::{ash, check_flip, cpu, out_dir, read_ash, root, wgpu};
+use common::{ash, ash_with, check_flip, cpu, out_dir, read_ash, root, wgpu, wgpu_with};
 
 const W: u32 = 200;
 const H: u32 = 120;
@@ -465,4 +465,54 @@ fn the_maps_are_the_same_whether_depth_tests_before_its_atomic() {
     let (d, l) = maps(&mut p, false);
     assert!(d == depth, "the depth maps differ");
     assert!(l == layers, "the opacity maps differ");
+}
+
+/// naga's forced loop bounding (off by default, runner::OpenOptions::
+/// loop_bounding) adds a counter to every loop and changes nothing else:
+/// the LOD, the maps and the picture are the same bits with it, on ash and
+/// on wgpu. (The G-buffer and the shaded records are defined only inside
+/// the groom's rectangle, lipp::rect; the picture is made of them.)
+#[test]
+fn the_frame_is_the_same_with_naga_s_loop_bounding() {
+    let p = prepare(&small_scene("loop_bounding", false), None, Some((W, H)))
+        .unwrap_or_else(|e| panic!("{e:?}"));
+    let read = [
+        "raster_args",
+        "bundle_lod",
+        "dom_depth",
+        "dom_layers",
+        "output.final",
+    ];
+    let ash_frame = |loop_bounding| {
+        let backend = strandgraph_ash::AshBackend {
+            alias: false,
+            loop_bounding,
+            ..Default::default()
+        };
+        let s = ash_with(&p, backend);
+        read.map(|r| read_ash(&s, r))
+    };
+    let wgpu_frame = |loop_bounding| {
+        let backend = strandgraph_wgpu::WgpuBackend {
+            loop_bounding,
+            ..Default::default()
+        };
+        let f = wgpu_with(&p, backend);
+        read.map(|r| f.read(&p.plan, r).unwrap().unwrap())
+    };
+    for (backend, free, bounded) in [
+        ("ash", ash_frame(false), ash_frame(true)),
+        ("wgpu", wgpu_frame(false), wgpu_frame(true)),
+    ] {
+        assert!(free[0][3] > 0, "{backend}: no strand drawn");
+        let hit = |t: &u32| *t != strandgraph_passes::lipp::dom::NO_HIT;
+        assert!(free[2].iter().any(hit), "{backend}: no strand in the maps");
+        for ((name, a), b) in read.iter().zip(&free).zip(&bounded) {
+            let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
+            assert!(
+                a.len() == b.len() && differ == 0,
+                "{backend} {name}: {differ} words differ with loop bounding"
+            );
+        }
+    }
 }

@@ -11,7 +11,7 @@ mod common;
 use common::{out_dir, root};
 use std::process::Command;
 use strandgraph::frame::prepare_with;
-use strandgraph::runner::{self, Backend, CpuOptions};
+use strandgraph::runner::{self, Backend, OpenOptions};
 use strandgraph::sequence::frame_upload;
 use strandgraph_passes::sim::SimVertex;
 
@@ -52,9 +52,9 @@ fn after_frames(sim: &Simulated, backend: Backend, extra: &[&str], resource: &st
         .collect();
     let graph = root().join(sim.graph);
     let mut p = prepare_with(&scene, Some(&graph), Some((160, 90)), &overrides).unwrap();
-    let options = CpuOptions {
+    let options = OpenOptions {
         alias: false,
-        ..CpuOptions::default()
+        ..OpenOptions::default()
     };
     let mut session = runner::open(backend, &p.plan, &p.instance, options).unwrap_or_else(|e| {
         panic!(

@@ -15,7 +15,7 @@ pub mod rules;
 pub mod summary;
 
 use crate::frame::Prepared;
-use crate::runner::{self, Backend, CpuOptions};
+use crate::runner::{self, Backend, OpenOptions};
 use compare::{Outcome, compare};
 use miette::{IntoDiagnostic, Result};
 use serde::Serialize;
@@ -116,7 +116,7 @@ pub fn check_pass(
     };
     let outputs: Vec<&isolate::Port> = alone.ports.iter().filter(|p| p.mode.writes()).collect();
     let run = |backend: Backend| -> Result<Vec<Vec<u32>>> {
-        let mut session = runner::open(backend, &alone.plan, &instance, CpuOptions::default())?;
+        let mut session = runner::open(backend, &alone.plan, &instance, OpenOptions::default())?;
         session.run(&inputs)?;
         outputs
             .iter()

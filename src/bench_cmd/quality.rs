@@ -20,7 +20,7 @@ use std::path::Path;
 use strandgraph::compare::{ImageDiff, Temporal, coverage_error, flip, temporal};
 use strandgraph::frame::override_param;
 use strandgraph::images::{Display, Picture, main_picture};
-use strandgraph::runner::{self, Backend, CpuOptions};
+use strandgraph::runner::{self, Backend, OpenOptions};
 use strandgraph::sequence;
 
 /// The ground truth a pipeline's rows are measured against, if it has one.
@@ -73,7 +73,7 @@ pub struct Setup<'a> {
     pub scene: &'a Path,
     pub size: Option<(u32, u32)>,
     pub quick: bool,
-    pub cpu: CpuOptions,
+    pub cpu: OpenOptions,
     /// The row's untimed and timed frames (an animated scene's reference
     /// runs as many).
     pub warmup: usize,

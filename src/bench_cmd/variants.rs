@@ -15,6 +15,9 @@ pub struct Variant {
     pub raster: &'static [&'static str],
     /// The roofline pass whose rate is the raster's ceiling.
     pub ceiling: &'static str,
+    /// The GPU backends' shaders with naga's forced loop bounding
+    /// (`runner::OpenOptions::loop_bounding`, off in every other row).
+    pub loop_bounding: bool,
 }
 
 const KULIKOV: &str = "scenes/graphs/kulikov.ron";
@@ -30,6 +33,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -39,6 +43,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -53,6 +58,18 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
+    },
+    // Ours off: every shader compiled with naga's loop counters, as wgpu
+    // compiles an untrusted shader (runner::OpenOptions::loop_bounding).
+    Variant {
+        pipeline: "Kulikov",
+        name: "naga's loop bounding",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+        loop_bounding: true,
     },
     Variant {
         pipeline: "Kulikov",
@@ -61,6 +78,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.loop_flattening=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -74,6 +92,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -82,6 +101,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -90,6 +110,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.last_layer_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -98,6 +119,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.analytic_coverage=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Ours, not the talk's: each compose workgroup skips models whose tiles
     // cannot reach its pixels (passes/src/kulikov/compose/mod.rs).
@@ -108,6 +130,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.workgroup_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Ours, shipped off because it measured slower: head triangles with
     // boxes over 64 pixels rasterized by the whole workgroup
@@ -119,6 +142,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["visibility.cooperative_above=64"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Ours: each skin-shadow workgroup marches only the density grids its
     // rays can reach (passes/src/kulikov/skin_shadow/tile.rs).
@@ -129,6 +153,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["skin_shadow.tile_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Ours: the sort's scatter issues one atomicAdd per subgroup and
     // bucket (passes/src/kulikov/sort.rs).
@@ -139,6 +164,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.wave_aggregated_atomics=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Ours: the shading sort reads a word of visibility bits per lane, not
     // one bit (passes/src/kulikov/shade_sort.rs).
@@ -149,6 +175,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade_sort.word_per_lane=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Quality ablations of the talk's composition (their FLIP against the
     // reference is the point; the raster still writes three layers):
@@ -162,6 +189,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.layers=1"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -170,6 +198,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.coverage_fit=\"Exponential\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Kulikov",
@@ -178,6 +207,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.reconstruct_missing=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
+        loop_bounding: false,
     },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
@@ -195,6 +225,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -203,6 +234,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // The filter without §3.3.2's strand connection: conservative-only
     // pixels are not promoted and no flyaway is overlaid (the bilateral
@@ -220,6 +252,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // The filter's opacity as the paper estimates it: the coverage of the
     // centre test's half-pixel lines, not of the groom's strands
@@ -235,6 +268,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -243,6 +277,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -251,6 +286,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Every groom's bundles simulated (sim.pbd_chains, passes/src/sim/chains.rs).
     Variant {
@@ -260,6 +296,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Ours, each switched off in turn on the published configuration
     // (passes/src/lipp/raster.rs).
@@ -270,6 +307,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.segment_payload=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -278,6 +316,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.occlusion_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -286,6 +325,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.strip_rounds=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // C_max points however fine the groom (passes/src/lipp/lod/mod.rs,
     // `groom_resolution`), in the camera's view and the maps'.
@@ -299,6 +339,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
     // (passes/src/lipp/lod/mod.rs).
@@ -309,6 +350,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.view=\"Camera\"", "shadow_lod.lambda=1.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -317,6 +359,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.camera_bound=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Every conservative sample shaded, not only where lipp.filter reads
     // its colour (passes/src/lipp/shade.rs, `read_layers_only`).
@@ -327,6 +370,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.read_layers_only=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // lipp.filter over every tile lipp.shade ran rather than the tiles with
     // hair it lists (passes/src/lipp/tiles.rs): the tiles in the groom's
@@ -338,6 +382,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.hair_tiles=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // lipp.filter with a lane a pixel rather than two or more, each taking
     // every other row of the window (passes/src/lipp/filter.rs, `lanes`).
@@ -348,6 +393,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.lanes=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Ours off: lipp.filter's dispatch a workgroup a tile, two lanes a pixel
     // however few the tiles (passes/src/lipp/tiles.rs, `filter_lane_budget`).
@@ -358,6 +404,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.filter_lane_budget=0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Ours off: lipp.dom_opacity assembles every strand again rather than
     // walk the points lipp.dom_depth kept (passes/src/lipp/dom.rs,
@@ -372,6 +419,18 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
+    },
+    // Ours off: every shader compiled with naga's loop counters, as wgpu
+    // compiles an untrusted shader (runner::OpenOptions::loop_bounding).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, naga's loop bounding",
+        graph: LIPP,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+        loop_bounding: true,
     },
     // Ours: the first-hit map's atomicMin without the plain load before it
     // (passes/src/lipp/dom.rs, `test_first`).
@@ -382,6 +441,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["dom_depth.test_first=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Ours: every tap of the window, not only the band along the tangent
     // (passes/src/lipp/filter.rs, `band`).
@@ -392,6 +452,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.band=0.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // lipp.shade over every pixel, as the paper's deferred shading, and
     // lipp.clear_gbuffer over the whole G-buffer, rather than the groom's
@@ -403,6 +464,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.groom_rect=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // lipp.clear_gbuffer a workgroup per run of 64 pixels, as lipp.shade is
     // dispatched, rather than a block of lod_scan's clear_runs runs
@@ -414,6 +476,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.clear_runs=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // The window of Lipp's Fig. 5 ("a single 7 × 7 kernel pass"), where
     // §3.3.1 says r = 5 (the default) and Code 2 r = 7.
@@ -424,6 +487,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.radius=3"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Without the camera's LOD but with the maps' own (ours): SWR 1 and
     // SWR 1+F with their deep opacity maps built like SWR 1+F+L's. The rows
@@ -439,6 +503,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -447,6 +512,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // A filter tap reading both G-buffer layers, then its colour, rather
     // than the neighbour's 8-byte record (passes/src/lipp/shaded.rs).
@@ -457,6 +523,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.packed_taps=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -470,6 +537,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -483,6 +551,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -496,6 +565,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -504,6 +574,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=2", "filter.msaa=2"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -512,6 +583,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=4", "filter.msaa=4"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Lipp",
@@ -520,6 +592,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=8", "filter.msaa=8"],
         raster: &["raster"],
         ceiling: "atomic_min64",
+        loop_bounding: false,
     },
     // Scheuermann 2004's optimized scheme as published (Z primed), and its
     // unoptimized "Sorted Hair Rendering Scheme" (the opaque pass alpha tests
@@ -531,6 +604,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "Scheuermann",
@@ -539,6 +613,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["prime_depth.enabled=false", "opaque_hair.primed=false"],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     // Lipp's Table 1 baseline: the same strands through the hardware
     // rasterizer (scenes/graphs/hw_strands.ron), MSAA 1/4/8 without and
@@ -556,6 +631,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW strands",
@@ -569,6 +645,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW strands",
@@ -582,6 +659,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW strands",
@@ -590,6 +668,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW strands",
@@ -598,6 +677,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW strands",
@@ -606,6 +686,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
+        loop_bounding: false,
     },
     // The same quads from mesh shaders (scenes/graphs/hw_mesh.ron): a task
     // workgroup per bundle applying the LOD, strands assembled in mesh
@@ -623,6 +704,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW mesh",
@@ -636,6 +718,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW mesh",
@@ -649,6 +732,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW mesh",
@@ -657,6 +741,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW mesh",
@@ -665,6 +750,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
     Variant {
         pipeline: "HW mesh",
@@ -673,6 +759,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &["mesh"],
         ceiling: "fragments",
+        loop_bounding: false,
     },
 ];
 

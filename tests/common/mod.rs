@@ -24,10 +24,20 @@ pub fn out_dir(test: &str) -> PathBuf {
 /// One frame on ash under the Khronos layer with synchronization
 /// validation (any message fails it); no device or no layer is a failure.
 pub fn ash(p: &Prepared, alias: bool) -> Session {
+    ash_with(
+        p,
+        AshBackend {
+            alias,
+            ..AshBackend::default()
+        },
+    )
+}
+
+/// [`ash`] with `backend`'s other settings (validation is always on).
+pub fn ash_with(p: &Prepared, backend: AshBackend) -> Session {
     let backend = AshBackend {
         validation: Validation::Sync,
-        alias,
-        ..AshBackend::default()
+        ..backend
     };
     let (session, frame) = backend
         .execute(&p.plan, &p.instance, &p.upload)
@@ -58,7 +68,12 @@ pub fn cpu(p: &Prepared, subgroup_width: u32) -> strandgraph_cpu::Frame<'static>
 
 /// One frame on wgpu; no adapter is a failure.
 pub fn wgpu(p: &Prepared) -> strandgraph_wgpu::Frame {
-    strandgraph_wgpu::WgpuBackend::default()
+    wgpu_with(p, strandgraph_wgpu::WgpuBackend::default())
+}
+
+/// [`wgpu`] with `backend`'s settings.
+pub fn wgpu_with(p: &Prepared, backend: strandgraph_wgpu::WgpuBackend) -> strandgraph_wgpu::Frame {
+    backend
         .execute(&p.plan, &p.instance, &p.upload)
         .unwrap_or_else(|e| {
             panic!(

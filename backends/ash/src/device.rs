@@ -58,6 +58,8 @@ pub(crate) struct Gpu {
     /// workgroup memory is the driver's job (as wgpu-hal does on 1.3),
     /// not a loop naga adds to every shader.
     pub zero_init_native: bool,
+    /// [`crate::AshBackend::loop_bounding`].
+    pub loop_bounding: bool,
     /// VK_EXT_mesh_shader's commands, where a pass draws with mesh shaders.
     pub mesh: Option<ext::mesh_shader::Device>,
     /// `maxTaskWorkGroupCount[0]` (0 without VK_EXT_mesh_shader).
@@ -280,6 +282,15 @@ fn create_device(
 }
 
 impl Gpu {
+    /// What the backend's SPIR-V is written for on this device.
+    pub(crate) fn spirv_target(&self) -> crate::spirv::Target<'_> {
+        crate::spirv::Target {
+            caps: &self.spirv_caps,
+            zero_init_native: self.zero_init_native,
+            loop_bounding: self.loop_bounding,
+        }
+    }
+
     pub fn new(backend: &AshBackend, needs: &Needs) -> Result<Gpu, AshError> {
         // Best effort: where it fails, the instance below says why.
         let _ = crate::loader::keep_driver_loaded();
@@ -332,6 +343,7 @@ impl Gpu {
             enabled: want.names,
             spirv_caps: want.spirv_caps,
             zero_init_native: want.zero_init_workgroup_memory,
+            loop_bounding: backend.loop_bounding,
             mesh,
             max_task_groups: have.max_task_groups,
             stats,

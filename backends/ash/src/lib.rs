@@ -146,6 +146,15 @@ pub struct AshBackend {
     pub device_name: Option<String>,
     /// By default from `$STRANDGRAPH_ASH_SUBMIT` ([`Submit::from_env`]).
     pub submit: Submit,
+    /// naga's forced loop bounding (`spv::Options::force_loop_bounding`,
+    /// on by default in naga, as wgpu does for every shader): a 64-bit
+    /// counter in every loop, so that a driver cannot treat a loop as
+    /// endless and optimise it away. It guards untrusted (web) shaders; ours
+    /// end by construction, and the counters keep NVIDIA's compiler from
+    /// unrolling short loops, whose arrays then live in local memory (docs/
+    /// architecture.md, "Shaders"). Off by default; the bench row "naga's
+    /// loop bounding" turns it on.
+    pub loop_bounding: bool,
 }
 
 impl Default for AshBackend {
@@ -158,6 +167,7 @@ impl Default for AshBackend {
             timeout: Duration::from_secs(60),
             device_name: std::env::var("STRANDGRAPH_VK_DEVICE").ok(),
             submit: Submit::from_env(),
+            loop_bounding: false,
         }
     }
 }

@@ -162,8 +162,7 @@ fn build_pass(
             &prep.composed,
             entries,
             only.copied(),
-            &gpu.spirv_caps,
-            gpu.zero_init_native,
+            gpu.spirv_target(),
             &pass.name,
             &gpu.name,
         )

@@ -20,6 +20,20 @@ pub(crate) struct Spirv {
     pub descriptors: Vec<(u32, vk::DescriptorType)>,
 }
 
+/// What the SPIR-V is written for: the device's capabilities and how naga
+/// writes what WGSL promises beyond SPIR-V.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Target<'a> {
+    /// The capabilities the device's enabled features allow.
+    pub caps: &'a [spv::Capability],
+    /// `shaderZeroInitializeWorkgroupMemory` is enabled (else naga zeroes
+    /// workgroup memory in every entry point).
+    pub zero_init_native: bool,
+    /// naga's forced loop bounding: a counter in every loop that breaks
+    /// out after 2^64 iterations ([`crate::AshBackend::loop_bounding`]).
+    pub loop_bounding: bool,
+}
+
 /// Translates `composed` for the entry points `entries` (compute, or vertex
 /// and fragments), every entry point of the module or `only` that one;
 /// `pass` names the pass in errors.
@@ -27,11 +41,15 @@ pub(crate) fn translate(
     composed: &Composed,
     entries: &[&str],
     only: Option<&str>,
-    caps: &[spv::Capability],
-    zero_init_native: bool,
+    target: Target<'_>,
     pass: &str,
     device: &str,
 ) -> Result<Spirv, AshError> {
+    let Target {
+        caps,
+        zero_init_native,
+        loop_bounding,
+    } = target;
     let module = &composed.module;
     let info = validate(module, all_capabilities())
         .map_err(|e| AshError::Shader(format!("pass `{pass}`: {e}")))?;
@@ -103,6 +121,7 @@ pub(crate) fn translate(
         } else {
             spv::ZeroInitializeWorkgroupMemoryMode::Polyfill
         },
+        force_loop_bounding: loop_bounding,
         ..Default::default()
     };
     let pipeline = only
@@ -191,6 +210,15 @@ mod tests {
     use super::*;
     use strandgraph_passes::wgsl::Shaders;
 
+    /// `caps`, naga's polyfill for zeroed workgroup memory, no loop bounding.
+    fn plain(caps: &[spv::Capability]) -> Target<'_> {
+        Target {
+            caps,
+            zero_init_native: false,
+            loop_bounding: false,
+        }
+    }
+
     #[test]
     fn clear_translates_with_a_uniform_and_a_storage_buffer() {
         let mut shaders = Shaders::embedded().unwrap();
@@ -200,8 +228,7 @@ mod tests {
             &composed,
             &[&entry],
             None,
-            &[spv::Capability::Shader],
-            false,
+            plain(&[spv::Capability::Shader]),
             "clear",
             "test",
         )
@@ -216,15 +243,43 @@ mod tests {
         );
     }
 
+    #[test]
+    fn loop_bounding_adds_naga_s_counter_to_each_loop() {
+        let mut shaders = Shaders::embedded().unwrap();
+        let composed = shaders.compose("sim/follow.wgsl").unwrap();
+        let caps = [spv::Capability::Shader];
+        let words = |loop_bounding| {
+            let target = Target {
+                loop_bounding,
+                ..plain(&caps)
+            };
+            translate(&composed, &["follow"], None, target, "follow", "test")
+                .unwrap()
+                .words
+        };
+        let (bounded, free) = (words(true), words(false));
+        // OpLoopMerge (opcode 246): the same loops either way.
+        let loops = |w: &[u32]| opcodes(w).filter(|&op| op == 246).count();
+        assert!(loops(&free) > 0);
+        assert_eq!(loops(&bounded), loops(&free));
+        // OpVariable (59): the counter, one per loop.
+        let vars = |w: &[u32]| opcodes(w).filter(|&op| op == 59).count();
+        assert_eq!(vars(&bounded), vars(&free) + loops(&free));
+    }
+
+    /// The opcode of every instruction after the header.
+    fn opcodes(words: &[u32]) -> impl Iterator<Item = u32> + '_ {
+        let mut i = 5;
+        std::iter::from_fn(move || {
+            let w = *words.get(i)?;
+            i += ((w >> 16) as usize).max(1);
+            Some(w & 0xFFFF)
+        })
+    }
+
     /// `OpEntryPoint` (opcode 15) instructions in a module.
     fn entry_points(words: &[u32]) -> usize {
-        let mut i = 5;
-        let mut n = 0;
-        while i < words.len() && words[i] >> 16 != 0 {
-            n += usize::from(words[i] & 0xFFFF == 15);
-            i += (words[i] >> 16) as usize;
-        }
-        n
+        opcodes(words).filter(|&op| op == 15).count()
     }
 
     #[test]
@@ -247,8 +302,7 @@ mod tests {
             &composed,
             &["ms_main", "ts_main", "fs_main"],
             None,
-            &caps,
-            false,
+            plain(&caps),
             "mesh",
             "test",
         )
@@ -256,7 +310,7 @@ mod tests {
         assert_eq!(s.words[1], 0x0001_0400, "SPIR-V 1.4");
         // One entry point per module, as the backend builds mesh pipelines.
         for e in ["ms_main", "ts_main", "fs_main"] {
-            let one = translate(&composed, &[e], Some(e), &caps, true, "mesh", "test").unwrap();
+            let one = translate(&composed, &[e], Some(e), plain(&caps), "mesh", "test").unwrap();
             assert_eq!(entry_points(&one.words), 1, "{e}");
         }
         assert!(declared_capabilities(&s.words).contains(&(C::MeshShadingEXT as u32)));
@@ -269,8 +323,7 @@ mod tests {
             &composed,
             &["ms_main"],
             Some("ms_main"),
-            &without,
-            false,
+            plain(&without),
             "mesh",
             "test",
         )
@@ -293,8 +346,7 @@ mod tests {
             &composed,
             &[&entry],
             None,
-            &[spv::Capability::Shader],
-            false,
+            plain(&[spv::Capability::Shader]),
             "lod",
             "test",
         )

@@ -87,6 +87,11 @@ pub struct WgpuBackend {
     pub shader_dir: Option<PathBuf>,
     /// Which wgpu backends to look for an adapter on (Vulkan by default).
     pub backends: wgpu::Backends,
+    /// naga's forced loop bounding, which wgpu adds to every shader unless
+    /// it is created trusted (`ShaderRuntimeChecks::force_loop_bounding`):
+    /// the same switch as the ash backend's `AshBackend::loop_bounding`,
+    /// off by default for the same reason.
+    pub loop_bounding: bool,
 }
 
 impl Default for WgpuBackend {
@@ -94,6 +99,7 @@ impl Default for WgpuBackend {
         Self {
             shader_dir: strandgraph_passes::wgsl::override_dir(),
             backends: wgpu::Backends::VULKAN,
+            loop_bounding: false,
         }
     }
 }
@@ -159,6 +165,8 @@ struct Prepared<'d> {
     composed: Composed,
     /// The draw state, for raster passes.
     raster: Option<strandgraph_passes::RasterState>,
+    /// [`WgpuBackend::loop_bounding`].
+    loop_bounding: bool,
 }
 
 fn read_only_storage_texture_needs(module: &naga::Module) -> Option<naga::StorageFormat> {

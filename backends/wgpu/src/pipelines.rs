@@ -90,10 +90,18 @@ impl<'a> PassContext<'a> {
         prep: &'a Prepared<'a>,
         memory: &'a [Option<Memory>],
     ) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let desc = wgpu::ShaderModuleDescriptor {
             label: Some(prep.def.shader().file),
             source: wgpu::ShaderSource::Naga(Cow::Owned(prep.composed.module.clone())),
-        });
+        };
+        let checks = wgpu::ShaderRuntimeChecks {
+            force_loop_bounding: prep.loop_bounding,
+            ..wgpu::ShaderRuntimeChecks::checked()
+        };
+        // SAFETY: every check but loop bounding stays on, and without it
+        // the caller must ensure no loop is endless: our shaders' loops end
+        // by construction (WgpuBackend::loop_bounding).
+        let module = unsafe { device.create_shader_module_trusted(desc, checks) };
         let views = prep
             .bindings
             .iter()

@@ -59,6 +59,7 @@ pub(crate) fn prepare<'d>(
             entry,
             composed,
             raster,
+            loop_bounding: true, // WgpuBackend::prepare sets the backend's
         });
     }
     Ok(out)

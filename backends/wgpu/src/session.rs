@@ -87,7 +87,11 @@ impl WgpuBackend {
         instance: &Instance,
     ) -> Result<Vec<Prepared<'static>>, WgpuError> {
         let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
-        prepare(defs, plan, instance, &mut shaders)
+        let mut prepared = prepare(defs, plan, instance, &mut shaders)?;
+        for p in &mut prepared {
+            p.loop_bounding = self.loop_bounding;
+        }
+        Ok(prepared)
     }
 }
 
