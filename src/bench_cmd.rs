@@ -103,6 +103,10 @@ pub struct Args {
     /// overrides, as PASS.PARAM=VALUE (repeatable); the report notes it.
     #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
     pub params: Vec<String>,
+    /// Compile every row's GPU shaders with naga's forced loop bounding
+    /// (docs/architecture.md, "Shaders"); the report notes it.
+    #[arg(long)]
+    pub loop_bounding: bool,
 }
 
 /// `rel` under the working directory, else under the checkout the binary
@@ -258,6 +262,9 @@ pub fn run(mut args: Args) -> Result<()> {
     let mut report = Report::new(&args, &scenes);
     for spec in &args.params {
         report.note(format!("--param {spec} on every row"));
+    }
+    if args.loop_bounding {
+        report.note("--loop-bounding: naga's loop counters in every row's GPU shaders".into());
     }
     if args.quick {
         report.note(format!(
@@ -579,7 +586,7 @@ fn measure(
 ) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let cpu = OpenOptions {
-        loop_bounding: v.loop_bounding,
+        loop_bounding: v.loop_bounding || args.loop_bounding,
         ..cpu
     };
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
