@@ -53,6 +53,9 @@ pub struct Pass {
     /// Accesses written `"resource as name"`: the kernel binds `resource`
     /// under `name` (one pass kind used on two sets of resources).
     pub bind_as: Vec<(ResourceId, String)>,
+    /// Keep naga's loop counters in this pass's shader
+    /// ([`crate::schema::PassDecl::loop_bounding`]).
+    pub loop_bounding: bool,
 }
 
 impl Pass {
@@ -193,6 +196,7 @@ pub fn resolve(
             accesses,
             span,
             repeat: decl.repeat,
+            loop_bounding: decl.loop_bounding,
             model_index: None,
             bind_as,
         });

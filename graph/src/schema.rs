@@ -267,6 +267,11 @@ pub struct PassDecl {
     /// Run this pass once per hair model (see [`Repeat`]).
     #[serde(default)]
     pub repeat: Repeat,
+    /// Compile this pass's shader with naga's loop counters even where the
+    /// backend leaves them out (docs/architecture.md, "Shaders"): a kernel
+    /// whose loops the driver unrolls into more registers than they save.
+    #[serde(default)]
+    pub loop_bounding: bool,
 }
 
 /// How often a pass runs per frame.

@@ -475,6 +475,29 @@ fn a_capped_size_grows_with_the_scene_up_to_its_cap() {
 }
 
 #[test]
+fn a_pass_keeps_naga_s_loop_counters_where_it_says_so() {
+    let src = r#"Graph(
+    name: "g",
+    resources: [
+        Buffer(name: "a", size: Bytes(16)),
+        Buffer(name: "out", size: Bytes(16), lifetime: Imported),
+    ],
+    passes: [
+        Pass(name: "make", kind: "test.produce", writes: ["a"], loop_bounding: true),
+        Pass(name: "use", kind: "test.consume", reads: ["a"], writes: ["out"]),
+    ],
+    outputs: ["out"],
+)"#;
+    let plan = compile_str("loops.ron", src, &registry(), 1).unwrap();
+    let kept = |name: &str| {
+        let p = plan.graph.passes.iter().find(|p| p.name == name).unwrap();
+        p.loop_bounding
+    };
+    assert!(kept("make"));
+    assert!(!kept("use"));
+}
+
+#[test]
 fn several_errors_are_reported_together() {
     let src = r#"Graph(
     name: "g",

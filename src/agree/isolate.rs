@@ -79,6 +79,7 @@ pub fn isolate(plan: &Plan, p: PassId) -> Result<Isolated> {
             writes,
             atomics,
             repeat: Repeat::Once,
+            loop_bounding: pass.loop_bounding,
         }],
         outputs: ports
             .iter()

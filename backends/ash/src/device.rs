@@ -282,12 +282,13 @@ fn create_device(
 }
 
 impl Gpu {
-    /// What the backend's SPIR-V is written for on this device.
-    pub(crate) fn spirv_target(&self) -> crate::spirv::Target<'_> {
+    /// What the backend's SPIR-V is written for on this device, for a pass
+    /// that keeps naga's loop counters or not (its graph's `loop_bounding`).
+    pub(crate) fn spirv_target(&self, pass_loop_bounding: bool) -> crate::spirv::Target<'_> {
         crate::spirv::Target {
             caps: &self.spirv_caps,
             zero_init_native: self.zero_init_native,
-            loop_bounding: self.loop_bounding,
+            loop_bounding: self.loop_bounding || pass_loop_bounding,
         }
     }
 

@@ -152,8 +152,9 @@ pub struct AshBackend {
     /// endless and optimise it away. It guards untrusted (web) shaders; ours
     /// end by construction, and the counters keep NVIDIA's compiler from
     /// unrolling short loops, whose arrays then live in local memory (docs/
-    /// architecture.md, "Shaders"). Off by default; the bench row "naga's
-    /// loop bounding" turns it on.
+    /// architecture.md, "Shaders"). Off by default, and then a pass keeps
+    /// them where its graph says `loop_bounding: true`; on, every pass has
+    /// them (the bench rows "naga's loop bounding").
     pub loop_bounding: bool,
 }
 

@@ -162,7 +162,7 @@ fn build_pass(
             &prep.composed,
             entries,
             only.copied(),
-            gpu.spirv_target(),
+            gpu.spirv_target(pass.loop_bounding),
             &pass.name,
             &gpu.name,
         )

@@ -90,7 +90,8 @@ pub struct WgpuBackend {
     /// naga's forced loop bounding, which wgpu adds to every shader unless
     /// it is created trusted (`ShaderRuntimeChecks::force_loop_bounding`):
     /// the same switch as the ash backend's `AshBackend::loop_bounding`,
-    /// off by default for the same reason.
+    /// off by default for the same reason (and a pass's graph can keep
+    /// them, `loop_bounding: true`).
     pub loop_bounding: bool,
 }
 
