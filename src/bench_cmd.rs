@@ -24,7 +24,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
 use strandgraph::images::{Picture, main_picture};
-use strandgraph::runner::{self, Backend, Clock, OpenOptions, PassTime, Session, frame_millis};
+use strandgraph::runner::{
+    self, Backend, Clock, LoopCounters, OpenOptions, PassTime, Session, frame_millis,
+};
 use strandgraph::sequence;
 use strandgraph_assets::Scene;
 use strandgraph_graph::schema::Quantity;
@@ -103,10 +105,11 @@ pub struct Args {
     /// overrides, as PASS.PARAM=VALUE (repeatable); the report notes it.
     #[arg(long = "param", value_name = "PASS.PARAM=VALUE")]
     pub params: Vec<String>,
-    /// Compile every row's GPU shaders with naga's forced loop bounding
-    /// (docs/architecture.md, "Shaders"); the report notes it.
-    #[arg(long)]
-    pub loop_bounding: bool,
+    /// Put naga's loop counters in every row's GPU shaders as this says
+    /// (graph, every or none; docs/architecture.md, "Shaders") rather than
+    /// as each row does; the report notes it.
+    #[arg(long, value_parser = clap::value_parser!(LoopCounters))]
+    pub loop_counters: Option<LoopCounters>,
 }
 
 /// `rel` under the working directory, else under the checkout the binary
@@ -263,8 +266,10 @@ pub fn run(mut args: Args) -> Result<()> {
     for spec in &args.params {
         report.note(format!("--param {spec} on every row"));
     }
-    if args.loop_bounding {
-        report.note("--loop-bounding: naga's loop counters in every row's GPU shaders".into());
+    if let Some(c) = args.loop_counters {
+        report.note(format!(
+            "--loop-counters {c} on every row (naga's loop counters)"
+        ));
     }
     if args.quick {
         report.note(format!(
@@ -586,7 +591,7 @@ fn measure(
 ) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let cpu = OpenOptions {
-        loop_bounding: v.loop_bounding || args.loop_bounding,
+        loop_counters: args.loop_counters.unwrap_or(v.loop_counters),
         ..cpu
     };
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;

@@ -8,7 +8,7 @@ use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{
     Display, Tonemap, coverage, depth_to_view, motion_image, to_linear, to_picture,
 };
-use strandgraph::runner::{self, OpenOptions, PassTime, frame_millis};
+use strandgraph::runner::{self, LoopCounters, OpenOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
 use strandgraph_passes::backend::Clock;
 
@@ -76,10 +76,11 @@ pub struct Args {
     /// Give every transient its own memory instead of the plan's aliasing.
     #[arg(long)]
     pub no_alias: bool,
-    /// Compile the GPU backends' shaders with naga's forced loop bounding
-    /// (a counter in every loop; off by default, docs/architecture.md).
-    #[arg(long)]
-    pub loop_bounding: bool,
+    /// Which passes' GPU shaders get naga's loop counters: graph (those
+    /// whose graph keeps them), every or none (docs/architecture.md,
+    /// "Shaders").
+    #[arg(long, default_value = "graph", value_parser = clap::value_parser!(LoopCounters))]
+    pub loop_counters: LoopCounters,
     /// The display transform of PNG outputs (EXR stays scene-linear).
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: Tonemap,
@@ -142,7 +143,7 @@ pub fn run(args: Args) -> Result<()> {
         subgroup_width: args.subgroup,
         instrument: args.instrument,
         alias: !args.no_alias,
-        loop_bounding: args.loop_bounding,
+        loop_counters: args.loop_counters,
     };
     let mut all = Vec::new();
     for (i, &backend) in chosen.iter().enumerate() {

@@ -5,6 +5,7 @@
 
 use miette::{IntoDiagnostic, Result};
 use strandgraph_graph::{Instance, Plan};
+pub use strandgraph_passes::LoopCounters;
 use strandgraph_passes::Registry;
 pub use strandgraph_passes::backend::{BackendError, Clock, PassTime, Session, frame_millis};
 
@@ -55,9 +56,9 @@ pub struct OpenOptions {
     /// Place transients at the plan's aliasing offsets (cpu, ash; wgpu
     /// cannot alias); off gives every transient its own memory.
     pub alias: bool,
-    /// naga's forced loop bounding in the GPU backends' shaders
-    /// (`strandgraph_ash::AshBackend::loop_bounding`); off by default.
-    pub loop_bounding: bool,
+    /// Which passes' GPU shaders get naga's loop counters
+    /// ([`LoopCounters`]; by default those whose graph keeps them).
+    pub loop_counters: LoopCounters,
 }
 
 impl Default for OpenOptions {
@@ -66,7 +67,7 @@ impl Default for OpenOptions {
             subgroup_width: 32,
             instrument: false,
             alias: true,
-            loop_bounding: false,
+            loop_counters: LoopCounters::Graph,
         }
     }
 }
@@ -95,7 +96,7 @@ pub fn open(
             // says why). Without a loader wgpu reports its own error.
             let _ = strandgraph_ash::keep_driver_loaded();
             let b = strandgraph_wgpu::WgpuBackend {
-                loop_bounding: options.loop_bounding,
+                loop_counters: options.loop_counters,
                 ..Default::default()
             };
             let session = b.open(&Registry, plan, instance).map_err(|e| match e {
@@ -109,7 +110,7 @@ pub fn open(
         Backend::Ash => {
             let b = strandgraph_ash::AshBackend {
                 alias: options.alias,
-                loop_bounding: options.loop_bounding,
+                loop_counters: options.loop_counters,
                 ..Default::default()
             };
             Box::new(b.open(plan, instance).map_err(|e| match e {

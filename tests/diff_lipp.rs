@@ -467,14 +467,15 @@ fn the_maps_are_the_same_whether_depth_tests_before_its_atomic() {
     assert!(l == layers, "the opacity maps differ");
 }
 
-/// naga's forced loop bounding (off by default, runner::OpenOptions::
-/// loop_bounding) adds a counter to every loop and changes nothing else:
-/// the LOD, the maps and the picture are the same bits with it, on ash and
-/// on wgpu. (The G-buffer and the shaded records are defined only inside
-/// the groom's rectangle, lipp::rect; the picture is made of them.)
+/// naga's loop counters (passes/src/loop_counters.rs) add a counter to
+/// every loop and change nothing else: the LOD, the maps and the picture are
+/// the same bits in every pass or in none, on ash and on wgpu. (The G-buffer
+/// and the shaded records are defined only inside the groom's rectangle,
+/// lipp::rect; the picture is made of them.)
 #[test]
-fn the_frame_is_the_same_with_naga_s_loop_bounding() {
-    let p = prepare(&small_scene("loop_bounding", false), None, Some((W, H)))
+fn the_frame_is_the_same_with_naga_s_loop_counters() {
+    use strandgraph_passes::LoopCounters;
+    let p = prepare(&small_scene("loop_counters", false), None, Some((W, H)))
         .unwrap_or_else(|e| panic!("{e:?}"));
     let read = [
         "raster_args",
@@ -483,26 +484,27 @@ fn the_frame_is_the_same_with_naga_s_loop_bounding() {
         "dom_layers",
         "output.final",
     ];
-    let ash_frame = |loop_bounding| {
+    let ash_frame = |loop_counters| {
         let backend = strandgraph_ash::AshBackend {
             alias: false,
-            loop_bounding,
+            loop_counters,
             ..Default::default()
         };
         let s = ash_with(&p, backend);
         read.map(|r| read_ash(&s, r))
     };
-    let wgpu_frame = |loop_bounding| {
+    let wgpu_frame = |loop_counters| {
         let backend = strandgraph_wgpu::WgpuBackend {
-            loop_bounding,
+            loop_counters,
             ..Default::default()
         };
         let f = wgpu_with(&p, backend);
         read.map(|r| f.read(&p.plan, r).unwrap().unwrap())
     };
+    let (every, none) = (LoopCounters::Every, LoopCounters::None);
     for (backend, free, bounded) in [
-        ("ash", ash_frame(false), ash_frame(true)),
-        ("wgpu", wgpu_frame(false), wgpu_frame(true)),
+        ("ash", ash_frame(none), ash_frame(every)),
+        ("wgpu", wgpu_frame(none), wgpu_frame(every)),
     ] {
         assert!(free[0][3] > 0, "{backend}: no strand drawn");
         let hit = |t: &u32| *t != strandgraph_passes::lipp::dom::NO_HIT;
@@ -511,7 +513,7 @@ fn the_frame_is_the_same_with_naga_s_loop_bounding() {
             let differ = a.iter().zip(b).filter(|(x, y)| x != y).count();
             assert!(
                 a.len() == b.len() && differ == 0,
-                "{backend} {name}: {differ} words differ with loop bounding"
+                "{backend} {name}: {differ} words differ with the loop counters"
             );
         }
     }

@@ -26,6 +26,7 @@ pub mod kernel;
 pub mod kulikov;
 pub mod layout;
 pub mod lipp;
+pub mod loop_counters;
 pub mod opaque_mesh;
 pub mod params;
 pub mod raster_state;
@@ -39,6 +40,7 @@ pub mod wgsl;
 
 pub use contract::{Binding, CpuKernel, Dispatch, GpuLayout, ParamError, Params, PassDef, Shader};
 pub use describe::{GpuBlock, PassKind};
+pub use loop_counters::LoopCounters;
 pub use params::{Invalid, NoParams, PassParams};
 pub use raster_state::RasterState;
 use strandgraph_graph::PassRegistry;

@@ -1,6 +1,8 @@
 //! The bench's rows: each pipeline's published configuration and its
 //! ablations, one published (or our own) optimisation switched off at a time.
 
+use strandgraph::runner::LoopCounters;
+
 /// One row of the table: a pipeline configuration.
 #[derive(Debug, Clone, Copy)]
 pub struct Variant {
@@ -15,9 +17,10 @@ pub struct Variant {
     pub raster: &'static [&'static str],
     /// The roofline pass whose rate is the raster's ceiling.
     pub ceiling: &'static str,
-    /// The GPU backends' shaders with naga's forced loop bounding
-    /// (`runner::OpenOptions::loop_bounding`, off in every other row).
-    pub loop_bounding: bool,
+    /// Which passes' GPU shaders get naga's loop counters
+    /// (`runner::OpenOptions::loop_counters`): as the graph says in every
+    /// row but those that measure it.
+    pub loop_counters: LoopCounters,
 }
 
 const KULIKOV: &str = "scenes/graphs/kulikov.ron";
@@ -33,7 +36,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -43,7 +46,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -58,18 +61,29 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
-    // Ours off: every shader compiled with naga's loop counters, as wgpu
-    // compiles an untrusted shader (runner::OpenOptions::loop_bounding).
+    // Ours off, both ways (passes/src/loop_counters.rs): every shader
+    // compiled with naga's loop counters, as wgpu compiles an untrusted
+    // shader; and none, raster and compose included, which kulikov.ron
+    // keeps them in.
     Variant {
         pipeline: "Kulikov",
-        name: "naga's loop bounding",
+        name: "naga's loop counters in every pass",
         graph: KULIKOV,
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: true,
+        loop_counters: LoopCounters::Every,
+    },
+    Variant {
+        pipeline: "Kulikov",
+        name: "no naga loop counters",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+        loop_counters: LoopCounters::None,
     },
     Variant {
         pipeline: "Kulikov",
@@ -78,7 +92,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.loop_flattening=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -92,7 +106,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -101,7 +115,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -110,7 +124,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.last_layer_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -119,7 +133,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.analytic_coverage=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours, not the talk's: each compose workgroup skips models whose tiles
     // cannot reach its pixels (passes/src/kulikov/compose/mod.rs).
@@ -130,7 +144,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.workgroup_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours, shipped off because it measured slower: head triangles with
     // boxes over 64 pixels rasterized by the whole workgroup
@@ -142,7 +156,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["visibility.cooperative_above=64"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours: each skin-shadow workgroup marches only the density grids its
     // rays can reach (passes/src/kulikov/skin_shadow/tile.rs).
@@ -153,7 +167,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["skin_shadow.tile_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours: the sort's scatter issues one atomicAdd per subgroup and
     // bucket (passes/src/kulikov/sort.rs).
@@ -164,7 +178,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.wave_aggregated_atomics=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours: the shading sort reads a word of visibility bits per lane, not
     // one bit (passes/src/kulikov/shade_sort.rs).
@@ -175,7 +189,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade_sort.word_per_lane=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Quality ablations of the talk's composition (their FLIP against the
     // reference is the point; the raster still writes three layers):
@@ -189,7 +203,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.layers=1"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -198,7 +212,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.coverage_fit=\"Exponential\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Kulikov",
@@ -207,7 +221,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.reconstruct_missing=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
@@ -225,7 +239,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -234,7 +248,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // The filter without §3.3.2's strand connection: conservative-only
     // pixels are not promoted and no flyaway is overlaid (the bilateral
@@ -252,7 +266,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // The filter's opacity as the paper estimates it: the coverage of the
     // centre test's half-pixel lines, not of the groom's strands
@@ -268,7 +282,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -277,7 +291,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -286,7 +300,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Every groom's bundles simulated (sim.pbd_chains, passes/src/sim/chains.rs).
     Variant {
@@ -296,7 +310,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours, each switched off in turn on the published configuration
     // (passes/src/lipp/raster.rs).
@@ -307,7 +321,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.segment_payload=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -316,7 +330,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.occlusion_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -325,7 +339,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.strip_rounds=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // C_max points however fine the groom (passes/src/lipp/lod/mod.rs,
     // `groom_resolution`), in the camera's view and the maps'.
@@ -339,7 +353,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
     // (passes/src/lipp/lod/mod.rs).
@@ -350,7 +364,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.view=\"Camera\"", "shadow_lod.lambda=1.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -359,7 +373,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.camera_bound=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Every conservative sample shaded, not only where lipp.filter reads
     // its colour (passes/src/lipp/shade.rs, `read_layers_only`).
@@ -370,7 +384,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.read_layers_only=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // lipp.filter over every tile lipp.shade ran rather than the tiles with
     // hair it lists (passes/src/lipp/tiles.rs): the tiles in the groom's
@@ -382,7 +396,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.hair_tiles=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // lipp.filter with a lane a pixel rather than two or more, each taking
     // every other row of the window (passes/src/lipp/filter.rs, `lanes`).
@@ -393,7 +407,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.lanes=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours off: lipp.filter's dispatch a workgroup a tile, two lanes a pixel
     // however few the tiles (passes/src/lipp/tiles.rs, `filter_lane_budget`).
@@ -404,7 +418,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.filter_lane_budget=0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours off: lipp.dom_opacity assembles every strand again rather than
     // walk the points lipp.dom_depth kept (passes/src/lipp/dom.rs,
@@ -419,18 +433,18 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours off: every shader compiled with naga's loop counters, as wgpu
-    // compiles an untrusted shader (runner::OpenOptions::loop_bounding).
+    // compiles an untrusted shader (passes/src/loop_counters.rs).
     Variant {
         pipeline: "Lipp",
-        name: "SWR 1+F+L, naga's loop bounding",
+        name: "SWR 1+F+L, naga's loop counters in every pass",
         graph: LIPP,
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: true,
+        loop_counters: LoopCounters::Every,
     },
     // Ours: the first-hit map's atomicMin without the plain load before it
     // (passes/src/lipp/dom.rs, `test_first`).
@@ -441,7 +455,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["dom_depth.test_first=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Ours: every tap of the window, not only the band along the tangent
     // (passes/src/lipp/filter.rs, `band`).
@@ -452,7 +466,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.band=0.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // lipp.shade over every pixel, as the paper's deferred shading, and
     // lipp.clear_gbuffer over the whole G-buffer, rather than the groom's
@@ -464,7 +478,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.groom_rect=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // lipp.clear_gbuffer a workgroup per run of 64 pixels, as lipp.shade is
     // dispatched, rather than a block of lod_scan's clear_runs runs
@@ -476,7 +490,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.clear_runs=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // The window of Lipp's Fig. 5 ("a single 7 × 7 kernel pass"), where
     // §3.3.1 says r = 5 (the default) and Code 2 r = 7.
@@ -487,7 +501,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.radius=3"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Without the camera's LOD but with the maps' own (ours): SWR 1 and
     // SWR 1+F with their deep opacity maps built like SWR 1+F+L's. The rows
@@ -503,7 +517,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -512,7 +526,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // A filter tap reading both G-buffer layers, then its colour, rather
     // than the neighbour's 8-byte record (passes/src/lipp/shaded.rs).
@@ -523,7 +537,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.packed_taps=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -537,7 +551,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -551,7 +565,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -565,7 +579,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -574,7 +588,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=2", "filter.msaa=2"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -583,7 +597,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=4", "filter.msaa=4"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Lipp",
@@ -592,7 +606,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=8", "filter.msaa=8"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Scheuermann 2004's optimized scheme as published (Z primed), and its
     // unoptimized "Sorted Hair Rendering Scheme" (the opaque pass alpha tests
@@ -604,7 +618,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "Scheuermann",
@@ -613,7 +627,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["prime_depth.enabled=false", "opaque_hair.primed=false"],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // Lipp's Table 1 baseline: the same strands through the hardware
     // rasterizer (scenes/graphs/hw_strands.ron), MSAA 1/4/8 without and
@@ -631,7 +645,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW strands",
@@ -645,7 +659,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW strands",
@@ -659,7 +673,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW strands",
@@ -668,7 +682,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW strands",
@@ -677,7 +691,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW strands",
@@ -686,7 +700,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     // The same quads from mesh shaders (scenes/graphs/hw_mesh.ron): a task
     // workgroup per bundle applying the LOD, strands assembled in mesh
@@ -704,7 +718,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW mesh",
@@ -718,7 +732,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW mesh",
@@ -732,7 +746,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW mesh",
@@ -741,7 +755,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW mesh",
@@ -750,7 +764,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
     Variant {
         pipeline: "HW mesh",
@@ -759,7 +773,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_bounding: false,
+        loop_counters: LoopCounters::Graph,
     },
 ];
 

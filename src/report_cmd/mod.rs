@@ -88,7 +88,7 @@ fn bench_args(args: &Args, out: &Path) -> bench_cmd::Args {
         quick: args.quick,
         subgroup: 32,
         params: args.params.clone(),
-        loop_bounding: false,
+        loop_counters: None,
     }
 }
 

@@ -58,8 +58,8 @@ pub(crate) struct Gpu {
     /// workgroup memory is the driver's job (as wgpu-hal does on 1.3),
     /// not a loop naga adds to every shader.
     pub zero_init_native: bool,
-    /// [`crate::AshBackend::loop_bounding`].
-    pub loop_bounding: bool,
+    /// [`crate::AshBackend::loop_counters`].
+    pub loop_counters: strandgraph_passes::LoopCounters,
     /// VK_EXT_mesh_shader's commands, where a pass draws with mesh shaders.
     pub mesh: Option<ext::mesh_shader::Device>,
     /// `maxTaskWorkGroupCount[0]` (0 without VK_EXT_mesh_shader).
@@ -283,12 +283,12 @@ fn create_device(
 
 impl Gpu {
     /// What the backend's SPIR-V is written for on this device, for a pass
-    /// that keeps naga's loop counters or not (its graph's `loop_bounding`).
-    pub(crate) fn spirv_target(&self, pass_loop_bounding: bool) -> crate::spirv::Target<'_> {
+    /// whose graph keeps naga's loop counters or not (`loop_bounding`).
+    pub(crate) fn spirv_target(&self, graph_keeps: bool) -> crate::spirv::Target<'_> {
         crate::spirv::Target {
             caps: &self.spirv_caps,
             zero_init_native: self.zero_init_native,
-            loop_bounding: self.loop_bounding || pass_loop_bounding,
+            loop_bounding: self.loop_counters.for_pass(graph_keeps),
         }
     }
 
@@ -344,7 +344,7 @@ impl Gpu {
             enabled: want.names,
             spirv_caps: want.spirv_caps,
             zero_init_native: want.zero_init_workgroup_memory,
-            loop_bounding: backend.loop_bounding,
+            loop_counters: backend.loop_counters,
             mesh,
             max_task_groups: have.max_task_groups,
             stats,

@@ -82,7 +82,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 use strandgraph_graph::{Instance, Plan};
 use strandgraph_passes::upload::Upload;
-use strandgraph_passes::{Definitions, Registry};
+use strandgraph_passes::{Definitions, LoopCounters, Registry};
 
 /// Whether to load the Khronos validation layer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -146,16 +146,10 @@ pub struct AshBackend {
     pub device_name: Option<String>,
     /// By default from `$STRANDGRAPH_ASH_SUBMIT` ([`Submit::from_env`]).
     pub submit: Submit,
-    /// naga's forced loop bounding (`spv::Options::force_loop_bounding`,
-    /// on by default in naga, as wgpu does for every shader): a 64-bit
-    /// counter in every loop, so that a driver cannot treat a loop as
-    /// endless and optimise it away. It guards untrusted (web) shaders; ours
-    /// end by construction, and the counters keep NVIDIA's compiler from
-    /// unrolling short loops, whose arrays then live in local memory (docs/
-    /// architecture.md, "Shaders"). Off by default, and then a pass keeps
-    /// them where its graph says `loop_bounding: true`; on, every pass has
-    /// them (the bench rows "naga's loop bounding").
-    pub loop_bounding: bool,
+    /// Which passes get naga's loop counters
+    /// (`spv::Options::force_loop_bounding`; [`LoopCounters`] says why).
+    /// By default those whose graph keeps them.
+    pub loop_counters: LoopCounters,
 }
 
 impl Default for AshBackend {
@@ -168,7 +162,7 @@ impl Default for AshBackend {
             timeout: Duration::from_secs(60),
             device_name: std::env::var("STRANDGRAPH_VK_DEVICE").ok(),
             submit: Submit::from_env(),
-            loop_bounding: false,
+            loop_counters: LoopCounters::Graph,
         }
     }
 }

@@ -30,7 +30,7 @@ pub(crate) struct Target<'a> {
     /// workgroup memory in every entry point).
     pub zero_init_native: bool,
     /// naga's forced loop bounding: a counter in every loop that breaks
-    /// out after 2^64 iterations ([`crate::AshBackend::loop_bounding`]).
+    /// out after 2^64 iterations ([`crate::AshBackend::loop_counters`]).
     pub loop_bounding: bool,
 }
 

@@ -37,6 +37,7 @@ use std::sync::{Arc, Mutex};
 use strandgraph_graph::resolve::PassId;
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl, Usage};
 use strandgraph_graph::{Instance, LifetimeClass, Plan, Queue};
+use strandgraph_passes::LoopCounters;
 use strandgraph_passes::upload::Upload;
 use strandgraph_passes::wgsl::{Composed, Shaders};
 use strandgraph_passes::{Definitions, Dispatch, PassDef, Registry};
@@ -87,12 +88,11 @@ pub struct WgpuBackend {
     pub shader_dir: Option<PathBuf>,
     /// Which wgpu backends to look for an adapter on (Vulkan by default).
     pub backends: wgpu::Backends,
-    /// naga's forced loop bounding, which wgpu adds to every shader unless
-    /// it is created trusted (`ShaderRuntimeChecks::force_loop_bounding`):
-    /// the same switch as the ash backend's `AshBackend::loop_bounding`,
-    /// off by default for the same reason (and a pass's graph can keep
-    /// them, `loop_bounding: true`).
-    pub loop_bounding: bool,
+    /// Which passes get naga's loop counters, which wgpu adds to every
+    /// shader it does not create trusted
+    /// (`ShaderRuntimeChecks::force_loop_bounding`; [`LoopCounters`] says
+    /// why). By default those whose graph keeps them.
+    pub loop_counters: LoopCounters,
 }
 
 impl Default for WgpuBackend {
@@ -100,7 +100,7 @@ impl Default for WgpuBackend {
         Self {
             shader_dir: strandgraph_passes::wgsl::override_dir(),
             backends: wgpu::Backends::VULKAN,
-            loop_bounding: false,
+            loop_counters: LoopCounters::Graph,
         }
     }
 }
@@ -166,7 +166,8 @@ struct Prepared<'d> {
     composed: Composed,
     /// The draw state, for raster passes.
     raster: Option<strandgraph_passes::RasterState>,
-    /// [`WgpuBackend::loop_bounding`].
+    /// Whether this pass's module has naga's loop counters
+    /// ([`WgpuBackend::loop_counters`]).
     loop_bounding: bool,
 }
 

@@ -100,7 +100,7 @@ impl<'a> PassContext<'a> {
         };
         // SAFETY: every check but loop bounding stays on, and without it
         // the caller must ensure no loop is endless: our shaders' loops end
-        // by construction (WgpuBackend::loop_bounding).
+        // by construction (WgpuBackend::loop_counters).
         let module = unsafe { device.create_shader_module_trusted(desc, checks) };
         let views = prep
             .bindings
