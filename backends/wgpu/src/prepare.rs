@@ -3,12 +3,14 @@
 use super::*;
 
 /// Looks up every live pass's definition, binds it, fills its parameter block
-/// and composes its shader.
+/// and composes its shader; `loop_counters` says whether its module gets
+/// naga's loop counters.
 pub(crate) fn prepare<'d>(
     defs: &'d dyn Definitions,
     plan: &Plan,
     instance: &Instance,
     shaders: &mut Shaders,
+    loop_counters: LoopCounters,
 ) -> Result<Vec<Prepared<'d>>, WgpuError> {
     let g = &plan.graph;
     let mut out = Vec::new();
@@ -59,7 +61,7 @@ pub(crate) fn prepare<'d>(
             entry,
             composed,
             raster,
-            loop_bounding: true, // WgpuBackend::prepare sets the backend's
+            loop_bounding: loop_counters.for_pass(g.passes[p].loop_bounding),
         });
     }
     Ok(out)

@@ -87,13 +87,7 @@ impl WgpuBackend {
         instance: &Instance,
     ) -> Result<Vec<Prepared<'static>>, WgpuError> {
         let mut shaders = Shaders::open(self.shader_dir.as_deref()).map_err(WgpuError::Shader)?;
-        let mut prepared = prepare(defs, plan, instance, &mut shaders)?;
-        for p in &mut prepared {
-            p.loop_bounding = self
-                .loop_counters
-                .for_pass(plan.graph.passes[p.p].loop_bounding);
-        }
-        Ok(prepared)
+        prepare(defs, plan, instance, &mut shaders, self.loop_counters)
     }
 }
 
