@@ -25,7 +25,7 @@ use std::time::Instant;
 use strandgraph::frame::{Prepared, complete_upload, override_param, parse_size, prepare};
 use strandgraph::images::{Picture, main_picture};
 use strandgraph::runner::{
-    self, Backend, Clock, LoopCounters, OpenOptions, PassTime, Session, frame_millis,
+    self, Backend, Barriers, Clock, LoopCounters, OpenOptions, PassTime, Session, frame_millis,
 };
 use strandgraph::sequence;
 use strandgraph_assets::Scene;
@@ -110,6 +110,11 @@ pub struct Args {
     /// as each row does; the report notes it.
     #[arg(long, value_parser = clap::value_parser!(LoopCounters))]
     pub loop_counters: Option<LoopCounters>,
+    /// Separate ash's passes with barriers as this says (levels or
+    /// per-pass; docs/architecture.md, "Synchronisation") rather than as
+    /// each row does; the report notes it.
+    #[arg(long, value_parser = clap::value_parser!(Barriers))]
+    pub barriers: Option<Barriers>,
 }
 
 /// `rel` under the working directory, else under the checkout the binary
@@ -270,6 +275,9 @@ pub fn run(mut args: Args) -> Result<()> {
         report.note(format!(
             "--loop-counters {c} on every row (naga's loop counters)"
         ));
+    }
+    if let Some(b) = args.barriers {
+        report.note(format!("--barriers {b} on every row (ash's barriers)"));
     }
     if args.quick {
         report.note(format!(
@@ -591,7 +599,8 @@ fn measure(
 ) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
     let plan = variant_plan(p, v, &args.params)?;
     let cpu = OpenOptions {
-        loop_counters: args.loop_counters.unwrap_or(v.loop_counters),
+        loop_counters: args.loop_counters.unwrap_or(v.backend.loop_counters),
+        barriers: args.barriers.unwrap_or(v.backend.barriers),
         ..cpu
     };
     let mut session = runner::open(backend, &plan, &p.instance, cpu)?;

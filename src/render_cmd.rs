@@ -8,7 +8,7 @@ use strandgraph::frame::{Prepared, parse_size, prepare_with};
 use strandgraph::images::{
     Display, Tonemap, coverage, depth_to_view, motion_image, to_linear, to_picture,
 };
-use strandgraph::runner::{self, LoopCounters, OpenOptions, PassTime, frame_millis};
+use strandgraph::runner::{self, Barriers, LoopCounters, OpenOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
 use strandgraph_passes::backend::Clock;
 
@@ -81,6 +81,11 @@ pub struct Args {
     /// "Shaders").
     #[arg(long, default_value = "graph", value_parser = clap::value_parser!(LoopCounters))]
     pub loop_counters: LoopCounters,
+    /// How ash separates a queue's passes with pipeline barriers: levels
+    /// (passes that wait for none of each other between one barrier and
+    /// the next) or per-pass (docs/architecture.md, "Synchronisation").
+    #[arg(long, default_value = "levels", value_parser = clap::value_parser!(Barriers))]
+    pub barriers: Barriers,
     /// The display transform of PNG outputs (EXR stays scene-linear).
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: Tonemap,
@@ -144,6 +149,7 @@ pub fn run(args: Args) -> Result<()> {
         instrument: args.instrument,
         alias: !args.no_alias,
         loop_counters: args.loop_counters,
+        barriers: args.barriers,
     };
     let mut all = Vec::new();
     for (i, &backend) in chosen.iter().enumerate() {

@@ -4,6 +4,7 @@
 //! ([`strandgraph_passes::backend`]).
 
 use miette::{IntoDiagnostic, Result};
+pub use strandgraph_ash::Barriers;
 use strandgraph_graph::{Instance, Plan};
 pub use strandgraph_passes::LoopCounters;
 use strandgraph_passes::Registry;
@@ -59,6 +60,9 @@ pub struct OpenOptions {
     /// Which passes' GPU shaders get naga's loop counters
     /// ([`LoopCounters`]; by default those whose graph keeps them).
     pub loop_counters: LoopCounters,
+    /// How ash separates a queue's passes with barriers ([`Barriers`]; by
+    /// default in dependency levels). The other backends place their own.
+    pub barriers: Barriers,
 }
 
 impl Default for OpenOptions {
@@ -68,6 +72,7 @@ impl Default for OpenOptions {
             instrument: false,
             alias: true,
             loop_counters: LoopCounters::Graph,
+            barriers: Barriers::Levels,
         }
     }
 }
@@ -111,6 +116,7 @@ pub fn open(
             let b = strandgraph_ash::AshBackend {
                 alias: options.alias,
                 loop_counters: options.loop_counters,
+                barriers: options.barriers,
                 ..Default::default()
             };
             Box::new(b.open(plan, instance).map_err(|e| match e {

@@ -217,6 +217,45 @@ fn showcase_composed_matches_cpu_on_ash() {
     assert_eq!(read_ash(&session, name), a, "the second frame differs");
 }
 
+/// Barriers in dependency levels (`strandgraph_ash::Barriers::Levels`, the
+/// default) reorder a queue's passes and drop barriers between them, and
+/// change no bit of the frame: Kulikov's and Lipp's pictures are the same
+/// with a barrier before each pass, with the plan's aliasing (whose
+/// hand-overs the levels must respect) and synchronization validation on.
+/// lavapipe has one queue, so its levels mix both queues' passes.
+#[test]
+fn barrier_levels_change_no_bit_of_the_frame() {
+    use strandgraph_ash::{AshBackend, Barriers};
+    for (graph, output) in [("kulikov", "output.composed"), ("lipp", "output.final")] {
+        let p = prepare(
+            &root().join("scenes/showcase.ron"),
+            Some(&root().join(format!("scenes/graphs/{graph}.ron"))),
+            Some((96, 54)),
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+        let frame = |barriers| {
+            let s = common::ash_with(
+                &p,
+                AshBackend {
+                    barriers,
+                    ..Default::default()
+                },
+            );
+            read_ash(&s, output)
+        };
+        let (levels, per_pass) = (frame(Barriers::Levels), frame(Barriers::PerPass));
+        assert!(
+            levels.iter().any(|&w| w != levels[0]),
+            "{graph}: a blank picture"
+        );
+        let differ = levels.iter().zip(&per_pass).filter(|(a, b)| a != b).count();
+        assert_eq!(
+            differ, 0,
+            "{graph}: {differ} words differ between the barrier settings"
+        );
+    }
+}
+
 /// A frame that does not finish within the session's timeout ends with an
 /// error naming the pass it is stuck at, rather than waiting forever: with
 /// no time at all, lavapipe has barely started the showcase.

@@ -1,7 +1,7 @@
 //! The bench's rows: each pipeline's published configuration and its
 //! ablations, one published (or our own) optimisation switched off at a time.
 
-use strandgraph::runner::LoopCounters;
+use strandgraph::runner::{Barriers, LoopCounters};
 
 /// One row of the table: a pipeline configuration.
 #[derive(Debug, Clone, Copy)]
@@ -17,11 +17,25 @@ pub struct Variant {
     pub raster: &'static [&'static str],
     /// The roofline pass whose rate is the raster's ceiling.
     pub ceiling: &'static str,
-    /// Which passes' GPU shaders get naga's loop counters
-    /// (`runner::OpenOptions::loop_counters`): as the graph says in every
-    /// row but those that measure it.
-    pub loop_counters: LoopCounters,
+    /// The GPU backends' settings: [`DEFAULTS`] in every row but those
+    /// that measure them.
+    pub backend: RowBackend,
 }
+
+/// A row's settings of the GPU backends (`runner::OpenOptions`).
+#[derive(Debug, Clone, Copy)]
+pub struct RowBackend {
+    /// Which passes' shaders get naga's loop counters.
+    pub loop_counters: LoopCounters,
+    /// How ash separates a queue's passes with barriers.
+    pub barriers: Barriers,
+}
+
+/// As the graph says and as the backends do by default.
+pub const DEFAULTS: RowBackend = RowBackend {
+    loop_counters: LoopCounters::Graph,
+    barriers: Barriers::Levels,
+};
 
 const KULIKOV: &str = "scenes/graphs/kulikov.ron";
 
@@ -36,7 +50,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -46,7 +60,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -61,7 +75,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours off, both ways (passes/src/loop_counters.rs): every shader
     // compiled with naga's loop counters, as wgpu compiles an untrusted
@@ -74,7 +88,10 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Every,
+        backend: RowBackend {
+            loop_counters: LoopCounters::Every,
+            ..DEFAULTS
+        },
     },
     Variant {
         pipeline: "Kulikov",
@@ -83,7 +100,24 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::None,
+        backend: RowBackend {
+            loop_counters: LoopCounters::None,
+            ..DEFAULTS
+        },
+    },
+    // Ours off: a pipeline barrier before every pass that has a dependency,
+    // in the plan's order (backends/ash/src/record.rs, `levels`).
+    Variant {
+        pipeline: "Kulikov",
+        name: "a barrier before each pass",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+        backend: RowBackend {
+            barriers: Barriers::PerPass,
+            ..DEFAULTS
+        },
     },
     Variant {
         pipeline: "Kulikov",
@@ -92,7 +126,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.loop_flattening=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -106,7 +140,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -115,7 +149,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -124,7 +158,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.last_layer_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -133,7 +167,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.analytic_coverage=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours, not the talk's: each compose workgroup skips models whose tiles
     // cannot reach its pixels (passes/src/kulikov/compose/mod.rs).
@@ -144,7 +178,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.workgroup_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours, shipped off because it measured slower: head triangles with
     // boxes over 64 pixels rasterized by the whole workgroup
@@ -156,7 +190,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["visibility.cooperative_above=64"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours: each skin-shadow workgroup marches only the density grids its
     // rays can reach (passes/src/kulikov/skin_shadow/tile.rs).
@@ -167,7 +201,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["skin_shadow.tile_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours: the sort's scatter issues one atomicAdd per subgroup and
     // bucket (passes/src/kulikov/sort.rs).
@@ -178,7 +212,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["sort.wave_aggregated_atomics=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours: the shading sort reads a word of visibility bits per lane, not
     // one bit (passes/src/kulikov/shade_sort.rs).
@@ -189,7 +223,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade_sort.word_per_lane=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Quality ablations of the talk's composition (their FLIP against the
     // reference is the point; the raster still writes three layers):
@@ -203,7 +237,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.layers=1"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -212,7 +246,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.coverage_fit=\"Exponential\""],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Kulikov",
@@ -221,7 +255,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["compose.reconstruct_missing=false"],
         raster: &["raster"],
         ceiling: "atomic_min32",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Lipp's Table 1 rows: SWR = software rasterizer, F = reconstruction
     // filter (lipp.filter), L = LOD (lipp.lod), 2/4/8 = MSAA samples (the
@@ -239,7 +273,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -248,7 +282,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "shadow_lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // The filter without §3.3.2's strand connection: conservative-only
     // pixels are not promoted and no flyaway is overlaid (the bilateral
@@ -266,7 +300,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // The filter's opacity as the paper estimates it: the coverage of the
     // centre test's half-pixel lines, not of the groom's strands
@@ -282,7 +316,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -291,7 +325,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -300,7 +334,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Every groom's bundles simulated (sim.pbd_chains, passes/src/sim/chains.rs).
     Variant {
@@ -310,7 +344,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["simulate.models=\"All\"", "splat.models=\"All\""],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours, each switched off in turn on the published configuration
     // (passes/src/lipp/raster.rs).
@@ -321,7 +355,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.segment_payload=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -330,7 +364,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.occlusion_cull=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -339,7 +373,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.strip_rounds=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // C_max points however fine the groom (passes/src/lipp/lod/mod.rs,
     // `groom_resolution`), in the camera's view and the maps'.
@@ -353,7 +387,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // The deep opacity maps' LOD as it was: the camera's, at the camera's λ
     // (passes/src/lipp/lod/mod.rs).
@@ -364,7 +398,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.view=\"Camera\"", "shadow_lod.lambda=1.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -373,7 +407,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shadow_lod.camera_bound=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Every conservative sample shaded, not only where lipp.filter reads
     // its colour (passes/src/lipp/shade.rs, `read_layers_only`).
@@ -384,7 +418,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.read_layers_only=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // lipp.filter over every tile lipp.shade ran rather than the tiles with
     // hair it lists (passes/src/lipp/tiles.rs): the tiles in the groom's
@@ -396,7 +430,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.hair_tiles=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // lipp.filter with a lane a pixel rather than two or more, each taking
     // every other row of the window (passes/src/lipp/filter.rs, `lanes`).
@@ -407,7 +441,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.lanes=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours off: lipp.filter's dispatch a workgroup a tile, two lanes a pixel
     // however few the tiles (passes/src/lipp/tiles.rs, `filter_lane_budget`).
@@ -418,7 +452,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["shade.filter_lane_budget=0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours off: lipp.dom_opacity assembles every strand again rather than
     // walk the points lipp.dom_depth kept (passes/src/lipp/dom.rs,
@@ -433,7 +467,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours off: every shader compiled with naga's loop counters, as wgpu
     // compiles an untrusted shader (passes/src/loop_counters.rs).
@@ -444,7 +478,24 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Every,
+        backend: RowBackend {
+            loop_counters: LoopCounters::Every,
+            ..DEFAULTS
+        },
+    },
+    // Ours off: a pipeline barrier before every pass that has a dependency,
+    // in the plan's order (backends/ash/src/record.rs, `levels`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, a barrier before each pass",
+        graph: LIPP,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+        backend: RowBackend {
+            barriers: Barriers::PerPass,
+            ..DEFAULTS
+        },
     },
     // Ours: the first-hit map's atomicMin without the plain load before it
     // (passes/src/lipp/dom.rs, `test_first`).
@@ -455,7 +506,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["dom_depth.test_first=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Ours: every tap of the window, not only the band along the tangent
     // (passes/src/lipp/filter.rs, `band`).
@@ -466,7 +517,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.band=0.0"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // lipp.shade over every pixel, as the paper's deferred shading, and
     // lipp.clear_gbuffer over the whole G-buffer, rather than the groom's
@@ -478,7 +529,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.groom_rect=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // lipp.clear_gbuffer a workgroup per run of 64 pixels, as lipp.shade is
     // dispatched, rather than a block of lod_scan's clear_runs runs
@@ -490,7 +541,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod_scan.clear_runs=1"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // The window of Lipp's Fig. 5 ("a single 7 × 7 kernel pass"), where
     // §3.3.1 says r = 5 (the default) and Code 2 r = 7.
@@ -501,7 +552,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.radius=3"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Without the camera's LOD but with the maps' own (ours): SWR 1 and
     // SWR 1+F with their deep opacity maps built like SWR 1+F+L's. The rows
@@ -517,7 +568,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false", "filter.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -526,7 +577,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["lod.enabled=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // A filter tap reading both G-buffer layers, then its colour, rather
     // than the neighbour's 8-byte record (passes/src/lipp/shaded.rs).
@@ -537,7 +588,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["filter.packed_taps=false"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -551,7 +602,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -565,7 +616,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -579,7 +630,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -588,7 +639,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=2", "filter.msaa=2"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -597,7 +648,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=4", "filter.msaa=4"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Lipp",
@@ -606,7 +657,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["raster.msaa=8", "filter.msaa=8"],
         raster: &["raster"],
         ceiling: "atomic_min64",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Scheuermann 2004's optimized scheme as published (Z primed), and its
     // unoptimized "Sorted Hair Rendering Scheme" (the opaque pass alpha tests
@@ -618,7 +669,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &[],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "Scheuermann",
@@ -627,7 +678,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["prime_depth.enabled=false", "opaque_hair.primed=false"],
         raster: &SCHEUERMANN_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // Lipp's Table 1 baseline: the same strands through the hardware
     // rasterizer (scenes/graphs/hw_strands.ron), MSAA 1/4/8 without and
@@ -645,7 +696,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW strands",
@@ -659,7 +710,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW strands",
@@ -673,7 +724,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW strands",
@@ -682,7 +733,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW strands",
@@ -691,7 +742,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW strands",
@@ -700,7 +751,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &HW_STRANDS_PASSES,
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     // The same quads from mesh shaders (scenes/graphs/hw_mesh.ron): a task
     // workgroup per bundle applying the LOD, strands assembled in mesh
@@ -718,7 +769,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW mesh",
@@ -732,7 +783,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW mesh",
@@ -746,7 +797,7 @@ pub const VARIANTS: &[Variant] = &[
         ],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW mesh",
@@ -755,7 +806,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=1", "filter.msaa=1"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW mesh",
@@ -764,7 +815,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=4", "filter.msaa=4"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
     Variant {
         pipeline: "HW mesh",
@@ -773,7 +824,7 @@ pub const VARIANTS: &[Variant] = &[
         overrides: &["strand_depth.samples=8", "filter.msaa=8"],
         raster: &["mesh"],
         ceiling: "fragments",
-        loop_counters: LoopCounters::Graph,
+        backend: DEFAULTS,
     },
 ];
 

@@ -89,6 +89,7 @@ fn bench_args(args: &Args, out: &Path) -> bench_cmd::Args {
         subgroup: 32,
         params: args.params.clone(),
         loop_counters: None,
+        barriers: None,
     }
 }
 

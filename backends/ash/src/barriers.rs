@@ -181,6 +181,10 @@ pub(crate) struct SyncPlan {
     /// cross-queue ones left to the sync points (for the frame notes).
     pub barrier_deps: usize,
     pub semaphore_deps: usize,
+    /// Indexed by pass id: the passes on its queue whose work its barriers
+    /// wait for (its same-queue dependencies, and the earlier users of
+    /// bytes it reuses). What [`crate::Barriers::Levels`] groups by.
+    pub waits_on: Vec<Vec<PassId>>,
 }
 
 /// What the planner needs to know about the backend's queues and memory.
@@ -233,6 +237,7 @@ impl Planner<'_> {
                 continue;
             }
             out.barrier_deps += 1;
+            out.waits_on[d.to].push(d.from);
             if g.resources[d.resource].decl.is_image() {
                 continue;
             }
@@ -253,7 +258,7 @@ impl Planner<'_> {
 
     /// Per transient that reuses another's bytes: its first pass, and the
     /// earlier transient's uses on that pass's queue.
-    fn alias_sources(&self) -> BTreeMap<usize, (PassId, Scope)> {
+    fn alias_sources(&self, waits_on: &mut [Vec<PassId>]) -> BTreeMap<usize, (PassId, Scope)> {
         let plan = self.plan;
         let mut alias_src: BTreeMap<usize, (PassId, Scope)> = BTreeMap::new();
         for &(a, b) in self.at.aliases {
@@ -268,6 +273,7 @@ impl Planner<'_> {
             for &(u, _) in &la.uses {
                 if self.q(u) == self.q(first) {
                     src = src.or(Scope::of(&self.point(u, a), self.co(first)));
+                    waits_on[first].push(u);
                 }
             }
             let e = alias_src.entry(b).or_insert((first, Scope::NONE));
@@ -433,11 +439,12 @@ pub(crate) fn plan_sync(plan: &Plan, at: &Placement<'_>) -> SyncPlan {
     let mut out = SyncPlan {
         before: vec![Vec::new(); n],
         after: vec![Vec::new(); n],
+        waits_on: vec![Vec::new(); n],
         ..SyncPlan::default()
     };
     let planner = Planner { plan, at };
     planner.buffer_barriers(&mut out);
-    let mut alias_src = planner.alias_sources();
+    let mut alias_src = planner.alias_sources(&mut out.waits_on);
     planner.image_barriers(&mut out, &mut alias_src);
     // Buffers (and images whose first use was not a write) that reuse bytes.
     for (b, (first, src)) in alias_src {

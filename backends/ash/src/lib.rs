@@ -126,6 +126,54 @@ impl Submit {
     }
 }
 
+/// How a queue's passes are separated by pipeline barriers (record.rs).
+///
+/// A Vulkan pipeline barrier waits for *every* earlier command of its source
+/// stages, not only the pass it names. Recorded before each pass, it turns
+/// a queue into a chain: two independent passes recorded one after the
+/// other with a barrier between them never overlap, however small they are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Barriers {
+    /// Passes in the plan's order, each after the barrier its own
+    /// dependencies need.
+    PerPass,
+    /// Ours: between two cross-queue waits, the passes in dependency levels
+    /// (a pass one level after the last pass on its queue it waits for),
+    /// every barrier of a level in one `vkCmdPipelineBarrier2` before it:
+    /// the passes of a level run side by side.
+    #[default]
+    Levels,
+}
+
+impl Barriers {
+    /// The names `FromStr` takes.
+    pub const NAMES: [&'static str; 2] = ["per-pass", "levels"];
+}
+
+impl std::str::FromStr for Barriers {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "per-pass" => Ok(Barriers::PerPass),
+            "levels" => Ok(Barriers::Levels),
+            _ => Err(format!(
+                "`{s}` is not a barrier setting (one of {})",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Barriers {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Barriers::PerPass => "per-pass",
+            Barriers::Levels => "levels",
+        })
+    }
+}
+
 /// How the ash backend runs.
 #[derive(Debug, Clone)]
 pub struct AshBackend {
@@ -150,6 +198,8 @@ pub struct AshBackend {
     /// (`spv::Options::force_loop_bounding`; [`LoopCounters`] says why).
     /// By default those whose graph keeps them.
     pub loop_counters: LoopCounters,
+    /// How each queue's passes are separated by barriers ([`Barriers`]).
+    pub barriers: Barriers,
 }
 
 impl Default for AshBackend {
@@ -163,6 +213,7 @@ impl Default for AshBackend {
             device_name: std::env::var("STRANDGRAPH_VK_DEVICE").ok(),
             submit: Submit::from_env(),
             loop_counters: LoopCounters::Graph,
+            barriers: Barriers::Levels,
         }
     }
 }

@@ -11,6 +11,7 @@
 //! command buffers do not change between frames; only the timeline values
 //! (offset per frame) do, so frames resubmit them.
 
+use crate::Barriers;
 use crate::barriers::{Barrier, SyncPlan, Target};
 use crate::device::Gpu;
 use crate::error::{AshError, VkContext};
@@ -51,6 +52,8 @@ pub(crate) struct Batch {
     pub last: usize,
     /// `(lane, 1-based position)` this batch waits for.
     pub waits: Vec<(usize, u64)>,
+    /// The batch's positions grouped between barriers ([`Lanes::group`]).
+    pub levels: Vec<Vec<usize>>,
 }
 
 pub(crate) struct Lane {
@@ -73,6 +76,28 @@ pub(crate) struct Lanes {
     pub lanes: Vec<Lane>,
     /// Lane index of every pass (by pass id).
     pub lane_of: Vec<usize>,
+}
+
+impl Lanes {
+    /// Groups each batch's passes between barriers as `barriers` says:
+    /// one pass a group, or [`levels`] of the passes' waits in `sync`.
+    pub fn group(&mut self, plan: &Plan, sync: &SyncPlan, barriers: Barriers) {
+        for lane in &mut self.lanes {
+            for (b, batch) in lane.batches.iter_mut().enumerate() {
+                let range = batch.first..=batch.last;
+                batch.levels = match barriers {
+                    Barriers::PerPass => range.map(|i| vec![i]).collect(),
+                    Barriers::Levels => levels(&lane.passes, range, &sync.waits_on),
+                };
+                let names: Vec<Vec<&str>> = batch
+                    .levels
+                    .iter()
+                    .map(|l| l.iter().map(|&i| plan.pass_name(lane.passes[i])).collect())
+                    .collect();
+                tracing::debug!(queue = lane.queue, batch = b, ?names, "barrier levels");
+            }
+        }
+    }
 }
 
 /// A timeline semaphore starting at 0.
@@ -241,6 +266,7 @@ fn batches(l: usize, order: &[When], points: &[Point]) -> Vec<Batch> {
                 first: start,
                 last: i,
                 waits,
+                levels: Vec::new(),
             });
             start = i + 1;
         }
@@ -354,10 +380,22 @@ pub(crate) fn record_all(
                         unsafe { d.cmd_write_timestamp2(cmd, after_wait, qp, 0) };
                     }
                 }
-                for i in batch.first..=batch.last {
-                    let built = built_pass(plan, pipelines, lane.passes[i])?;
-                    let qp = pool.filter(|_| per_pass);
-                    record_pass(d, cmd, built, memory, sync, qp.map(|qp| (qp, 2 * i as u32)));
+                for level in &batch.levels {
+                    let before: Vec<Barrier> = level
+                        .iter()
+                        .flat_map(|&i| sync.before[lane.passes[i]].iter().copied())
+                        .collect();
+                    record_barriers(d, cmd, &before, memory);
+                    for &i in level {
+                        let built = built_pass(plan, pipelines, lane.passes[i])?;
+                        let qp = pool.filter(|_| per_pass);
+                        record_pass(d, cmd, built, memory, sync, qp.map(|qp| (qp, 2 * i as u32)));
+                    }
+                    let after: Vec<Barrier> = level
+                        .iter()
+                        .flat_map(|&i| sync.after[lane.passes[i]].iter().copied())
+                        .collect();
+                    record_barriers(d, cmd, &after, memory);
                 }
                 if let Some(qp) = pool.filter(|_| stamps == Stamps::Frame && batch.last + 1 == n) {
                     // SAFETY: recording; reset by the lane's first batch.
@@ -382,8 +420,51 @@ fn built_pass<'a>(plan: &Plan, pipelines: &'a Pipelines, p: PassId) -> Result<&'
         })
 }
 
-/// One pass: its barriers before, its work (between timestamps `query`
-/// and `query + 1` of the pool, where given) and its barriers after.
+/// Lane positions `range` (one batch) in dependency levels, each level in
+/// lane order. The barriers a level's passes need go before the level, and
+/// its passes are not ordered among themselves: none waits for another, and
+/// a barrier waits for every earlier pass anyway.
+///
+/// A position's level is one more than the highest level of the positions
+/// it waits for (`waits_on`, by pass id), 0 when it waits for none in the
+/// batch; except that a pass nothing in the batch waits for goes in the
+/// last level: it can only shorten the batch by running beside the passes
+/// that end it, and started early it takes the GPU from the passes that
+/// lead there (measured: a clear moved beside the head's first pass made
+/// Lipp's mid view slower, benches/results/barrier-levels-h200.txt).
+pub(crate) fn levels(
+    passes: &[PassId],
+    range: std::ops::RangeInclusive<usize>,
+    waits_on: &[Vec<PassId>],
+) -> Vec<Vec<usize>> {
+    let first = *range.start();
+    let positions: Vec<usize> = range.collect();
+    let waits = |i: usize, j: usize| waits_on[passes[i]].contains(&passes[j]);
+    let mut level_of: Vec<usize> = Vec::with_capacity(positions.len());
+    for &i in &positions {
+        let level = (first..i)
+            .filter(|&j| waits(i, j))
+            .map(|j| level_of[j - first] + 1)
+            .max()
+            .unwrap_or(0);
+        level_of.push(level);
+    }
+    let last = level_of.iter().copied().max().unwrap_or(0);
+    let mut out: Vec<Vec<usize>> = vec![Vec::new(); last + 1];
+    for &i in &positions {
+        let waited_for = positions.iter().any(|&k| k > i && waits(k, i));
+        out[if waited_for {
+            level_of[i - first]
+        } else {
+            last
+        }]
+        .push(i);
+    }
+    out
+}
+
+/// One pass's work between timestamps `query` and `query + 1` of the pool,
+/// where given (its barriers are its level's: [`record_all`]).
 fn record_pass(
     d: &ash::Device,
     cmd: vk::CommandBuffer,
@@ -392,8 +473,6 @@ fn record_pass(
     sync: &SyncPlan,
     stamps: Option<(vk::QueryPool, u32)>,
 ) {
-    let p = built.p;
-    record_barriers(d, cmd, &sync.before[p], memory);
     // SAFETY: recording; handles live for the session; the queries were
     // reset at the start of this command buffer.
     unsafe {
@@ -405,7 +484,6 @@ fn record_pass(
             d.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::BOTTOM_OF_PIPE, qp, q + 1);
         }
     }
-    record_barriers(d, cmd, &sync.after[p], memory);
 }
 
 /// # Safety
@@ -596,7 +674,7 @@ unsafe fn record_raster(
 
 #[cfg(test)]
 mod tests {
-    use super::{Point, When, batches};
+    use super::{Point, When, batches, levels};
 
     fn at(order: usize, step: usize) -> When {
         When { order, step }
@@ -648,5 +726,33 @@ mod tests {
         // batch's first): cut as well.
         let long = [signal, point((0, 2), (1, 4), at(5, 2))];
         assert_eq!(ranges(1, &order, &long), cut);
+    }
+
+    #[test]
+    fn passes_that_wait_for_none_of_each_other_share_a_level() {
+        // Pass ids 10..=15 at lane positions 0..=5. 11 waits for 10; 13
+        // waits for 11 and 12; 14 for 10; 15 for nothing. 12 is waited for,
+        // so it stays in level 0 beside 10; 14 and 15 are waited for by
+        // nothing in the batch, so they go in the last level with 13.
+        let passes: Vec<usize> = (10..=15).collect();
+        let mut waits_on = vec![Vec::new(); 16];
+        waits_on[11] = vec![10];
+        waits_on[13] = vec![11, 12];
+        waits_on[14] = vec![10];
+        assert_eq!(
+            levels(&passes, 0..=5, &waits_on),
+            vec![vec![0, 2], vec![1], vec![3, 4, 5]]
+        );
+        // A batch that starts later in the lane: only its own positions,
+        // and a wait for a pass before the batch (10) is no wait in it.
+        assert_eq!(levels(&passes, 3..=5, &waits_on), vec![vec![3, 4, 5]]);
+        assert_eq!(levels(&passes, 1..=3, &waits_on), vec![vec![1, 2], vec![3]]);
+        // A chain stays a chain.
+        let mut chain = vec![Vec::new(); 16];
+        for (p, waits) in chain.iter_mut().enumerate().skip(11) {
+            *waits = vec![p - 1];
+        }
+        let one_each: Vec<Vec<usize>> = (0..=5).map(|i| vec![i]).collect();
+        assert_eq!(levels(&passes, 0..=5, &chain), one_each);
     }
 }

@@ -155,7 +155,7 @@ impl Session {
         let families: Vec<u32> = gpu.queues.iter().map(|q| q.family).collect();
         let used = used_resources(plan);
         let memory = Memory::create(&gpu, plan, instance, &used, &families, backend.alias)?;
-        let lanes = make_lanes(&gpu, plan)?;
+        let mut lanes = make_lanes(&gpu, plan)?;
         let queue_of: Vec<usize> = lanes
             .lane_of
             .iter()
@@ -172,6 +172,7 @@ impl Session {
                 aliases: &memory.aliases,
             },
         );
+        lanes.group(plan, &sync, backend.barriers);
         let t0 = std::time::Instant::now();
         let pipelines = build(&gpu, plan, instance, &prepared, &memory, &sync)?;
         tracing::debug!(
