@@ -428,10 +428,12 @@ fn built_pass<'a>(plan: &Plan, pipelines: &'a Pipelines, p: PassId) -> Result<&'
 /// A position's level is one more than the highest level of the positions
 /// it waits for (`waits_on`, by pass id), 0 when it waits for none in the
 /// batch; except that a pass nothing in the batch waits for goes in the
-/// last level: it can only shorten the batch by running beside the passes
-/// that end it, and started early it takes the GPU from the passes that
-/// lead there (measured: a clear moved beside the head's first pass made
-/// Lipp's mid view slower, benches/results/barrier-levels-h200.txt).
+/// last level: started early it takes SMs from the chain that leads to
+/// the batch's end, started last it runs beside that chain's last passes
+/// (the plan's sinks are short clears). (On an H200 the difference
+/// was small: Lipp's close and mid views 1.871 / 0.510 ms with sinks as
+/// early as their waits allow, 1.870-1.875 / 0.501-0.510 last;
+/// benches/results/barrier-levels-h200.txt, items 2, 4 and 5.)
 pub(crate) fn levels(
     passes: &[PassId],
     range: std::ops::RangeInclusive<usize>,
