@@ -187,6 +187,19 @@ fn lower_first(s: &str) -> String {
     }
 }
 
+/// An `Option` parameter written as its value: `Some(v)` as `v` (the
+/// counterpart of [`some`]), so that defaults and widgets show a plain value.
+pub fn plain<S, T>(v: &Option<T>, s: S) -> Result<S::Ok, S::Error>
+where
+    S: serde::Serializer,
+    T: serde::Serialize,
+{
+    match v {
+        Some(v) => v.serialize(s),
+        None => s.serialize_none(),
+    }
+}
+
 /// `model_index` as `Option<u32>`: ron's `Value` has no options of its own,
 /// so a present number means `Some`.
 pub fn some<'de, D, T>(d: D) -> Result<Option<T>, D::Error>

@@ -64,9 +64,32 @@ pub fn points_room(words: usize, total: u32) -> u32 {
     ((words - POINTS_HEADER) / 3 / total as usize).min(MAX_CONTROL_POINTS as usize) as u32
 }
 
+/// Which map pass a [`DomParams`] is for.
+pub trait MapPass: Copy + Default + PartialEq + std::fmt::Debug + Send + Sync + 'static {
+    /// `lipp.dom_depth`, which alone takes `test_first`.
+    const DEPTH: bool;
+}
+
+/// `lipp.dom_depth`'s [`MapPass`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DepthMap;
+/// `lipp.dom_opacity`'s [`MapPass`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OpacityMap;
+
+impl MapPass for DepthMap {
+    const DEPTH: bool = true;
+}
+impl MapPass for OpacityMap {
+    const DEPTH: bool = false;
+}
+
+/// The parameters of both map passes; `M` tells `lipp.dom_depth`'s, which
+/// alone takes `test_first`, from `lipp.dom_opacity`'s, which rejects it
+/// ([`DomDepthParams`], [`DomOpacityParams`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct DomParams {
+#[serde(deny_unknown_fields, default, bound = "")]
+pub struct DomParams<M: MapPass> {
     /// Texels per side of each light's map (16..=4096).
     pub resolution: u32,
     /// Opacity layers behind the first hit (1..=8).
@@ -81,13 +104,26 @@ pub struct DomParams {
     /// Ours: `dom_opacity` walks the points `dom_depth` assembled rather
     /// than assemble each strand again (set it on both passes).
     pub shared_points: bool,
-    /// `dom_depth` only: a plain load of the texel before its atomicMin,
-    /// which most strand texels behind the first hit then skip; off, every
-    /// texel an atomicMin whose result nobody waits for.
-    pub test_first: bool,
+    /// `dom_depth` only (ours): a plain load of the texel before its
+    /// atomicMin, which most strand texels behind the first hit then skip;
+    /// off, every texel an atomicMin whose result nobody waits for.
+    /// `dom_opacity` has no such load, and an error names the key.
+    #[serde(
+        deserialize_with = "crate::params::some",
+        serialize_with = "crate::params::plain",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub test_first: Option<bool>,
+    #[serde(skip)]
+    pass: std::marker::PhantomData<M>,
 }
 
-impl Default for DomParams {
+/// `lipp.dom_depth`'s parameters.
+pub type DomDepthParams = DomParams<DepthMap>;
+/// `lipp.dom_opacity`'s parameters.
+pub type DomOpacityParams = DomParams<OpacityMap>;
+
+impl<M: MapPass> Default for DomParams<M> {
     fn default() -> Self {
         Self {
             resolution: 512,
@@ -98,13 +134,20 @@ impl Default for DomParams {
             cooperative_assembly: true,
             styling: true,
             shared_points: true,
-            test_first: true,
+            test_first: M::DEPTH.then_some(true),
+            pass: std::marker::PhantomData,
         }
     }
 }
 
-impl PassParams for DomParams {
+impl<M: MapPass> PassParams for DomParams<M> {
     fn validate(&self) -> Result<(), Invalid> {
+        if !M::DEPTH && self.test_first.is_some() {
+            return Err(Invalid::new(
+                "test_first",
+                "is lipp.dom_depth's: dom_opacity loads no texel before its atomics",
+            ));
+        }
         in_range("resolution", self.resolution, 16..=4096)?;
         in_range("layers", self.layers, 1..=8)?;
         if !(self.layer_thickness.is_finite() && self.layer_thickness > 0.0) {
@@ -135,7 +178,7 @@ crate::gpu_block! {
     }
 }
 
-impl DomParams {
+impl<M: MapPass> DomParams<M> {
     /// The WGSL `DomParams` block.
     pub fn uniform(&self, q: &Quantities) -> DomGpu {
         DomGpu {
@@ -148,7 +191,7 @@ impl DomParams {
             styling: flag(self.styling),
             bundles: count(q.bundles),
             shared_points: flag(self.shared_points),
-            test_first: flag(self.test_first),
+            test_first: flag(self.test_first == Some(true)),
             ..Default::default()
         }
     }
@@ -312,8 +355,7 @@ macro_rules! dom_bindings {
     };
 }
 
-pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = dom_pass(
-    Stage::Depth,
+pub static DOM_DEPTH: PassKind<DomDepthParams, DomGpu> = dom_pass(
     "lipp.dom_depth",
     "deep opacity map per light, stage 1: first-hit depth of the drawn strands in the light's view",
     "Lipp §3.4; Yuksel and Keyser 2008",
@@ -323,8 +365,7 @@ pub static DOM_DEPTH: PassKind<DomParams, DomGpu> = dom_pass(
     ),
 );
 
-pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = dom_pass(
-    Stage::Opacity,
+pub static DOM_OPACITY: PassKind<DomOpacityParams, DomGpu> = dom_pass(
     "lipp.dom_opacity",
     "deep opacity map per light, stage 2: strand opacity per layer behind the first hit (density-compensated for LOD)",
     "Lipp §3.2.3, §3.4; Yuksel and Keyser 2008",
@@ -339,13 +380,17 @@ pub static DOM_OPACITY: PassKind<DomParams, DomGpu> = dom_pass(
 /// entry point and kernel stage: both walk the drawn strands in each
 /// light's view with one workgroup per drawn strand, as the main view's
 /// rasterizer, configured by the same parameter block.
-const fn dom_pass(
-    stage: Stage,
+const fn dom_pass<M: MapPass>(
     kind: &'static str,
     summary: &'static str,
     source: &'static str,
     bindings: &'static [Binding],
-) -> PassKind<DomParams, DomGpu> {
+) -> PassKind<DomParams<M>, DomGpu> {
+    let stage = if M::DEPTH {
+        Stage::Depth
+    } else {
+        Stage::Opacity
+    };
     PassKind {
         kind,
         summary,
@@ -357,7 +402,7 @@ const fn dom_pass(
             word: 0,
         },
         shader: Shader::compute("lipp/dom_maps.wgsl", stage.entry()),
-        kernel: stage.kernel(),
+        kernel: DomKernel::boxed::<M>,
         gpu: |p, q| p.uniform(q),
         raster: None,
     }
@@ -371,24 +416,36 @@ impl Stage {
             Stage::Opacity => "dom_opacity_pass",
         }
     }
-
-    /// The stage's CPU kernel, configured by checked parameters.
-    const fn kernel(self) -> fn(&DomParams) -> Box<dyn CpuKernel> {
-        match self {
-            Stage::Depth => |p| DomKernel::boxed(Stage::Depth, p),
-            Stage::Opacity => |p| DomKernel::boxed(Stage::Opacity, p),
-        }
-    }
 }
 
 struct DomKernel {
     stage: Stage,
-    p: DomParams,
+    /// Either stage's checked parameters; `test_first` is `Some(false)`
+    /// for `dom_opacity`, which has no load to test with.
+    p: DomDepthParams,
 }
 
 impl DomKernel {
-    fn boxed(stage: Stage, p: &DomParams) -> Box<dyn CpuKernel> {
-        Box::new(DomKernel { stage, p: *p })
+    /// The stage's CPU kernel, configured by checked parameters.
+    fn boxed<M: MapPass>(p: &DomParams<M>) -> Box<dyn CpuKernel> {
+        let stage = if M::DEPTH {
+            Stage::Depth
+        } else {
+            Stage::Opacity
+        };
+        let p = DomDepthParams {
+            resolution: p.resolution,
+            layers: p.layers,
+            layer_thickness: p.layer_thickness,
+            strand_opacity: p.strand_opacity,
+            density_compensation: p.density_compensation,
+            cooperative_assembly: p.cooperative_assembly,
+            styling: p.styling,
+            shared_points: p.shared_points,
+            test_first: Some(p.test_first == Some(true)),
+            pass: std::marker::PhantomData,
+        };
+        Box::new(DomKernel { stage, p })
     }
 
     /// One texel (x, y) of light `l`'s maps at normalised depth `z`.
@@ -415,7 +472,7 @@ impl DomKernel {
                 // neither wins everywhere (README, "Lipp: the maps' lanes,
                 // what did not pay, and one switch").
                 let bits = z.to_bits();
-                if !self.p.test_first || bits < maps.0.load(texel) {
+                if self.p.test_first != Some(true) || bits < maps.0.load(texel) {
                     maps.0.fetch_min(texel, bits);
                 }
             }
@@ -543,6 +600,32 @@ impl CpuKernel for DomKernel {
 mod tests {
     use super::*;
     use bytemuck::Zeroable;
+
+    /// `test_first` is `dom_depth`'s alone: `dom_opacity` names it as an
+    /// error rather than ignore it, and only `dom_depth`'s defaults (the
+    /// viewer's widgets) list it, as a plain boolean.
+    #[test]
+    fn only_dom_depth_takes_test_first() {
+        use crate::contract::PassDef;
+        let key = || ron::Value::String("test_first".into());
+        let set = |v: bool| ron::Value::Map([(key(), ron::Value::Bool(v))].into_iter().collect());
+        let depth = DOM_DEPTH.params(&set(false)).unwrap();
+        assert_eq!(depth.test_first, Some(false));
+        let none = ron::Value::Map(ron::Map::new());
+        assert_eq!(DOM_DEPTH.params(&none).unwrap().test_first, Some(true));
+        let e = DOM_OPACITY.check_params(&set(true)).unwrap_err();
+        assert_eq!(e.param, "test_first");
+        assert!(e.message.contains("dom_depth"), "{}", e.message);
+        let listed = |d: ron::Value| match d {
+            ron::Value::Map(m) => m.get(&key()).cloned(),
+            _ => None,
+        };
+        assert_eq!(
+            listed(DOM_DEPTH.param_defaults()),
+            Some(ron::Value::Bool(true))
+        );
+        assert_eq!(listed(DOM_OPACITY.param_defaults()), None);
+    }
 
     #[test]
     fn light_frame_maps_the_bounds_into_the_unit_cube_along_the_light() {
