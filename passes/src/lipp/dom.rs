@@ -379,7 +379,8 @@ pub static DOM_OPACITY: PassKind<DomOpacityParams, DomGpu> = dom_pass(
 /// A stage's declaration. The two stages differ only in their name, maps,
 /// entry point and kernel stage: both walk the drawn strands in each
 /// light's view with one workgroup per drawn strand, as the main view's
-/// rasterizer, configured by the same parameter block.
+/// rasterizer, configured by the same parameter block (`M` says which
+/// stage; only `dom_depth`'s parameters take `test_first`).
 const fn dom_pass<M: MapPass>(
     kind: &'static str,
     summary: &'static str,
