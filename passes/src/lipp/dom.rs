@@ -66,8 +66,8 @@ pub fn points_room(words: usize, total: u32) -> u32 {
 
 /// Which map pass a [`DomParams`] is for.
 pub trait MapPass: Copy + Default + PartialEq + std::fmt::Debug + Send + Sync + 'static {
-    /// `lipp.dom_depth`, which alone takes `test_first`.
-    const DEPTH: bool;
+    /// The map the pass writes; `Depth` alone takes `test_first`.
+    const STAGE: Stage;
 }
 
 /// `lipp.dom_depth`'s [`MapPass`].
@@ -78,10 +78,10 @@ pub struct DepthMap;
 pub struct OpacityMap;
 
 impl MapPass for DepthMap {
-    const DEPTH: bool = true;
+    const STAGE: Stage = Stage::Depth;
 }
 impl MapPass for OpacityMap {
-    const DEPTH: bool = false;
+    const STAGE: Stage = Stage::Opacity;
 }
 
 /// The parameters of both map passes; `M` tells `lipp.dom_depth`'s, which
@@ -134,7 +134,7 @@ impl<M: MapPass> Default for DomParams<M> {
             cooperative_assembly: true,
             styling: true,
             shared_points: true,
-            test_first: M::DEPTH.then_some(true),
+            test_first: matches!(M::STAGE, Stage::Depth).then_some(true),
             pass: std::marker::PhantomData,
         }
     }
@@ -142,7 +142,7 @@ impl<M: MapPass> Default for DomParams<M> {
 
 impl<M: MapPass> PassParams for DomParams<M> {
     fn validate(&self) -> Result<(), Invalid> {
-        if !M::DEPTH && self.test_first.is_some() {
+        if M::STAGE == Stage::Opacity && self.test_first.is_some() {
             return Err(Invalid::new(
                 "test_first",
                 "is lipp.dom_depth's: dom_opacity loads no texel before its atomics",
@@ -387,11 +387,6 @@ const fn dom_pass<M: MapPass>(
     source: &'static str,
     bindings: &'static [Binding],
 ) -> PassKind<DomParams<M>, DomGpu> {
-    let stage = if M::DEPTH {
-        Stage::Depth
-    } else {
-        Stage::Opacity
-    };
     PassKind {
         kind,
         summary,
@@ -402,8 +397,8 @@ const fn dom_pass<M: MapPass>(
             binding: "raster_args",
             word: 0,
         },
-        shader: Shader::compute("lipp/dom_maps.wgsl", stage.entry()),
-        kernel: DomKernel::boxed::<M>,
+        shader: Shader::compute("lipp/dom_maps.wgsl", M::STAGE.entry()),
+        kernel: DomKernel::<M>::boxed,
         gpu: |p, q| p.uniform(q),
         raster: None,
     }
@@ -419,34 +414,14 @@ impl Stage {
     }
 }
 
-struct DomKernel {
-    stage: Stage,
-    /// Either stage's checked parameters; `test_first` is `Some(false)`
-    /// for `dom_opacity`, which has no load to test with.
-    p: DomDepthParams,
+/// A stage's CPU kernel (`M::STAGE`), configured by checked parameters.
+struct DomKernel<M: MapPass> {
+    p: DomParams<M>,
 }
 
-impl DomKernel {
-    /// The stage's CPU kernel, configured by checked parameters.
-    fn boxed<M: MapPass>(p: &DomParams<M>) -> Box<dyn CpuKernel> {
-        let stage = if M::DEPTH {
-            Stage::Depth
-        } else {
-            Stage::Opacity
-        };
-        let p = DomDepthParams {
-            resolution: p.resolution,
-            layers: p.layers,
-            layer_thickness: p.layer_thickness,
-            strand_opacity: p.strand_opacity,
-            density_compensation: p.density_compensation,
-            cooperative_assembly: p.cooperative_assembly,
-            styling: p.styling,
-            shared_points: p.shared_points,
-            test_first: Some(p.test_first == Some(true)),
-            pass: std::marker::PhantomData,
-        };
-        Box::new(DomKernel { stage, p })
+impl<M: MapPass> DomKernel<M> {
+    fn boxed(p: &DomParams<M>) -> Box<dyn CpuKernel> {
+        Box::new(DomKernel { p: *p })
     }
 
     /// One texel (x, y) of light `l`'s maps at normalised depth `z`.
@@ -463,7 +438,7 @@ impl DomKernel {
         if !(0.0..=1.0).contains(&z) {
             return;
         }
-        match self.stage {
+        match M::STAGE {
             Stage::Depth => {
                 // Ours, `test_first`: a plain load first. Most strand texels
                 // lie behind the current first hit, and skipping their
@@ -495,14 +470,14 @@ impl DomKernel {
     }
 }
 
-impl DomKernel {
+impl<M: MapPass> DomKernel<M> {
     /// The room per strand in `dom_points` this frame: `dom_depth` decides
     /// it (and workgroup 0 records it in the header), `dom_opacity` reads it.
     fn room(&self, group: u32, points: &Words<'_>, total: u32) -> u32 {
         if !self.p.shared_points {
             return 0;
         }
-        match self.stage {
+        match M::STAGE {
             Stage::Depth => {
                 let room = points_room(points.len(), total);
                 if group == 0 {
@@ -535,10 +510,10 @@ impl DomKernel {
     }
 }
 
-impl CpuKernel for DomKernel {
+impl<M: MapPass> CpuKernel for DomKernel<M> {
     fn run_workgroup(&self, group: u32, ctx: &Ctx<'_>) {
         let depth = ctx.words("dom_depth");
-        let layers_map = match self.stage {
+        let layers_map = match M::STAGE {
             Stage::Depth => depth,
             Stage::Opacity => ctx.words("dom_layers"),
         };
@@ -562,7 +537,7 @@ impl CpuKernel for DomKernel {
             // Strand s's slot: point k at words slot + 3k.
             let slot = POINTS_HEADER + s as usize * room as usize * 3;
             let kept = c <= room;
-            if self.stage == Stage::Opacity && kept {
+            if M::STAGE == Stage::Opacity && kept {
                 let point = |k: usize| {
                     let w = slot + 3 * k;
                     [0, 1, 2].map(|i| f32::from_bits(points.load(w + i)))
@@ -571,7 +546,7 @@ impl CpuKernel for DomKernel {
                     self.walk_segment(maps, &lights, (point(k), point(k + 1)), amount);
                 }
             } else {
-                let keep = self.stage == Stage::Depth && kept;
+                let keep = M::STAGE == Stage::Depth && kept;
                 let store = |k: usize, p: [f32; 3]| {
                     for (i, v) in p.into_iter().enumerate() {
                         points.store(slot + 3 * k + i, v.to_bits());
