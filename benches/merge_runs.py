@@ -12,13 +12,22 @@ from the later runs of the same device are added to it, replacing those it
 had on the backends the later runs measured; the notes say which runs.
 
     python3 benches/merge_runs.py --add "HW mesh" benches/results/h100.json ash/bench.json wgpu/bench.json
+
+With `--rows`, the runs are of one backend, each timing other rows (a
+bench whose rows run past one call's limit, split by `--row`): their cells
+are joined in order, and a row measured twice is an error.
+
+    python3 benches/merge_runs.py --rows first/bench.json rest/bench.json > benches/results/h200-lipp.json
 """
 import json
 import sys
 
 args = sys.argv[1:]
 add = None
-if args[:1] == ["--add"]:
+rows = args[:1] == ["--rows"]
+if rows:
+    args = args[1:]
+elif args[:1] == ["--add"]:
     add, args = args[1], args[2:]
 runs = [json.load(open(p)) for p in args]
 partial = [p for p, r in zip(args, runs) if r.get("partial")]
@@ -30,7 +39,17 @@ if len(devices) != 1:
     sys.exit(f"runs of different devices: {sorted(devices)}")
 out = dict(runs[0])
 backends = ", ".join(f"{d['backend']} ({r['elapsed_s']:.0f} s)" for r in runs[1 if add else 0:] for d in r["devices"])
-if add is None:
+if rows:
+    key = lambda c: (c["backend"], c["pipeline"], c["variant"], c["view"])
+    seen = set()
+    for c in (c for r in runs for c in r["cells"]):
+        if key(c) in seen:
+            sys.exit(f"measured in two runs: {key(c)}")
+        seen.add(key(c))
+    out["cells"] = [c for r in runs for c in r["cells"]]
+    out["elapsed_s"] = sum(r["elapsed_s"] for r in runs)
+    out["notes"] = out["notes"] + [f"rows joined from runs of one backend (benches/merge_runs.py --rows): {backends}"]
+elif add is None:
     for key in ("cells", "devices", "roofline", "notes"):
         out[key] = [x for r in runs for x in r[key]]
     out["elapsed_s"] = sum(r["elapsed_s"] for r in runs)
