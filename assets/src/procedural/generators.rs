@@ -322,7 +322,7 @@ mod tests {
     use super::*;
     use crate::mesh::Bvh;
     use crate::procedural::head::{BodyParams, HeadParams};
-    use crate::procedural::surface::Shape;
+    use crate::procedural::surface::{Region, Shape};
 
     fn head() -> Surface {
         Surface::procedural(Shape::Head(HeadParams {
@@ -441,6 +441,53 @@ mod tests {
         assert!(
             !scalp.roots().iter().any(|r| r.z > 0.06 && r.y < 0.06),
             "hair on the forehead"
+        );
+    }
+
+    #[test]
+    fn a_beard_thins_out_and_shortens_towards_its_edges() {
+        let surface = head();
+        let beard = grow(Style::Beard, 6000);
+        let fade = |p: Vec3| Region::Beard.fade(p - surface.center);
+        // The region's area within the fading band, against its roots there.
+        let (mut band, mut all) = (0.0, 0.0);
+        for t in 0..surface.mesh.triangle_count() {
+            let [a, b, c] = surface.mesh.corners(t);
+            let centre = (a + b + c) / 3.0 - surface.center;
+            if Region::Beard.contains(centre) {
+                all += surface.mesh.face_area(t);
+                if Region::Beard.fade(centre) < 0.5 {
+                    band += surface.mesh.face_area(t);
+                }
+            }
+        }
+        let roots = beard.roots();
+        let in_band = roots.iter().filter(|&&r| fade(r) < 0.5).count();
+        let (area_share, root_share) = (band / all, in_band as f32 / roots.len() as f32);
+        assert!(area_share > 0.1, "the band is {area_share} of the beard");
+        assert!(
+            root_share < 0.6 * area_share,
+            "{root_share} of the roots in {area_share} of the area"
+        );
+        let length = |s: usize| -> f32 {
+            beard
+                .strand(s)
+                .windows(2)
+                .map(|w| w[0].distance(w[1]))
+                .sum()
+        };
+        let mean = |keep: &dyn Fn(f32) -> bool| {
+            let l: Vec<f32> = (0..beard.strand_count())
+                .filter(|&s| keep(fade(beard.strand(s)[0])))
+                .map(length)
+                .collect();
+            assert!(!l.is_empty());
+            l.iter().sum::<f32>() / l.len() as f32
+        };
+        let (edge, inside) = (mean(&|f| f < 0.2), mean(&|f| f >= 1.0));
+        assert!(
+            edge < 0.6 * inside,
+            "edge strands {edge} m, inside {inside} m"
         );
     }
 

@@ -110,9 +110,17 @@ fn comb_direction(comb: Comb, p: Vec3, rng: &mut Pcg64Mcg) -> Vec3 {
     }
 }
 
+/// The length, as a fraction, of a strand rooted on a fading region's edge.
+const EDGE_LENGTH: f32 = 0.35;
+
 /// Grows one guide from `root` (head frame) with skin normal `normal`.
 pub fn grow(surface: &Surface, r: &Resolved, root: Vec3, normal: Vec3, rng: &mut Pcg64Mcg) -> Path {
-    let length = r.length * (1.0 - r.length_variation * 0.5 * rng.random::<f32>());
+    // Near a fading region's edge strands are shorter as well as sparser
+    // (Region::fade): a third of the length at the edge.
+    let fade = r.region.fade(root - surface.center);
+    let length = r.length
+        * (1.0 - r.length_variation * 0.5 * rng.random::<f32>())
+        * (EDGE_LENGTH + (1.0 - EDGE_LENGTH) * fade);
     let step = length / (GUIDE_POINTS - 1) as f32;
     let comb = comb_direction(r.comb, root - surface.center, rng)
         .reject_from(normal)

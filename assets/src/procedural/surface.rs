@@ -89,6 +89,23 @@ const BEARDLINE: [(f32, f32); 5] = [
     (1.3, -0.025),
 ];
 
+/// How far inside the beard's edges its density reaches full (ours): the
+/// upper edge over 16 mm on the cheeks and 3 mm over the moustache (only
+/// 4 mm tall: nose to lip), the sideburns' back edge over 0.18 rad of
+/// azimuth (about 14 mm), the neck over 20 mm. A beard thins out towards
+/// its edges rather than stopping at a line.
+const BEARD_FADE_TOP: [(f32, f32); 2] = [(0.35, 0.003), (0.8, 0.016)];
+const BEARD_FADE_SIDE: f32 = 0.18;
+const BEARD_FADE_NECK: f32 = 0.02;
+/// The beard's back edge (azimuth) and lowest root on the neck (y).
+const BEARD_AZIMUTH: f32 = 1.3;
+const BEARD_NECK: f32 = -0.135;
+
+fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
+    let t = ((x - edge0) / (edge1 - edge0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
 impl Region {
     /// Whether the surface point `p` (head frame, metres) is in the region.
     pub fn contains(self, p: Vec3) -> bool {
@@ -105,9 +122,9 @@ impl Region {
             Region::Beard => {
                 let lips = q.x < 0.029 && p.y < -0.047 && p.y > -0.078 && p.z > 0.07;
                 on_head
-                    && azimuth < 1.3
+                    && azimuth < BEARD_AZIMUTH
                     && !lips
-                    && p.y > -0.135
+                    && p.y > BEARD_NECK
                     && p.y < lerp_table(&BEARDLINE, azimuth)
             }
             Region::Eyebrows => {
@@ -124,6 +141,26 @@ impl Region {
                     && p.z > EYE_CENTRE.z + 0.004
             }
             Region::Everywhere => true,
+        }
+    }
+
+    /// How densely strands grow at `p` relative to the region's inside, and
+    /// how long they grow (ours; [`Surface::region_cdf`], `guides::grow`):
+    /// 1 everywhere but near the beard's upper edge, its sideburns' back
+    /// edge and its lower edge on the neck, where it falls smoothly to 0 at
+    /// the edge. The other regions keep hard edges (the scalp's hairline is
+    /// hidden by the hair it grows; eyebrows and lashes are narrow).
+    pub fn fade(self, p: Vec3) -> f32 {
+        match self {
+            Region::Beard => {
+                let q = Vec3::new(p.x.abs(), p.y, p.z);
+                let azimuth = q.x.atan2(q.z);
+                let top = lerp_table(&BEARDLINE, azimuth) - p.y;
+                smoothstep(0.0, lerp_table(&BEARD_FADE_TOP, azimuth), top)
+                    * smoothstep(0.0, BEARD_FADE_SIDE, BEARD_AZIMUTH - azimuth)
+                    * smoothstep(0.0, BEARD_FADE_NECK, p.y - BEARD_NECK)
+            }
+            _ => 1.0,
         }
     }
 }
@@ -196,14 +233,16 @@ impl Surface {
         }
     }
 
-    /// Area-weighted cumulative distribution over the triangles in `region`.
+    /// Cumulative distribution over the triangles in `region`, each weighted
+    /// by its area and the region's [`Region::fade`] at its centre.
     pub fn region_cdf(&self, region: Region) -> Vec<f32> {
         let mut acc = 0.0;
         (0..self.mesh.triangle_count())
             .map(|t| {
                 let [a, b, c] = self.mesh.corners(t);
-                if region.contains((a + b + c) / 3.0 - self.center) {
-                    acc += self.mesh.face_area(t);
+                let centre = (a + b + c) / 3.0 - self.center;
+                if region.contains(centre) {
+                    acc += self.mesh.face_area(t) * region.fade(centre);
                 }
                 acc
             })
