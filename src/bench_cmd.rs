@@ -10,6 +10,7 @@
 //! prepared for the row's graph; a graph that cannot run a scene gets its
 //! cells marked skipped with the reason.
 
+mod levels;
 mod pictures;
 mod progress;
 mod quality;
@@ -115,6 +116,12 @@ pub struct Args {
     /// each row does; the report notes it.
     #[arg(long, value_parser = clap::value_parser!(Barriers))]
     pub barriers: Option<Barriers>,
+    /// Also time each ash cell's frame level by level (as many frames
+    /// again): every batch's start and each dependency level's end, the
+    /// medians in bench.json's `levels`; where a frame's time goes with its
+    /// queues overlapping (docs/architecture.md, "Synchronisation").
+    #[arg(long)]
+    pub levels: bool,
 }
 
 /// `rel` under the working directory, else under the checkout the binary
@@ -609,11 +616,18 @@ fn measure(
     let inputs = animation.unwrap_or(&still);
     let (passes, totals) = frames(session.as_mut(), inputs, args)?;
     let bounds = bounds_frames(session.as_mut(), inputs, args)?;
+    let levels = if args.levels {
+        let next = args.warmup + 2 * args.frames;
+        levels::level_frames(session.as_mut(), inputs, next, args)?
+    } else {
+        Vec::new()
+    };
     runner::check_frame(&plan, &p.instance, session.as_ref())?;
     let mut stats = Stats::new(&passes, &totals, v.raster, atomics);
     if !bounds.is_empty() {
         stats.bounds = Some(report::Spread::of(&bounds));
     }
+    stats.levels = levels;
     // Read back only what a reference will be compared with, or
     // `--pictures` saves: the last frame; of an animated scene with a
     // reference, every timed frame, from a second run of the sequence (so

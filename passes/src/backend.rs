@@ -55,6 +55,28 @@ pub struct PassTime {
     pub counters: Option<CounterValues>,
 }
 
+/// One dependency level of one queue's batch (ash's barrier levels,
+/// docs/architecture.md, "Synchronisation"), timed by
+/// [`Session::run_levels_timed`]: its passes run side by side between two
+/// barriers, so a level's time is its slowest pass with the others beside
+/// it, and a queue's levels in a row show which chain sets the frame.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LevelTime {
+    /// The backend's queue it ran on, in the backend's numbering (ash: 0
+    /// for the graphics queue, 1 for async compute where the device has a
+    /// compute-only family; with one queue, every plan queue's passes share
+    /// 0 and its levels).
+    pub queue: usize,
+    /// Its batch on that queue (a batch ends where another queue waits).
+    pub batch: usize,
+    /// Its passes, in lane order.
+    pub passes: Vec<String>,
+    /// Begin and end in ms from the frame's first timestamp on any queue:
+    /// the batch's start after its waits (a first level) or the previous
+    /// level's end, then its own end.
+    pub span: (f64, f64),
+}
+
 /// A frame's time: first begin to last end where passes carry spans (queues
 /// overlap), else the sum of the passes.
 pub fn frame_millis(passes: &[PassTime]) -> f64 {
@@ -105,6 +127,17 @@ pub trait Session {
     /// own cost; this is the frame without them. `None` where the backend
     /// has no such mode (its frame time is [`frame_millis`] of `run`).
     fn run_frame_timed(&mut self, inputs: &Upload) -> Result<Option<f64>, BackendError> {
+        self.run(inputs).map(|_| None)
+    }
+    /// Runs one frame as [`Session::run`] does, with GPU timestamps only
+    /// where each batch begins and each of its dependency levels ends, and
+    /// returns the levels in lane order per queue: where the frame's time
+    /// goes with its queues overlapping, which per-pass queries prevent.
+    /// `None` where the backend has no such mode (only ash records levels).
+    fn run_levels_timed(
+        &mut self,
+        inputs: &Upload,
+    ) -> Result<Option<Vec<LevelTime>>, BackendError> {
         self.run(inputs).map(|_| None)
     }
     /// A copy of resource `name`'s words after the last frame (a version

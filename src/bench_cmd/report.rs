@@ -69,6 +69,8 @@ pub struct Stats {
     /// many frames run again so (ash; `None` where the backend times passes
     /// only): per-pass queries make a queue's passes wait for each other.
     pub bounds: Option<Spread>,
+    /// `bench --levels`: the frame's dependency levels, timed (ash).
+    pub levels: Vec<super::levels::LevelSpread>,
     /// The raster passes' summed time per frame.
     pub raster: Spread,
     /// Per pass, in plan order.
@@ -129,6 +131,7 @@ impl Stats {
             frames: frames.len(),
             total: Spread::of(totals),
             bounds: None,
+            levels: Vec::new(),
             raster: Spread::of(&raster_ms),
             passes,
             raster_atomics: atomics,
@@ -618,6 +621,9 @@ impl Report {
                         j["frame"] = st.total.json();
                         if let Some(b) = st.bounds {
                             j["frame_bounds"] = b.json();
+                        }
+                        if !st.levels.is_empty() {
+                            j["levels"] = st.levels.iter().map(|l| l.json()).collect();
                         }
                         j["raster"] = st.raster.json();
                         j["raster_passes"] = json!(v.raster);

@@ -53,6 +53,15 @@ impl api::Session for Session {
         Session::run_frame_timed(self, inputs).map_err(|e| BackendError::new("ash", e))
     }
 
+    fn run_levels_timed(
+        &mut self,
+        inputs: &Upload,
+    ) -> Result<Option<Vec<api::LevelTime>>, BackendError> {
+        Session::run_levels_timed(self, inputs)
+            .map(Some)
+            .map_err(|e| BackendError::new("ash", e))
+    }
+
     fn read(&self, name: &str) -> Result<Option<Vec<u32>>, BackendError> {
         Session::read(self, name).map_err(|e| BackendError::new("ash", e))
     }

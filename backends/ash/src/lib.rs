@@ -57,6 +57,7 @@ mod error;
 mod features;
 mod host;
 mod interface;
+mod level_timing;
 mod loader;
 mod memory;
 mod owned;

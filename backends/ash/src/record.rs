@@ -42,11 +42,20 @@ pub(crate) enum Stamps {
     /// Only before the lane's first pass (query 0) and after its last
     /// (query `2n - 1`): the frame with no query between its passes.
     Frame = 1,
+    /// At each batch's start, after its waits (query `2f` for the batch's
+    /// first position `f`), and after each of its levels' passes (`2f + 1
+    /// + k` for level `k`): the frame with its passes overlapping as they
+    /// do untimed, timed level by level ([`crate::level_timing`]).
+    Levels = 2,
+}
+
+impl Stamps {
+    pub const ALL: [Stamps; 3] = [Stamps::Passes, Stamps::Frame, Stamps::Levels];
 }
 
 pub(crate) struct Batch {
     /// The batch's command buffer per [`Stamps`] (indexed by it).
-    pub cmds: [vk::CommandBuffer; 2],
+    pub cmds: [vk::CommandBuffer; 3],
     /// Range of lane positions (0-based, inclusive).
     pub first: usize,
     pub last: usize,
@@ -156,12 +165,16 @@ pub(crate) fn make_lanes(gpu: &Gpu, plan: &Plan) -> Result<Lanes, AshError> {
         let info = vk::CommandBufferAllocateInfo::default()
             .command_pool(lane.pool.raw())
             .level(vk::CommandBufferLevel::PRIMARY)
-            .command_buffer_count(2 * lane.batches.len() as u32);
+            .command_buffer_count((Stamps::ALL.len() * lane.batches.len()) as u32);
         // SAFETY: valid pool; the buffers are freed with it.
         let cmds = unsafe { gpu.device.allocate_command_buffers(&info) }
             .ctx("vkAllocateCommandBuffers")?;
-        for (b, pair) in lane.batches.iter_mut().zip(cmds.chunks_exact(2)) {
-            b.cmds = [pair[0], pair[1]];
+        for (b, set) in lane
+            .batches
+            .iter_mut()
+            .zip(cmds.chunks_exact(Stamps::ALL.len()))
+        {
+            b.cmds = [set[0], set[1], set[2]];
         }
     }
     Ok(Lanes { lanes, lane_of })
@@ -262,7 +275,7 @@ fn batches(l: usize, order: &[When], points: &[Point]) -> Vec<Batch> {
                 }
             }
             out.push(Batch {
-                cmds: [vk::CommandBuffer::null(); 2],
+                cmds: [vk::CommandBuffer::null(); 3],
                 first: start,
                 last: i,
                 waits,
@@ -354,22 +367,29 @@ pub(crate) fn record_all(
         let pool = timestamps.pool(lane.queue);
         let n = lane.passes.len();
         for (b, batch) in lane.batches.iter().enumerate() {
-            for stamps in [Stamps::Passes, Stamps::Frame] {
+            for stamps in Stamps::ALL {
                 let cmd = batch.cmds[stamps as usize];
                 let begin = vk::CommandBufferBeginInfo::default();
                 // SAFETY: a fresh command buffer from this lane's pool.
                 unsafe { d.begin_command_buffer(cmd, &begin) }.ctx("vkBeginCommandBuffer")?;
                 // The queries this batch writes: (reset range, per-pass stamps).
+                let own = (2 * batch.first, 2 * (batch.last - batch.first + 1));
                 let (reset, per_pass) = match stamps {
-                    Stamps::Passes => ((2 * batch.first, 2 * (batch.last - batch.first + 1)), true),
+                    Stamps::Passes | Stamps::Levels => (own, stamps == Stamps::Passes),
                     Stamps::Frame if b == 0 => ((0, 2 * n), false),
                     Stamps::Frame => ((0, 0), false),
                 };
                 let bottom = vk::PipelineStageFlags2::BOTTOM_OF_PIPE;
+                // Stamps::Frame's first query, or Stamps::Levels' batch start.
+                let start = match stamps {
+                    Stamps::Frame => Some(0),
+                    Stamps::Levels => Some(2 * batch.first as u32),
+                    Stamps::Passes => None,
+                };
                 if let Some(qp) = pool.filter(|_| reset.1 > 0) {
                     // SAFETY: outside any render pass.
                     unsafe { d.cmd_reset_query_pool(cmd, qp, reset.0 as u32, reset.1 as u32) };
-                    if stamps == Stamps::Frame {
+                    if let Some(query) = start {
                         // ALL_COMMANDS, not TOP_OF_PIPE: in a semaphore
                         // wait's second scope TOP_OF_PIPE means no stage, so
                         // a TOP_OF_PIPE stamp first in the batch may be
@@ -377,10 +397,10 @@ pub(crate) fn record_all(
                         // ends, and the frame would include them.
                         let after_wait = vk::PipelineStageFlags2::ALL_COMMANDS;
                         // SAFETY: recording; the query was just reset.
-                        unsafe { d.cmd_write_timestamp2(cmd, after_wait, qp, 0) };
+                        unsafe { d.cmd_write_timestamp2(cmd, after_wait, qp, query) };
                     }
                 }
-                for level in &batch.levels {
+                for (k, level) in batch.levels.iter().enumerate() {
                     let before: Vec<Barrier> = level
                         .iter()
                         .flat_map(|&i| sync.before[lane.passes[i]].iter().copied())
@@ -390,6 +410,11 @@ pub(crate) fn record_all(
                         let built = built_pass(plan, pipelines, lane.passes[i])?;
                         let qp = pool.filter(|_| per_pass);
                         record_pass(d, cmd, built, memory, sync, qp.map(|qp| (qp, 2 * i as u32)));
+                    }
+                    if let Some(qp) = pool.filter(|_| stamps == Stamps::Levels) {
+                        let query = (2 * batch.first + 1 + k) as u32;
+                        // SAFETY: recording; reset at this buffer's start.
+                        unsafe { d.cmd_write_timestamp2(cmd, bottom, qp, query) };
                     }
                     let after: Vec<Barrier> = level
                         .iter()

@@ -41,7 +41,7 @@ impl Session {
         Ok(span)
     }
 
-    fn run_with(&mut self, inputs: &Upload, stamps: Stamps) -> Result<(), AshError> {
+    pub(crate) fn run_with(&mut self, inputs: &Upload, stamps: Stamps) -> Result<(), AshError> {
         self.stage_inputs(inputs)?;
         let prologue = self.record_prologue(inputs)?;
         self.submit_prologue(prologue)?;

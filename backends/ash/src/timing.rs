@@ -100,21 +100,27 @@ impl Timestamps {
         let mask = self.mask(q);
         let mut ticks = [0u64; 2];
         for (t, query) in ticks.iter_mut().zip([a, b]) {
-            let mut one = [0u64; 1];
-            // SAFETY: the frame that wrote the query has completed (the
-            // host waited on every queue's timeline before reading).
-            unsafe {
-                gpu.device.get_query_pool_results(
-                    pool.raw(),
-                    query,
-                    &mut one,
-                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-                )
-            }
-            .ctx("vkGetQueryPoolResults")?;
-            *t = one[0] & mask;
+            *t = read_query(gpu, pool.raw(), query)? & mask;
         }
         Ok(Some((ticks[0], ticks[1])))
+    }
+
+    /// Queries `queries` of queue `q`'s pool, masked to the valid bits: only
+    /// written ones (a reset query never written would be waited for).
+    pub fn read_some(
+        &self,
+        gpu: &Gpu,
+        q: usize,
+        queries: impl Iterator<Item = u32>,
+    ) -> Result<Option<Vec<u64>>, AshError> {
+        let Some((pool, _)) = &self.pools[q] else {
+            return Ok(None);
+        };
+        let mask = self.mask(q);
+        let ticks: Result<Vec<u64>, AshError> = queries
+            .map(|query| read_query(gpu, pool.raw(), query).map(|t| t & mask))
+            .collect();
+        ticks.map(Some)
     }
 
     pub fn mask(&self, q: usize) -> u64 {
@@ -124,4 +130,22 @@ impl Timestamps {
             (1u64 << self.bits[q]) - 1
         }
     }
+}
+
+/// One query's ticks, waiting for it.
+fn read_query(gpu: &Gpu, pool: vk::QueryPool, query: u32) -> Result<u64, AshError> {
+    let mut one = [0u64; 1];
+    // SAFETY: the frame that wrote the query has completed (the host waited
+    // on every queue's timeline before reading), and callers read only
+    // queries that frame wrote.
+    unsafe {
+        gpu.device.get_query_pool_results(
+            pool,
+            query,
+            &mut one,
+            vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+        )
+    }
+    .ctx("vkGetQueryPoolResults")?;
+    Ok(one[0])
 }

@@ -125,3 +125,44 @@ fn int64_atomics_are_enabled_for_the_pass_that_needs_them() {
         "some atomicMin landed"
     );
 }
+
+/// A frame timed level by level ([`strandgraph_ash::Session::run_levels_timed`])
+/// under synchronization validation: every pass is in exactly one level,
+/// a batch's levels follow one another, and the frame's result is the
+/// frame's (the debug view has hair in it, as with per-pass stamps).
+#[test]
+fn a_frame_timed_level_by_level_lists_every_pass_once_in_order() {
+    let scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
+    let plan = compile_file(
+        &root().join("scenes/graphs/kulikov_visibility.ron"),
+        &Registry,
+        scene.counts().models as u32,
+    )
+    .unwrap();
+    let up = upload(&scene, 96, 54);
+    let instance = plan.instantiate(&up.quantities).unwrap();
+    let mut session = validated()
+        .open(&plan, &instance)
+        .unwrap_or_else(|e| panic!("{e}"));
+    session.run(&up).unwrap_or_else(|e| panic!("{e}"));
+    let levels = session
+        .run_levels_timed(&up)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let mut named: Vec<&str> = levels
+        .iter()
+        .flat_map(|l| l.passes.iter().map(String::as_str))
+        .collect();
+    named.sort_unstable();
+    let mut live: Vec<&str> = plan.order.iter().map(|&p| plan.pass_name(p)).collect();
+    live.sort_unstable();
+    assert_eq!(named, live, "each live pass in one level");
+    for pair in levels.windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        assert!(a.span.0 >= 0.0 && a.span.0 <= a.span.1, "{a:?}");
+        if (a.queue, a.batch) == (b.queue, b.batch) {
+            assert_eq!(a.span.1, b.span.0, "{b:?} begins where {a:?} ends");
+        }
+    }
+    let layers = session.read("debug_layers").unwrap().unwrap();
+    assert!(layers.iter().any(|&w| w >> 24 != 0));
+}
