@@ -5,11 +5,11 @@
 //! the workspace root.
 
 use std::path::Path;
-use strandgraph_ash::{AshBackend, Validation};
+use strandgraph_ash::{AshBackend, Session, Validation};
 use strandgraph_assets::Scene;
-use strandgraph_graph::compile_file;
+use strandgraph_graph::{Plan, compile_file};
 use strandgraph_passes::Registry;
-use strandgraph_passes::upload::upload;
+use strandgraph_passes::upload::{Upload, upload};
 
 fn root() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
@@ -22,8 +22,8 @@ fn validated() -> AshBackend {
     }
 }
 
-#[test]
-fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
+/// The showcase's Kulikov visibility graph at 96x54, opened validated.
+fn visibility_session() -> (Plan, Upload, Session) {
     let scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
     let plan = compile_file(
         &root().join("scenes/graphs/kulikov_visibility.ron"),
@@ -33,9 +33,15 @@ fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
     .unwrap();
     let up = upload(&scene, 96, 54);
     let instance = plan.instantiate(&up.quantities).unwrap();
-    let mut session = validated()
+    let session = validated()
         .open(&plan, &instance)
         .unwrap_or_else(|e| panic!("{e}"));
+    (plan, up, session)
+}
+
+#[test]
+fn visibility_graph_runs_clean_under_sync_validation_for_two_frames() {
+    let (plan, up, mut session) = visibility_session();
     for n in &session.notes {
         eprintln!("ash: {n}");
     }
@@ -132,18 +138,7 @@ fn int64_atomics_are_enabled_for_the_pass_that_needs_them() {
 /// frame's (the debug view has hair in it, as with per-pass stamps).
 #[test]
 fn a_frame_timed_level_by_level_lists_every_pass_once_in_order() {
-    let scene = Scene::load(&root().join("scenes/showcase.ron")).unwrap();
-    let plan = compile_file(
-        &root().join("scenes/graphs/kulikov_visibility.ron"),
-        &Registry,
-        scene.counts().models as u32,
-    )
-    .unwrap();
-    let up = upload(&scene, 96, 54);
-    let instance = plan.instantiate(&up.quantities).unwrap();
-    let mut session = validated()
-        .open(&plan, &instance)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let (plan, up, mut session) = visibility_session();
     session.run(&up).unwrap_or_else(|e| panic!("{e}"));
     let levels = session
         .run_levels_timed(&up)
