@@ -51,11 +51,13 @@ impl Session {
             for (b, (batch, ticks)) in lane.batches.iter().zip(batches).enumerate() {
                 let Some(ticks) = ticks else { continue };
                 for (k, level) in batch.levels.iter().enumerate() {
-                    let passes: Vec<_> = level.iter().map(|&i| lane.passes[i]).collect();
                     out.push(LevelTime {
                         queue: lane.queue,
                         batch: b,
-                        passes: passes.iter().map(|&p| g.passes[p].name.clone()).collect(),
+                        passes: level
+                            .iter()
+                            .map(|&i| g.passes[lane.passes[i]].name.clone())
+                            .collect(),
                         span: (ms(ticks[k]), ms(ticks[k + 1])),
                     });
                 }
