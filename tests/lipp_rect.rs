@@ -15,10 +15,12 @@
 //! output as with `lipp.lod_scan`'s `groom_rect` off (everything shaded
 //! and cleared).
 
+use std::collections::HashMap;
 use std::path::Path;
 use strandgraph::agree::capture;
 use strandgraph::frame::{Prepared, prepare_with};
 use strandgraph_cpu::CpuBackend;
+use strandgraph_graph::unroll::base_name;
 use strandgraph_passes::lipp::payload::EMPTY;
 use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 
@@ -45,23 +47,30 @@ fn grooms(scene: &str, graph: Option<&str>, (w, h): (u32, u32)) -> Vec<(Rect, us
     )
     .unwrap_or_else(|e| panic!("{scene}: {e:?}"));
     let mut out = Vec::new();
-    // The G-buffer as the pass after its clear found it, and whether the
-    // last pass that bound it was a clear.
-    let (mut cleared, mut after_clear): (Option<Vec<u32>>, bool) = (None, false);
+    // Per groom (its G-buffer is its own copy of the transient, and the
+    // compiler may interleave the grooms' passes): the G-buffer as the pass
+    // after its clear found it, and whether the groom's last pass that
+    // bound it was a clear.
+    let mut cleared: HashMap<usize, Vec<u32>> = HashMap::new();
+    let mut after_clear: HashMap<usize, bool> = HashMap::new();
     for c in capture(&p).unwrap_or_else(|e| panic!("{scene}: {e:?}")) {
         let kind = p.plan.graph.passes[c.pass].kind.as_str();
+        let groom = groom_of(p.plan.pass_name(c.pass));
         let words = |name: &str| c.bindings.iter().find(|(n, _)| n == name).map(|b| &b.1);
         let Some(g) = words("gbuffer") else { continue };
-        if after_clear {
-            cleared = Some(g.clone());
+        if after_clear.get(&groom) == Some(&true) {
+            cleared.insert(groom, g.clone());
         }
-        after_clear = kind.ends_with("clear") || kind == "lipp.clear_gbuffer";
+        after_clear.insert(
+            groom,
+            kind.ends_with("clear") || kind == "lipp.clear_gbuffer",
+        );
         if kind != "lipp.shade" {
             continue;
         }
         let args = words("raster_args").expect("lipp.shade binds raster_args");
         let rect = Rect::from_args(args[ARGS_RECT_LO], args[ARGS_RECT_HI]);
-        let before = cleared.as_ref().expect("a clear before lipp.shade");
+        let before = cleared.get(&groom).expect("a clear before lipp.shade");
         let pixels = (w * h) as usize;
         let mut samples = 0;
         for (slot, pair) in g.chunks_exact(2).enumerate() {
@@ -82,6 +91,17 @@ fn grooms(scene: &str, graph: Option<&str>, (w, h): (u32, u32)) -> Vec<(Rect, us
     }
     assert!(!out.is_empty(), "{scene}: no lipp.shade pass ran");
     out
+}
+
+/// The groom a per-model pass copy draws: k of `name[k]`, 0 for a plain
+/// name (graph/src/unroll.rs).
+fn groom_of(pass: &str) -> usize {
+    let base = base_name(pass);
+    pass[base.len()..]
+        .trim_start_matches('[')
+        .trim_end_matches(']')
+        .parse()
+        .unwrap_or(0)
 }
 
 fn area(r: &Rect) -> u32 {
