@@ -20,6 +20,7 @@ mod variants;
 use miette::{Result, miette};
 use progress::Progress;
 use report::{Ceilings, Cell, Report, Stats};
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -30,6 +31,7 @@ use strandgraph::runner::{
 };
 use strandgraph::sequence;
 use strandgraph_assets::Scene;
+use strandgraph_graph::alias::Aliasing;
 use strandgraph_graph::schema::Quantity;
 use strandgraph_passes::bench::RasterBenchParams;
 use strandgraph_passes::params::check;
@@ -116,6 +118,11 @@ pub struct Args {
     /// each row does; the report notes it.
     #[arg(long, value_parser = clap::value_parser!(Barriers))]
     pub barriers: Option<Barriers>,
+    /// Plan transient memory as this says (first-fit or no-new-waits;
+    /// docs/architecture.md, "Synchronisation") rather than as each row
+    /// does; the report notes it.
+    #[arg(long, value_parser = clap::value_parser!(Aliasing))]
+    pub aliasing: Option<Aliasing>,
     /// Also time each ash cell's frame level by level (as many frames
     /// again): every batch's start and each dependency level's end, the
     /// medians in bench.json's `levels`; where a frame's time goes with its
@@ -285,6 +292,9 @@ pub fn run(mut args: Args) -> Result<()> {
     }
     if let Some(b) = args.barriers {
         report.note(format!("--barriers {b} on every row (ash's barriers)"));
+    }
+    if let Some(a) = args.aliasing {
+        report.note(format!("--aliasing {a} on every row (the memory plan)"));
     }
     if args.quick {
         report.note(format!(
@@ -604,13 +614,19 @@ fn measure(
     atomics: u64,
     animation: Option<&[Upload]>,
 ) -> Result<(String, Vec<String>, Stats, Vec<Picture>)> {
-    let plan = variant_plan(p, v, &args.params)?;
+    let mut plan = variant_plan(p, v, &args.params)?;
+    plan.aliasing = args.aliasing.unwrap_or(v.backend.aliasing);
+    // The scene's instance was planned with the default aliasing.
+    let instance = match plan.aliasing == p.plan.aliasing {
+        true => Cow::Borrowed(&p.instance),
+        false => Cow::Owned(plan.instantiate(&p.upload.quantities)?),
+    };
     let cpu = OpenOptions {
         loop_counters: args.loop_counters.unwrap_or(v.backend.loop_counters),
         barriers: args.barriers.unwrap_or(v.backend.barriers),
         ..cpu
     };
-    let mut session = runner::open(backend, &plan, &p.instance, cpu)?;
+    let mut session = runner::open(backend, &plan, &instance, cpu)?;
     // A still scene: a game's frames at 60 fps, the simulation stepping.
     let still = [sequence::running(&p.upload, FPS)];
     let inputs = animation.unwrap_or(&still);

@@ -3,6 +3,7 @@
 use miette::{IntoDiagnostic, Result, WrapErr};
 use std::path::PathBuf;
 use strandgraph_assets::{Scene, SceneCounts};
+use strandgraph_graph::alias::Aliasing;
 use strandgraph_graph::{Quantities, compile_file, export, report};
 use strandgraph_passes::Registry;
 
@@ -29,6 +30,10 @@ pub struct Args {
     /// triangles, lights, width, height.
     #[arg(long = "set", value_name = "NAME=VALUE")]
     pub set: Vec<String>,
+    /// Which transients share bytes: first-fit or no-new-waits
+    /// (docs/architecture.md, "Synchronisation").
+    #[arg(long, default_value = "first-fit", value_parser = clap::value_parser!(Aliasing))]
+    pub aliasing: Aliasing,
     /// Do not print the readable plan (useful with --dot/--json -).
     #[arg(long, short)]
     pub quiet: bool,
@@ -49,7 +54,8 @@ pub fn run(args: Args) -> Result<()> {
         .map_or_else(Quantities::example, |s| from_scene(s.counts()));
     let quantities = quantities(base, &args.set)?;
     let models = u32::try_from(quantities.models).unwrap_or(u32::MAX);
-    let plan = compile_file(&file, &Registry, models)?;
+    let mut plan = compile_file(&file, &Registry, models)?;
+    plan.aliasing = args.aliasing;
     let instance = plan.instantiate(&quantities)?;
     tracing::info!(
         passes = plan.order.len(),

@@ -10,6 +10,7 @@ use strandgraph::images::{
 };
 use strandgraph::runner::{self, Barriers, LoopCounters, OpenOptions, PassTime, frame_millis};
 use strandgraph_graph::Plan;
+use strandgraph_graph::alias::Aliasing;
 use strandgraph_passes::backend::Clock;
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -86,6 +87,11 @@ pub struct Args {
     /// the next) or per-pass (docs/architecture.md, "Synchronisation").
     #[arg(long, default_value = "levels", value_parser = clap::value_parser!(Barriers))]
     pub barriers: Barriers,
+    /// Which transients share bytes: first-fit (any whose lifetimes do not
+    /// overlap) or no-new-waits (only where the data flow already orders
+    /// them; docs/architecture.md, "Synchronisation").
+    #[arg(long, default_value = "first-fit", value_parser = clap::value_parser!(Aliasing))]
+    pub aliasing: Aliasing,
     /// The display transform of PNG outputs (EXR stays scene-linear).
     #[arg(long, value_enum, default_value = "aces")]
     pub tonemap: Tonemap,
@@ -112,6 +118,10 @@ pub fn run(args: Args) -> Result<()> {
         miette::bail!("--fps {}: expected a rate in (0, 1000]", args.fps);
     }
     let mut p = prepare_with(&scene, args.graph.as_deref(), size, &args.params)?;
+    if args.aliasing != p.plan.aliasing {
+        p.plan.aliasing = args.aliasing;
+        p.instance = p.plan.instantiate(&p.upload.quantities)?;
+    }
     let q = p.upload.quantities;
     println!(
         "scene {}: {} models, {} strands, {} segments, {}x{}; graph `{}`; prepared in {:.0} ms",

@@ -222,12 +222,15 @@ fn showcase_composed_matches_cpu_on_ash() {
 /// change no bit of the frame: Kulikov's and Lipp's pictures are the same
 /// with a barrier before each pass, with the plan's aliasing (whose
 /// hand-overs the levels must respect) and synchronization validation on.
-/// lavapipe has one queue, so its levels mix both queues' passes.
+/// Nor does aliasing that adds no wait (`Aliasing::NoNewWaits`), which
+/// drops hand-overs. lavapipe has one queue, so its levels mix both
+/// queues' passes.
 #[test]
 fn barrier_levels_change_no_bit_of_the_frame() {
     use strandgraph_ash::{AshBackend, Barriers};
+    use strandgraph_graph::alias::Aliasing;
     for (graph, output) in [("kulikov", "output.composed"), ("lipp", "output.final")] {
-        let p = prepare(
+        let mut p = prepare(
             &root().join("scenes/showcase.ron"),
             Some(&root().join(format!("scenes/graphs/{graph}.ron"))),
             Some((96, 54)),
@@ -244,15 +247,20 @@ fn barrier_levels_change_no_bit_of_the_frame() {
             read_ash(&s, output)
         };
         let (levels, per_pass) = (frame(Barriers::Levels), frame(Barriers::PerPass));
+        p.plan.aliasing = Aliasing::NoNewWaits;
+        p.instance = p.plan.instantiate(&p.upload.quantities).unwrap();
+        let no_new_waits = read_ash(&common::ash_with(&p, AshBackend::default()), output);
         assert!(
             levels.iter().any(|&w| w != levels[0]),
             "{graph}: a blank picture"
         );
-        let differ = levels.iter().zip(&per_pass).filter(|(a, b)| a != b).count();
-        assert_eq!(
-            differ, 0,
-            "{graph}: {differ} words differ between the barrier settings"
-        );
+        for (other, what) in [(&per_pass, "barrier"), (&no_new_waits, "aliasing")] {
+            let differ = levels.iter().zip(other).filter(|(a, b)| a != b).count();
+            assert_eq!(
+                differ, 0,
+                "{graph}: {differ} words differ between the {what} settings"
+            );
+        }
     }
 }
 

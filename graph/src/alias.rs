@@ -28,6 +28,51 @@ impl HeapKind {
     }
 }
 
+/// Which transients may take bytes an earlier one used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize)]
+pub enum Aliasing {
+    /// Any two whose lifetimes do not overlap.
+    #[default]
+    FirstFit,
+    /// Ours: only where the earlier one's users already come before the
+    /// later one's first user through the plan's own dependencies. Reused
+    /// bytes are a wait (ash's hand-over barrier makes the later one's
+    /// first user wait for the earlier one's users on its queue:
+    /// `SyncPlan::waits_on`), and a wait the data flow does not have
+    /// takes a pass out of a level it could share
+    /// (`Plan::reuse_adds_no_wait`).
+    NoNewWaits,
+}
+
+impl Aliasing {
+    /// The names `FromStr` takes.
+    pub const NAMES: [&'static str; 2] = ["first-fit", "no-new-waits"];
+}
+
+impl std::str::FromStr for Aliasing {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "first-fit" => Ok(Self::FirstFit),
+            "no-new-waits" => Ok(Self::NoNewWaits),
+            _ => Err(format!(
+                "unknown aliasing `{s}`; expected one of: {}",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Aliasing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::FirstFit => Self::NAMES[0],
+            Self::NoNewWaits => Self::NAMES[1],
+        })
+    }
+}
+
 /// A transient to place.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct AliasRequest {
@@ -78,6 +123,24 @@ fn align_up(x: u64, a: u64) -> u64 {
 }
 
 pub fn plan_memory(requests: &[AliasRequest]) -> MemoryPlan {
+    plan_memory_with(requests, &|_, _| true)
+}
+
+/// [`plan_memory`], where two transients whose lifetimes do not overlap
+/// share bytes only if `may_follow(earlier, later)` (resource ids) allows.
+pub fn plan_memory_with(
+    requests: &[AliasRequest],
+    may_follow: &dyn Fn(usize, usize) -> bool,
+) -> MemoryPlan {
+    // Whether bytes may pass from the earlier of two to the later; where
+    // not, they are kept apart as if both were alive at once.
+    let hands_over = |a: &AliasRequest, b: &AliasRequest| {
+        if a.end < b.first {
+            may_follow(a.resource, b.resource)
+        } else {
+            may_follow(b.resource, a.resource)
+        }
+    };
     let mut order: Vec<&AliasRequest> = requests.iter().collect();
     order.sort_by(|a, b| {
         b.size
@@ -89,7 +152,7 @@ pub fn plan_memory(requests: &[AliasRequest]) -> MemoryPlan {
     for req in order {
         let mut busy: Vec<(u64, u64)> = placed
             .iter()
-            .filter(|(o, _)| o.heap == req.heap && o.overlaps(req))
+            .filter(|(o, _)| o.heap == req.heap && (o.overlaps(req) || !hands_over(o, req)))
             .map(|(o, off)| (*off, off + o.size))
             .collect();
         busy.sort_unstable();
@@ -174,6 +237,26 @@ mod tests {
         assert_eq!(m.placements[0].offset, 0);
         assert_eq!(m.placements[1].offset, 1024);
         assert_eq!(m.lower_bound, 1100);
+    }
+
+    #[test]
+    fn a_reuse_the_rule_forbids_takes_bytes_of_its_own() {
+        // 1 may follow 0 in time, but not hand bytes over from it.
+        let reqs = [req(0, 1000, 0, 1), req(1, 1000, 2, 3)];
+        let m = plan_memory_with(&reqs, &|a, b| !(a == 0 && b == 1));
+        assert_eq!(m.placements[0].offset, 0);
+        assert_eq!(m.placements[1].offset, 1024);
+        assert_eq!(m.bytes_with_aliasing, 2024);
+        let m = plan_memory_with(&reqs, &|_, _| true);
+        assert_eq!(m.bytes_with_aliasing, 1000);
+    }
+
+    #[test]
+    fn aliasing_names_round_trip() {
+        for name in Aliasing::NAMES {
+            assert_eq!(name.parse::<Aliasing>().unwrap().to_string(), name);
+        }
+        assert!("first_fit".parse::<Aliasing>().is_err());
     }
 
     #[test]

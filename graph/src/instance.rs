@@ -1,9 +1,10 @@
 //! Instantiation: symbolic sizes resolved against a scene's quantities, then
 //! the memory plan.
 
-use crate::alias::{AliasRequest, HeapKind, MemoryPlan, plan_memory};
+use crate::alias::{AliasRequest, Aliasing, HeapKind, MemoryPlan, plan_memory, plan_memory_with};
 use crate::error::{ErrorKind, GraphError, GraphErrors};
 use crate::plan::Plan;
+use crate::reach::Reach;
 use crate::schema::{BufferSize, ImageSize, Quantity, ResourceDecl};
 use serde::{Deserialize, Serialize};
 
@@ -131,9 +132,35 @@ impl Plan {
             .collect();
         Ok(Instance {
             quantities: *q,
-            memory: plan_memory(&requests),
+            memory: self.plan_memory(&requests),
             sizes,
         })
+    }
+
+    /// Transients placed by [`Plan::aliasing`].
+    pub fn plan_memory(&self, requests: &[AliasRequest]) -> MemoryPlan {
+        match self.aliasing {
+            Aliasing::FirstFit => plan_memory(requests),
+            Aliasing::NoNewWaits => plan_memory_with(requests, &self.reuse_adds_no_wait()),
+        }
+    }
+
+    /// `(earlier, later)`: whether transient `later` can take `earlier`'s
+    /// bytes without a wait the plan's dependencies do not already make:
+    /// every pass that uses `earlier` comes before `later`'s first user
+    /// through them. A backend hands the bytes over with a barrier that
+    /// makes that first user wait for those passes ([`Aliasing::NoNewWaits`]).
+    pub fn reuse_adds_no_wait(&self) -> impl Fn(usize, usize) -> bool + '_ {
+        let edges = self.dependencies.iter().map(|d| (d.from, d.to));
+        let reach = Reach::new(self.graph.passes.len(), &self.order, edges);
+        let lifetime = |r: usize| self.lifetimes.iter().find(|l| l.resource == r);
+        move |earlier, later| match (lifetime(earlier), lifetime(later)) {
+            (Some(a), Some(b)) => {
+                let first = self.order[b.first];
+                a.uses.iter().all(|&(u, _)| reach.reaches(u, first))
+            }
+            _ => true,
+        }
     }
 }
 

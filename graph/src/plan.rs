@@ -1,5 +1,6 @@
 //! The compiler's entry points and its product, the [`Plan`].
 
+use crate::alias::Aliasing;
 use crate::cull::{Culled, cull};
 use crate::deps::analyse;
 use crate::error::{ErrorKind, GraphError, GraphErrors};
@@ -34,6 +35,10 @@ pub struct Plan {
     /// Transients used by live passes.
     pub lifetimes: Vec<Lifetime>,
     pub culled: Vec<Culled>,
+    /// Which transients may share bytes; [`Plan::instantiate`] and the
+    /// backends' re-placements plan memory with it (`Plan::plan_memory`).
+    /// Set it before instantiating.
+    pub aliasing: Aliasing,
 }
 
 impl Plan {
@@ -108,6 +113,7 @@ fn compile(
         sync_points: sched.sync_points,
         lifetimes,
         culled,
+        aliasing: Aliasing::default(),
         graph,
     })
 }

@@ -7,6 +7,7 @@
 use proptest::prelude::*;
 use proptest::sample::Index;
 use std::collections::{HashSet, VecDeque};
+use strandgraph_graph::alias::Aliasing;
 use strandgraph_graph::synthetic::{Spec, SynthPass};
 use strandgraph_graph::{Plan, Quantities, Queue, compile_str};
 
@@ -152,6 +153,18 @@ proptest! {
     }
 
     #[test]
+    fn without_new_waits_bytes_change_hands_only_along_the_data_flow(spec in spec()) {
+        let mut plan = compile(&spec);
+        plan.aliasing = Aliasing::NoNewWaits;
+        let m = plan.instantiate(&Quantities::example()).unwrap().memory;
+        for (p, q) in sharing_pairs(&plan, &m) {
+            prop_assert!(hands_over_without_a_new_wait(&plan, p, q),
+                "{} takes {}'s bytes, but a use of {} does not come before its first use",
+                plan.resource_name(q), plan.resource_name(p), plan.resource_name(p));
+        }
+    }
+
+    #[test]
     fn culling_keeps_every_pass_that_feeds_an_output(spec in spec()) {
         let plan = compile(&spec);
         // Pass i of the spec is pass i + 1 of the graph (pass 0 clears the counter).
@@ -169,6 +182,74 @@ proptest! {
             prop_assert!(!c.reason.is_empty());
         }
     }
+}
+
+/// Pairs of transients that share bytes, earlier lifetime first.
+fn sharing_pairs(plan: &Plan, m: &strandgraph_graph::alias::MemoryPlan) -> Vec<(usize, usize)> {
+    let first = |r: usize| {
+        plan.lifetimes
+            .iter()
+            .find(|l| l.resource == r)
+            .unwrap()
+            .first
+    };
+    let mut pairs = Vec::new();
+    for (i, p) in m.placements.iter().enumerate() {
+        for q in &m.placements[i + 1..] {
+            if p.heap == q.heap && p.offset < q.offset + q.size && q.offset < p.offset + p.size {
+                let (a, b) = if first(p.resource) < first(q.resource) {
+                    (p.resource, q.resource)
+                } else {
+                    (q.resource, p.resource)
+                };
+                pairs.push((a, b));
+            }
+        }
+    }
+    pairs
+}
+
+/// Every use of `earlier` reaches `later`'s first user along the plan's
+/// dependencies (its own search, not the compiler's reachability).
+fn hands_over_without_a_new_wait(plan: &Plan, earlier: usize, later: usize) -> bool {
+    let mut succ = vec![Vec::new(); plan.graph.passes.len()];
+    for d in &plan.dependencies {
+        succ[d.from].push(d.to);
+    }
+    let lifetime = |r: usize| plan.lifetimes.iter().find(|l| l.resource == r).unwrap();
+    let first = plan.order[lifetime(later).first];
+    lifetime(earlier)
+        .uses
+        .iter()
+        .all(|&(u, _)| happens_before(&succ, u, first))
+}
+
+#[test]
+fn first_fit_hands_bytes_between_independent_chains_and_no_new_waits_does_not() {
+    // Two chains on one queue, p0 -> p1 and p2 -> p3, each through a
+    // transient of the same size: the second chain's can reuse the first's
+    // bytes, which would make p2 wait for p1.
+    let pass = |reads: Vec<usize>| SynthPass {
+        queue: Queue::Graphics,
+        reads,
+        atomic: false,
+        size: 8,
+    };
+    let spec = Spec {
+        passes: vec![pass(vec![]), pass(vec![0]), pass(vec![]), pass(vec![2])],
+        outputs: vec![1, 3],
+    };
+    let mut plan = compile(&spec);
+    let shared = |plan: &Plan| {
+        let m = plan.instantiate(&Quantities::example()).unwrap().memory;
+        sharing_pairs(plan, &m)
+            .into_iter()
+            .filter(|&(a, b)| !hands_over_without_a_new_wait(plan, a, b))
+            .count()
+    };
+    assert!(shared(&plan) > 0, "{}", spec.to_ron());
+    plan.aliasing = Aliasing::NoNewWaits;
+    assert_eq!(shared(&plan), 0, "{}", spec.to_ron());
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! ablations, one published (or our own) optimisation switched off at a time.
 
 use strandgraph::runner::{Barriers, LoopCounters};
+use strandgraph_graph::alias::Aliasing;
 
 /// One row of the table: a pipeline configuration.
 #[derive(Debug, Clone, Copy)]
@@ -22,19 +23,23 @@ pub struct Variant {
     pub backend: RowBackend,
 }
 
-/// A row's settings of the GPU backends (`runner::OpenOptions`).
+/// A row's settings of the GPU backends (`runner::OpenOptions`) and of the
+/// memory plan they bind.
 #[derive(Debug, Clone, Copy)]
 pub struct RowBackend {
     /// Which passes' shaders get naga's loop counters.
     pub loop_counters: LoopCounters,
     /// How ash separates a queue's passes with barriers.
     pub barriers: Barriers,
+    /// Which transients share bytes (the plan's `aliasing`).
+    pub aliasing: Aliasing,
 }
 
 /// As the graph says and as the backends do by default.
 pub const DEFAULTS: RowBackend = RowBackend {
     loop_counters: LoopCounters::Graph,
     barriers: Barriers::Levels,
+    aliasing: Aliasing::FirstFit,
 };
 
 const KULIKOV: &str = "scenes/graphs/kulikov.ron";
@@ -116,6 +121,21 @@ pub const VARIANTS: &[Variant] = &[
         ceiling: "atomic_min32",
         backend: RowBackend {
             barriers: Barriers::PerPass,
+            ..DEFAULTS
+        },
+    },
+    // Ours, not yet the default (unmeasured on a GPU): transients share
+    // bytes only where the data flow already orders them (graph/src/alias.rs,
+    // `Aliasing::NoNewWaits`).
+    Variant {
+        pipeline: "Kulikov",
+        name: "aliasing that adds no wait",
+        graph: KULIKOV,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min32",
+        backend: RowBackend {
+            aliasing: Aliasing::NoNewWaits,
             ..DEFAULTS
         },
     },
@@ -494,6 +514,21 @@ pub const VARIANTS: &[Variant] = &[
         ceiling: "atomic_min64",
         backend: RowBackend {
             barriers: Barriers::PerPass,
+            ..DEFAULTS
+        },
+    },
+    // Ours, not yet the default (unmeasured on a GPU): transients share
+    // bytes only where the data flow already orders them (graph/src/alias.rs,
+    // `Aliasing::NoNewWaits`).
+    Variant {
+        pipeline: "Lipp",
+        name: "SWR 1+F+L, aliasing that adds no wait",
+        graph: LIPP,
+        overrides: &[],
+        raster: &["raster"],
+        ceiling: "atomic_min64",
+        backend: RowBackend {
+            aliasing: Aliasing::NoNewWaits,
             ..DEFAULTS
         },
     },

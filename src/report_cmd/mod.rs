@@ -90,6 +90,7 @@ fn bench_args(args: &Args, out: &Path) -> bench_cmd::Args {
         params: args.params.clone(),
         loop_counters: None,
         barriers: None,
+        aliasing: None,
         levels: false,
     }
 }

@@ -22,7 +22,7 @@ use crate::error::{AshError, VkContext};
 use crate::owned::Owned;
 use crate::placement::{Placements, alias_requests, placements_fit, sharing_bytes};
 use ash::vk;
-use strandgraph_graph::alias::{AliasRequest, HeapKind, plan_memory};
+use strandgraph_graph::alias::{AliasRequest, HeapKind};
 use strandgraph_graph::schema::{ImageFormat, ResourceDecl, Usage};
 use strandgraph_graph::{Instance, LifetimeClass, Plan};
 
@@ -346,7 +346,7 @@ impl Memory {
         let requests = alias_requests(plan, &reqs);
         mem.unaliased_bytes = requests.iter().map(|r| r.size).sum();
         if alias {
-            let placements = mem.placements(instance, &reqs, &requests);
+            let placements = mem.placements(plan, instance, &reqs, &requests);
             mem.bind_heaps(gpu, plan, &unbound, &placements, &requests)?;
         }
         mem.bind_separately(gpu, plan, &unbound, alias)?;
@@ -361,6 +361,7 @@ impl Memory {
     /// requirements, else re-planned with them (and a note saying so).
     fn placements(
         &mut self,
+        plan: &Plan,
         instance: &Instance,
         reqs: &[Option<vk::MemoryRequirements>],
         requests: &[AliasRequest],
@@ -380,7 +381,7 @@ impl Memory {
              transients were re-placed by the same planner with the real sizes and alignments"
                 .into(),
         );
-        plan_memory(requests)
+        plan.plan_memory(requests)
             .placements
             .iter()
             .map(|p| (p.resource, p.heap, p.offset))
