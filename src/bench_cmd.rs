@@ -617,9 +617,10 @@ fn measure(
     let mut plan = variant_plan(p, v, &args.params)?;
     plan.aliasing = args.aliasing.unwrap_or(v.backend.aliasing);
     // The scene's instance was planned with the default aliasing.
-    let instance = match plan.aliasing == p.plan.aliasing {
-        true => Cow::Borrowed(&p.instance),
-        false => Cow::Owned(plan.instantiate(&p.upload.quantities)?),
+    let instance = if plan.aliasing == p.plan.aliasing {
+        Cow::Borrowed(&p.instance)
+    } else {
+        Cow::Owned(plan.instantiate(&p.upload.quantities)?)
     };
     let cpu = OpenOptions {
         loop_counters: args.loop_counters.unwrap_or(v.backend.loop_counters),
@@ -638,7 +639,7 @@ fn measure(
     } else {
         Vec::new()
     };
-    runner::check_frame(&plan, &p.instance, session.as_ref())?;
+    runner::check_frame(&plan, &instance, session.as_ref())?;
     let mut stats = Stats::new(&passes, &totals, v.raster, atomics);
     if !bounds.is_empty() {
         stats.bounds = Some(report::Spread::of(&bounds));
@@ -652,10 +653,10 @@ fn measure(
     let judged = quality::reference_graph(v.pipeline).is_some();
     let pictures = match animation {
         Some(inputs) if judged => {
-            let mut again = runner::open(backend, &plan, &p.instance, cpu)?;
+            let mut again = runner::open(backend, &plan, &instance, cpu)?;
             let count = (args.warmup + args.frames).min(inputs.len());
             let inputs = &inputs[..count];
-            quality::sequence_pictures(again.as_mut(), &plan, &p.instance, inputs, args.warmup)?
+            quality::sequence_pictures(again.as_mut(), &plan, &instance, inputs, args.warmup)?
         }
         _ if args.pictures || judged => picture(&plan, q, session.as_ref()).into_iter().collect(),
         _ => Vec::new(),

@@ -20,7 +20,6 @@ use std::path::Path;
 use strandgraph::agree::capture;
 use strandgraph::frame::{Prepared, prepare_with};
 use strandgraph_cpu::CpuBackend;
-use strandgraph_graph::unroll::base_name;
 use strandgraph_passes::lipp::payload::EMPTY;
 use strandgraph_passes::lipp::rect::{ARGS_RECT_HI, ARGS_RECT_LO, Rect};
 
@@ -51,11 +50,12 @@ fn grooms(scene: &str, graph: Option<&str>, (w, h): (u32, u32)) -> Vec<(Rect, us
     // compiler may interleave the grooms' passes): the G-buffer as the pass
     // after its clear found it, and whether the groom's last pass that
     // bound it was a clear.
-    let mut cleared: HashMap<usize, Vec<u32>> = HashMap::new();
-    let mut after_clear: HashMap<usize, bool> = HashMap::new();
+    let mut cleared: HashMap<u32, Vec<u32>> = HashMap::new();
+    let mut after_clear: HashMap<u32, bool> = HashMap::new();
     for c in capture(&p).unwrap_or_else(|e| panic!("{scene}: {e:?}")) {
         let kind = p.plan.graph.passes[c.pass].kind.as_str();
-        let groom = groom_of(p.plan.pass_name(c.pass));
+        // Each unrolled copy carries its groom (graph/src/unroll.rs).
+        let groom = p.plan.graph.passes[c.pass].model_index.unwrap_or(0);
         let words = |name: &str| c.bindings.iter().find(|(n, _)| n == name).map(|b| &b.1);
         let Some(g) = words("gbuffer") else { continue };
         if after_clear.get(&groom) == Some(&true) {
@@ -91,17 +91,6 @@ fn grooms(scene: &str, graph: Option<&str>, (w, h): (u32, u32)) -> Vec<(Rect, us
     }
     assert!(!out.is_empty(), "{scene}: no lipp.shade pass ran");
     out
-}
-
-/// The groom a per-model pass copy draws: k of `name[k]`, 0 for a plain
-/// name (graph/src/unroll.rs).
-fn groom_of(pass: &str) -> usize {
-    let base = base_name(pass);
-    pass[base.len()..]
-        .trim_start_matches('[')
-        .trim_end_matches(']')
-        .parse()
-        .unwrap_or(0)
 }
 
 fn area(r: &Rect) -> u32 {
