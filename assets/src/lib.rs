@@ -51,3 +51,9 @@ pub use loaders::{LoadOptions, Units, load_groom, load_mesh};
 pub use mesh::TriMesh;
 
 pub use transform::Transform;
+
+/// Smooth 0 → 1 as `x` goes from `a` to `b` (GLSL's `smoothstep`).
+pub(crate) fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}

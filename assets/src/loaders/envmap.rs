@@ -22,6 +22,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use crate::error::{AssetError, FormatError, FormatErrorKind, Location};
+use crate::smoothstep;
 
 /// The widest map accepted (a probe keeps far less: the Lipp prefilter
 /// resamples to 128 × 64).
@@ -334,12 +335,6 @@ pub fn load(path: &Path) -> Result<EnvMap, AssetError> {
     let data = super::read_file(path)?;
     let _span = tracing::debug_span!("load_env_map", path = %path.display()).entered();
     parse(&data).map_err(|e| AssetError::format(path, e))
-}
-
-/// Smooth 0 → 1 as `x` goes from `a` to `b`.
-fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
-    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
 }
 
 /// A rectangular softbox seen from the origin: `centre` direction, half

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use super::head::{BodyParams, EYE_CENTRE, EYE_RADIUS, HeadParams};
 use super::sdf::gradient;
 use crate::mesh::TriMesh;
+use crate::smoothstep;
 
 /// The analytic shape behind a procedural mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -100,11 +101,6 @@ const BEARD_FADE_NECK: f32 = 0.02;
 /// The beard's back edge (azimuth) and lowest root on the neck (y).
 const BEARD_AZIMUTH: f32 = 1.3;
 const BEARD_NECK: f32 = -0.135;
-
-fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
-    let t = ((x - edge0) / (edge1 - edge0)).clamp(0.0, 1.0);
-    t * t * (3.0 - 2.0 * t)
-}
 
 impl Region {
     /// Whether the surface point `p` (head frame, metres) is in the region.
